@@ -1,0 +1,24 @@
+//! `gather`: one invocation sums the load on one grain in a fixed order (gravity, the pairs
+//! it owns, the pairs where it is partner, its wall contacts). No float atomics, so the result
+//! does not depend on scheduling.
+
+use super::pairs::PairList;
+use super::state::{Load, Props};
+use crate::model::ContactForce;
+use crate::real::{Real, Vec3};
+
+/// `gather` for grain `i`.
+#[inline]
+pub fn gather<T: Real>(i: usize, pairs: &PairList, out: &[ContactForce<T>], wall: &Load<T>, p: &Props<T>, gravity: Vec3<T>) -> Load<T> {
+    let mut force = gravity * p.mass;
+    let mut torque = Vec3::ZERO;
+    for k in pairs.owner_start[i] as usize..pairs.owner_start[i + 1] as usize {
+        force += out[k].f_i;
+        torque += out[k].t_i;
+    }
+    for &k in &pairs.rev_pair[pairs.rev_start[i] as usize..pairs.rev_start[i + 1] as usize] {
+        force += out[k as usize].f_j;
+        torque += out[k as usize].t_j;
+    }
+    Load { force: force + wall.force, torque: torque + wall.torque }
+}

@@ -1,0 +1,136 @@
+//! `hash_cells` and `detect_pairs`: cell hashing by counting sort and Verlet-list pair
+//! detection. One invocation of `detect_pairs` lists the pairs one grain owns.
+
+use super::reduce::chunked;
+use super::state::{Body, Props};
+use crate::real::{Real, Vec3};
+
+/// A uniform grid over the grains' bounding box with grains sorted by cell.
+#[derive(Clone, Debug, Default)]
+pub struct CellGrid<T> {
+    /// Lower corner (m).
+    pub origin: Vec3<T>,
+    /// Cell edge (m), at least the largest pair cut-off.
+    pub cell: T,
+    /// Cells per axis.
+    pub dims: [u32; 3],
+    /// `cell_start[c]..cell_start[c + 1]` indexes `cell_grains` for cell `c`.
+    pub cell_start: Vec<u32>,
+    /// Grain indices sorted by cell, ascending within a cell.
+    pub cell_grains: Vec<u32>,
+}
+
+/// Most cells per grain the grid may have; a sparse scene gets larger cells instead.
+pub const MAX_CELLS_PER_GRAIN: f64 = 8.0;
+
+impl<T: Real> CellGrid<T> {
+    /// Cell coordinates of a position, clamped to the grid.
+    #[inline(always)]
+    pub fn coords(&self, p: Vec3<T>) -> [u32; 3] {
+        let q = [(p.x - self.origin.x) / self.cell, (p.y - self.origin.y) / self.cell, (p.z - self.origin.z) / self.cell];
+        let mut c = [0u32; 3];
+        for a in 0..3 {
+            // `as` saturates: NaN -> 0, +inf -> u32::MAX, then clamped.
+            c[a] = (q[a].floor().f64() as u32).min(self.dims[a] - 1);
+        }
+        c
+    }
+    /// Linear cell index of cell coordinates.
+    #[inline(always)]
+    pub fn index(&self, c: [u32; 3]) -> usize {
+        (c[0] as usize) + self.dims[0] as usize * ((c[1] as usize) + self.dims[1] as usize * c[2] as usize)
+    }
+}
+
+/// `hash_cells`: sizes the grid to the grains' bounding box with cells at least `cutoff`
+/// wide, and sorts grain indices by cell (counting sort: count, exclusive scan, stable
+/// scatter). Returns `false` when a position is not finite.
+pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, grid: &mut CellGrid<T>) -> bool {
+    let bounds = chunked(body.len(), |r| {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut finite = true;
+        for b in &body[r] {
+            finite &= b.pos.is_finite();
+            let p = b.pos.f64();
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        (lo, hi, finite)
+    });
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for (l, h, finite) in bounds {
+        if !finite {
+            return false;
+        }
+        for a in 0..3 {
+            lo[a] = lo[a].min(l[a]);
+            hi[a] = hi[a].max(h[a]);
+        }
+    }
+    let mut cell = cutoff.f64();
+    let cap = (MAX_CELLS_PER_GRAIN * body.len() as f64).max(64.0);
+    let dims = loop {
+        let d: Vec<f64> = (0..3).map(|a| ((hi[a] - lo[a]) / cell).floor() + 1.0).collect();
+        if d[0] * d[1] * d[2] <= cap {
+            break [d[0] as u32, d[1] as u32, d[2] as u32];
+        }
+        cell *= 1.25;
+    };
+    grid.origin = Vec3::of(lo);
+    grid.cell = T::of(cell);
+    grid.dims = dims;
+    let n_cells = (dims[0] * dims[1] * dims[2]) as usize;
+    let cells: Vec<u32> = {
+        let g = &*grid;
+        chunked(body.len(), |r| body[r].iter().map(|b| g.index(g.coords(b.pos)) as u32).collect::<Vec<u32>>()).concat()
+    };
+    grid.cell_start.clear();
+    grid.cell_start.resize(n_cells + 1, 0);
+    for &c in &cells {
+        grid.cell_start[c as usize + 1] += 1;
+    }
+    for c in 0..n_cells {
+        grid.cell_start[c + 1] += grid.cell_start[c];
+    }
+    let mut cursor = grid.cell_start[..n_cells].to_vec();
+    grid.cell_grains.clear();
+    grid.cell_grains.resize(body.len(), 0);
+    for (i, &c) in cells.iter().enumerate() {
+        grid.cell_grains[cursor[c as usize] as usize] = i as u32;
+        cursor[c as usize] += 1;
+    }
+    true
+}
+
+/// `detect_pairs` for grain `i`: appends to `out` every grain `j` with a higher permanent id
+/// whose surface is within `skin` of i's (`|r_i - r_j| < R_i + R_j + skin`), in ascending id
+/// order, so that the list does not depend on the grid.
+#[inline]
+pub fn detect_pairs<T: Real>(i: usize, body: &[Body<T>], prop: &[Props<T>], id: &[u32], grid: &CellGrid<T>, skin: T, out: &mut Vec<u32>) {
+    let start = out.len();
+    let c = grid.coords(body[i].pos);
+    let lo = |a: usize| c[a].saturating_sub(1);
+    let hi = |a: usize| (c[a] + 1).min(grid.dims[a] - 1);
+    for z in lo(2)..=hi(2) {
+        for y in lo(1)..=hi(1) {
+            for x in lo(0)..=hi(0) {
+                let cell = grid.index([x, y, z]);
+                for &j in &grid.cell_grains[grid.cell_start[cell] as usize..grid.cell_start[cell + 1] as usize] {
+                    let j = j as usize;
+                    if id[j] <= id[i] {
+                        continue;
+                    }
+                    let reach = prop[i].radius + prop[j].radius + skin;
+                    if (body[i].pos - body[j].pos).norm2() < reach * reach {
+                        out.push(j as u32);
+                    }
+                }
+            }
+        }
+    }
+    out[start..].sort_unstable_by_key(|&j| id[j as usize]);
+}

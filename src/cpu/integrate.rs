@@ -1,0 +1,37 @@
+//! `integrate`: kicks (velocity updates) and drifts (position and orientation updates) of
+//! one grain. Velocity Verlet and seed 000's optimised velocity Verlet are sequences of these.
+
+use super::state::{Body, Load, Props};
+use crate::real::{Real, Vec3};
+
+/// Kick: `v += F/m tau`, `w += T/I tau` (spheres: the inertia is isotropic, so the world-frame
+/// torque needs no body-frame transform).
+#[inline(always)]
+pub fn kick<T: Real>(b: &mut Body<T>, l: &Load<T>, p: &Props<T>, tau: T) {
+    b.vel += l.force * (tau / p.mass);
+    b.omega += l.torque * (tau / p.inertia);
+}
+
+/// Drift: `x += v tau`. Returns the squared displacement since the last neighbour build.
+#[inline(always)]
+pub fn drift<T: Real>(b: &mut Body<T>, built_at: Vec3<T>, tau: T) -> T {
+    b.pos += b.vel * tau;
+    (b.pos - built_at).norm2()
+}
+
+/// Omelyan's norm-preserving rotation of a unit quaternion (scalar first) by the world-frame
+/// angular velocity `w` over `tau` (seed 000 eqs. 16-18):
+/// `q' = ((1 - a) q + tau/2 (0, w) * q) / (1 + a)`, `a = tau^2 |w|^2 / 16`. The body-frame
+/// form of eq. 18, `Q(w_b) q`, equals `1/2 (0, w) * q` because `w = q w_b q*`.
+#[inline(always)]
+pub fn rotate<T: Real>(q: [T; 4], w: Vec3<T>, tau: T) -> [T; 4] {
+    let a = tau * tau * w.norm2() / T::of(16.0);
+    let h = tau * T::of(0.5);
+    let qv = Vec3::new(q[1], q[2], q[3]);
+    // (0, w) * (q0, qv) = (-w.qv, q0 w + w x qv)
+    let s = -w.dot(qv);
+    let v = w * q[0] + w.cross(qv);
+    let inv = T::ONE / (T::ONE + a);
+    let one_a = T::ONE - a;
+    [(one_a * q[0] + h * s) * inv, (one_a * q[1] + h * v.x) * inv, (one_a * q[2] + h * v.y) * inv, (one_a * q[3] + h * v.z) * inv]
+}

@@ -1,0 +1,584 @@
+//! The CPU engine: the step's kernels as Rust twins, one invocation per grain or pair, mapped
+//! over threads with rayon. Generic over `f32` and `f64` (the reference).
+//!
+//! One step: `[kick] drift -> (rebuild: hash_cells, detect_pairs, remap_history) ->
+//! pair_force -> wall_contacts -> gather -> kick`, repeated per force evaluation of the
+//! integrator. Results are bitwise identical for any thread count: every invocation writes
+//! its own output, and reductions combine fixed chunks in order.
+
+mod gather;
+mod grid;
+mod integrate;
+mod pair_force;
+mod pairs;
+mod reduce;
+mod state;
+mod wall_contacts;
+
+pub use integrate::rotate;
+pub use pairs::PairList;
+pub use state::{Body, HistorySlots, Load, Props};
+
+use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
+use crate::model::{normal_potential, ContactForce, ContactModel, PairCoeffs};
+use crate::real::{Real, Vec3};
+use crate::scene::{Integrator, Scene, WallShape};
+use crate::walls::WallGeom;
+use gather::gather;
+use grid::{hash_cells, CellGrid};
+use pair_force::{pair_force, ForceContext};
+use rayon::prelude::*;
+use reduce::{chunked, CHUNK};
+use wall_contacts::{wall_contacts, WallState};
+
+/// Seed 000's optimised velocity Verlet parameter (eqs. 11-15).
+pub const OVV_XI: f64 = 0.1931833275037836;
+
+/// The piston's dynamic state.
+#[derive(Clone, Copy, Debug)]
+struct Piston<T> {
+    /// Index into the walls.
+    wall: usize,
+    mass: T,
+    area: T,
+    /// Target pressure (Pa).
+    pressure: T,
+}
+
+/// The CPU engine in precision `T`.
+pub struct CpuEngine<T: Real> {
+    model: ContactModel<T>,
+    slots: HistorySlots,
+    coeffs: Vec<PairCoeffs<T>>,
+    n_materials: usize,
+    gravity: Vec3<T>,
+    dt: T,
+    integrator: Integrator,
+    skin: T,
+    cutoff: T,
+    capacity: usize,
+    // Grains, indexed by slot; `id` is the permanent id (equal to the slot: grains are not
+    // reordered yet, so history lookups by slot stay valid across rebuilds).
+    id: Vec<u32>,
+    body: Vec<Body<T>>,
+    prop: Vec<Props<T>>,
+    load: Vec<Load<T>>,
+    built_at: Vec<Vec3<T>>,
+    orientation: Option<Vec<[T; 4]>>,
+    // Walls.
+    walls: Vec<WallState<T>>,
+    wall_names: Vec<String>,
+    piston: Option<Piston<T>>,
+    wall_hist: Vec<T>,
+    wall_load: Vec<Load<T>>,
+    wall_reaction: Vec<Vec3<T>>,
+    wall_count: Vec<u64>,
+    // Pairs.
+    grid: CellGrid<T>,
+    pairs: PairList,
+    hist: Vec<T>,
+    out: Vec<ContactForce<T>>,
+    // Clocks.
+    since_eval: T,
+    forces_valid: bool,
+    step: u64,
+    time: f64,
+    rebuilds: u64,
+    external_work: f64,
+}
+
+impl<T: Real> CpuEngine<T> {
+    /// Sets up the engine for a scene and builds the first neighbour list.
+    pub fn new(scene: &Scene) -> Result<Self, SimError> {
+        let n_materials = scene.materials.len();
+        let mut coeffs = Vec::with_capacity(n_materials * n_materials);
+        for a in &scene.materials {
+            for b in &scene.materials {
+                coeffs.push(PairCoeffs::mix(&a.constants, &b.constants));
+            }
+        }
+        let g = &scene.grains;
+        let n = g.len();
+        let body: Vec<Body<T>> =
+            (0..n).map(|i| Body { pos: Vec3::of(g.position[i]), vel: Vec3::of(g.velocity[i]), omega: Vec3::of(g.angular_velocity[i]) }).collect();
+        let prop: Vec<Props<T>> = (0..n)
+            .map(|i| Props {
+                radius: T::of(g.radius[i]),
+                mass: T::of(g.mass[i]),
+                inertia: T::of(0.4 * g.mass[i] * g.radius[i] * g.radius[i]),
+                material: g.material[i] as u32,
+            })
+            .collect();
+        let r_max = g.radius.iter().copied().fold(0.0, f64::max);
+        let model = scene.model.cast::<T>();
+        let slots = HistorySlots::new(model.history_layout());
+        let mut piston = None;
+        let walls: Vec<WallState<T>> = scene
+            .walls
+            .iter()
+            .enumerate()
+            .map(|(w, wall)| {
+                if let WallShape::Piston { pressure, mass, area, .. } = wall.shape {
+                    piston = Some(Piston { wall: w, mass: T::of(mass), area: T::of(area), pressure: T::of(pressure) });
+                }
+                WallState { geom: WallGeom::of(&wall.shape), velocity: Vec3::ZERO, material: wall.material as u32 }
+            })
+            .collect();
+        let n_walls = walls.len();
+        let mut engine = CpuEngine {
+            model,
+            slots,
+            coeffs,
+            n_materials,
+            gravity: Vec3::of(scene.gravity),
+            dt: T::of(scene.time_step.dt),
+            integrator: scene.integrator,
+            skin: T::of(scene.skin),
+            cutoff: T::of(2.0 * r_max + scene.skin),
+            capacity: scene.max_neighbours,
+            id: (0..n as u32).collect(),
+            built_at: body.iter().map(|b| b.pos).collect(),
+            body,
+            prop,
+            load: vec![Load::default(); n],
+            orientation: scene.track_orientation.then(|| vec![[T::ONE, T::ZERO, T::ZERO, T::ZERO]; n]),
+            wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
+            walls,
+            piston,
+            wall_hist: vec![T::ZERO; n * n_walls * slots.stride],
+            wall_load: vec![Load::default(); n],
+            wall_reaction: vec![Vec3::ZERO; n_walls],
+            wall_count: vec![0; n_walls],
+            grid: CellGrid::default(),
+            pairs: PairList::default(),
+            hist: Vec::new(),
+            out: Vec::new(),
+            since_eval: T::ZERO,
+            forces_valid: false,
+            step: 0,
+            time: 0.0,
+            rebuilds: 0,
+            external_work: 0.0,
+        };
+        engine.rebuild()?;
+        Ok(engine)
+    }
+
+    /// Rebuilds the neighbour list now (`hash_cells`, `detect_pairs`, `remap_history`),
+    /// carrying every contact's history over.
+    pub fn rebuild(&mut self) -> Result<(), SimError> {
+        if !hash_cells(&self.body, self.cutoff, &mut self.grid) {
+            return Err(self.non_finite_error());
+        }
+        let pairs = PairList::detect(&self.body, &self.prop, &self.id, &self.grid, self.skin, self.capacity)
+            .map_err(|(i, count)| SimError::Capacity { step: self.step, grain: self.id[i], count, capacity: self.capacity })?;
+        self.hist = pairs::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
+        self.pairs = pairs;
+        self.out.clear();
+        self.out.resize(self.pairs.len(), ContactForce::default());
+        for (b, at) in self.body.iter().zip(self.built_at.iter_mut()) {
+            *at = b.pos;
+        }
+        self.rebuilds += 1;
+        self.forces_valid = false;
+        Ok(())
+    }
+
+    fn non_finite_error(&self) -> SimError {
+        let grain = self.body.iter().position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).unwrap_or(0);
+        SimError::Unstable {
+            step: self.step,
+            time: self.time,
+            what: "non-finite position or velocity".into(),
+            grain: self.id[grain],
+            suggested_dt: 0.5 * self.dt.f64(),
+        }
+    }
+
+    /// The time step (s).
+    pub fn dt(&self) -> f64 {
+        self.dt.f64()
+    }
+
+    /// Grain states, by slot.
+    pub fn bodies(&self) -> &[Body<T>] {
+        &self.body
+    }
+
+    /// Loads from the last force evaluation, by slot.
+    pub fn loads(&self) -> &[Load<T>] {
+        &self.load
+    }
+
+    /// Orientation quaternions (scalar first), when tracked.
+    pub fn orientations(&self) -> Option<&[[T; 4]]> {
+        self.orientation.as_deref()
+    }
+
+    /// The current pair list.
+    pub fn pair_list(&self) -> &PairList {
+        &self.pairs
+    }
+
+    /// Runs the force passes: `pair_force`, `wall_contacts`, `gather`.
+    fn evaluate_forces(&mut self) {
+        let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: self.since_eval };
+        self.since_eval = T::ZERO;
+        let (pairs, body, prop) = (&self.pairs, &self.body, &self.prop);
+        let stride = self.slots.stride;
+        if stride == 0 {
+            self.out.par_iter_mut().with_min_len(512).enumerate().for_each(|(k, o)| *o = pair_force(k, pairs, body, prop, &ctx, &mut []));
+        } else {
+            self.out
+                .par_iter_mut()
+                .zip(self.hist.par_chunks_mut(stride))
+                .with_min_len(512)
+                .enumerate()
+                .for_each(|(k, (o, h))| *o = pair_force(k, pairs, body, prop, &ctx, h));
+        }
+        if !self.walls.is_empty() {
+            let (reaction, count) = wall_pass(&ctx, body, prop, &self.walls, &mut self.wall_load, &mut self.wall_hist);
+            self.wall_reaction = reaction;
+            self.wall_count = count;
+        }
+        let (out, wall_load, gravity) = (&self.out, &self.wall_load, self.gravity);
+        self.load.par_iter_mut().with_min_len(512).enumerate().for_each(|(i, l)| *l = gather(i, pairs, out, &wall_load[i], &prop[i], gravity));
+        self.forces_valid = true;
+    }
+
+    /// Kick of every grain and of the piston by `tau` (s).
+    fn kick(&mut self, tau: T) {
+        let (load, prop) = (&self.load, &self.prop);
+        self.body.par_iter_mut().with_min_len(1024).enumerate().for_each(|(i, b)| integrate::kick(b, &load[i], &prop[i], tau));
+        if let Some(p) = self.piston {
+            let push = self.wall_reaction[p.wall].z - p.pressure * p.area;
+            self.walls[p.wall].velocity.z += push * tau / p.mass;
+        }
+    }
+
+    /// Drift of every grain (and orientation, and piston) by `tau` (s); rebuilds the
+    /// neighbour list when a grain has moved half the skin since the last build.
+    fn drift(&mut self, tau: T) -> Result<(), SimError> {
+        let moved: Vec<T> = self
+            .body
+            .par_chunks_mut(CHUNK)
+            .zip(self.built_at.par_chunks(CHUNK))
+            .map(|(bodies, at)| bodies.iter_mut().zip(at).map(|(b, at)| integrate::drift(b, *at, tau)).fold(T::ZERO, T::max))
+            .collect();
+        if let Some(q) = &mut self.orientation {
+            let body = &self.body;
+            q.par_iter_mut().with_min_len(1024).enumerate().for_each(|(i, q)| *q = integrate::rotate(*q, body[i].omega, tau));
+        }
+        if let Some(p) = self.piston {
+            let wall = &mut self.walls[p.wall];
+            let dz = wall.velocity.z * tau;
+            if let WallGeom::Piston { z } = &mut wall.geom {
+                *z += dz;
+            }
+            self.external_work -= (p.pressure * p.area * dz).f64();
+        }
+        self.since_eval += tau;
+        let max_moved = moved.into_iter().fold(T::ZERO, T::max);
+        let half = self.skin * T::of(0.5);
+        if !(max_moved < half * half) {
+            self.rebuild()?;
+        }
+        Ok(())
+    }
+
+    /// One time step of the scene's integrator.
+    pub fn step(&mut self) -> Result<(), SimError> {
+        let dt = self.dt;
+        let half = dt * T::of(0.5);
+        match self.integrator {
+            Integrator::VelocityVerlet => {
+                if !self.forces_valid {
+                    self.evaluate_forces();
+                }
+                self.kick(half);
+                self.drift(dt)?;
+                self.evaluate_forces();
+                self.kick(half);
+            }
+            Integrator::OptimizedVerlet => {
+                let xi = T::of(OVV_XI);
+                self.drift(xi * dt)?;
+                self.evaluate_forces();
+                self.kick(half);
+                self.drift((T::ONE - T::of(2.0) * xi) * dt)?;
+                self.evaluate_forces();
+                self.kick(half);
+                self.drift(xi * dt)?;
+            }
+        }
+        self.step += 1;
+        self.time += self.dt.f64();
+        Ok(())
+    }
+
+    /// Overlap (m) and smaller radius (m) of pair `k`.
+    fn pair_overlap(&self, k: usize) -> (T, T) {
+        let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+        let d = (self.body[i].pos - self.body[j].pos).norm();
+        (self.prop[i].radius + self.prop[j].radius - d, self.prop[i].radius.min(self.prop[j].radius))
+    }
+}
+
+/// `wall_contacts` over every grain; returns the force on each wall (summed per fixed chunk,
+/// then over chunks in order) and its contact count.
+fn wall_pass<T: Real>(
+    ctx: &ForceContext<T>,
+    body: &[Body<T>],
+    prop: &[Props<T>],
+    walls: &[WallState<T>],
+    wall_load: &mut [Load<T>],
+    wall_hist: &mut [T],
+) -> (Vec<Vec3<T>>, Vec<u64>) {
+    let n_walls = walls.len();
+    let per_grain = n_walls * ctx.slots.stride;
+    let run = |c: usize, loads: &mut [Load<T>], hist: &mut [T]| {
+        let mut reaction = vec![Vec3::ZERO; n_walls];
+        let mut count = vec![0u64; n_walls];
+        for (ii, l) in loads.iter_mut().enumerate() {
+            let i = c * CHUNK + ii;
+            let h = if per_grain == 0 { &mut [][..] } else { &mut hist[ii * per_grain..(ii + 1) * per_grain] };
+            *l = wall_contacts(&body[i], &prop[i], walls, ctx, h, &mut reaction, &mut count);
+        }
+        (reaction, count)
+    };
+    let parts: Vec<(Vec<Vec3<T>>, Vec<u64>)> = if per_grain == 0 {
+        wall_load.par_chunks_mut(CHUNK).enumerate().map(|(c, loads)| run(c, loads, &mut [])).collect()
+    } else {
+        wall_load.par_chunks_mut(CHUNK).zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).enumerate().map(|(c, (loads, hist))| run(c, loads, hist)).collect()
+    };
+    let mut reaction = vec![Vec3::ZERO; n_walls];
+    let mut count = vec![0u64; n_walls];
+    for (r, c) in parts {
+        for w in 0..n_walls {
+            reaction[w] += r[w];
+            count[w] += c[w];
+        }
+    }
+    (reaction, count)
+}
+
+/// Per-chunk partial sums of the statistics over grains.
+#[derive(Clone, Copy, Default)]
+struct GrainSums {
+    ke_t: f64,
+    ke_r: f64,
+    pe_g: f64,
+    momentum: [f64; 3],
+    angular: [f64; 3],
+    net_force: f64,
+    wall_force: f64,
+    wall_contacts: u64,
+    wall_elastic: f64,
+    max_wall_overlap: (f64, u32),
+}
+
+/// Per-chunk partial sums of the statistics over pairs.
+#[derive(Clone, Copy, Default)]
+struct PairSums {
+    contacts: u64,
+    clamped: u64,
+    elastic: f64,
+    force: f64,
+    max_overlap: (f64, u32),
+}
+
+fn max_by_first(a: (f64, u32), b: (f64, u32)) -> (f64, u32) {
+    if b.0 > a.0 { b } else { a }
+}
+
+impl<T: Real> Engine for CpuEngine<T> {
+    fn backend(&self) -> &'static str {
+        "cpu"
+    }
+    fn precision(&self) -> &'static str {
+        T::NAME
+    }
+    fn grain_count(&self) -> usize {
+        self.body.len()
+    }
+    fn steps(&self) -> u64 {
+        self.step
+    }
+    fn time(&self) -> f64 {
+        self.time
+    }
+    fn advance(&mut self, n: u64) -> Result<(), SimError> {
+        for _ in 0..n {
+            self.step()?;
+        }
+        Ok(())
+    }
+
+    fn stats(&mut self) -> Stats {
+        if !self.forces_valid {
+            self.evaluate_forces();
+        }
+        let g = self.gravity;
+        let grain_sums = chunked(self.body.len(), |r| {
+            let mut s = GrainSums::default();
+            for i in r {
+                let (b, p, l) = (&self.body[i], &self.prop[i], &self.load[i]);
+                let m = p.mass.f64();
+                let v = b.vel.f64();
+                let x = b.pos.f64();
+                s.ke_t += 0.5 * m * b.vel.norm2().f64();
+                s.ke_r += 0.5 * p.inertia.f64() * b.omega.norm2().f64();
+                s.pe_g -= m * g.dot(b.pos).f64();
+                let w = b.omega.f64();
+                let ii = p.inertia.f64();
+                let mv = [m * v[0], m * v[1], m * v[2]];
+                for a in 0..3 {
+                    s.momentum[a] += mv[a];
+                }
+                s.angular[0] += x[1] * mv[2] - x[2] * mv[1] + ii * w[0];
+                s.angular[1] += x[2] * mv[0] - x[0] * mv[2] + ii * w[1];
+                s.angular[2] += x[0] * mv[1] - x[1] * mv[0] + ii * w[2];
+                s.net_force += l.force.norm().f64();
+                for wall in &self.walls {
+                    let (_, dist) = wall.geom.frame(b.pos);
+                    let h = p.radius - dist;
+                    if h > T::ZERO {
+                        let c = &self.coeffs[wall.material as usize * self.n_materials + p.material as usize];
+                        s.wall_contacts += 1;
+                        s.wall_elastic += normal_potential(&self.model.normal, c, p.radius, h).f64();
+                        s.max_wall_overlap = max_by_first(s.max_wall_overlap, ((h / p.radius).f64(), self.id[i]));
+                    }
+                }
+                s.wall_force += self.wall_load[i].force.norm().f64();
+            }
+            s
+        });
+        let pair_sums = chunked(self.pairs.len(), |r| {
+            let mut s = PairSums::default();
+            for k in r {
+                let (h, r_min) = self.pair_overlap(k);
+                if h <= T::ZERO {
+                    continue;
+                }
+                let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+                let (pi, pj) = (&self.prop[i], &self.prop[j]);
+                let c = &self.coeffs[pi.material as usize * self.n_materials + pj.material as usize];
+                let r_eff = pi.radius * pj.radius / (pi.radius + pj.radius);
+                s.contacts += 1;
+                s.clamped += self.out[k].clamped as u64;
+                s.elastic += normal_potential(&self.model.normal, c, r_eff, h).f64();
+                s.force += 2.0 * self.out[k].f_i.norm().f64();
+                s.max_overlap = max_by_first(s.max_overlap, ((h / r_min).f64(), self.id[i]));
+            }
+            s
+        });
+        let mut gs = GrainSums::default();
+        for s in grain_sums {
+            gs.ke_t += s.ke_t;
+            gs.ke_r += s.ke_r;
+            gs.pe_g += s.pe_g;
+            for a in 0..3 {
+                gs.momentum[a] += s.momentum[a];
+                gs.angular[a] += s.angular[a];
+            }
+            gs.net_force += s.net_force;
+            gs.wall_force += s.wall_force;
+            gs.wall_contacts += s.wall_contacts;
+            gs.wall_elastic += s.wall_elastic;
+            gs.max_wall_overlap = max_by_first(gs.max_wall_overlap, s.max_wall_overlap);
+        }
+        let mut ps = PairSums::default();
+        for s in pair_sums {
+            ps.contacts += s.contacts;
+            ps.clamped += s.clamped;
+            ps.elastic += s.elastic;
+            ps.force += s.force;
+            ps.max_overlap = max_by_first(ps.max_overlap, s.max_overlap);
+        }
+        let n = self.body.len() as f64;
+        // Each touching pair counts once per grain; each wall contact once.
+        let contact_ends = 2 * ps.contacts + gs.wall_contacts;
+        let unbalanced_force = if contact_ends == 0 {
+            if gs.net_force > 0.0 { f64::INFINITY } else { 0.0 }
+        } else {
+            (gs.net_force / n) / ((ps.force + gs.wall_force) / contact_ends as f64)
+        };
+        let (max_overlap, max_overlap_grain) = max_by_first(ps.max_overlap, gs.max_wall_overlap);
+        let walls = (0..self.walls.len())
+            .map(|w| WallStats { name: self.wall_names[w].clone(), force: self.wall_reaction[w].f64(), contacts: self.wall_count[w] })
+            .collect();
+        let piston = self.piston.map(|p| {
+            let wall = &self.walls[p.wall];
+            let z = match wall.geom {
+                WallGeom::Piston { z } => z.f64(),
+                _ => unreachable!("the piston's wall is a piston"),
+            };
+            PistonStats {
+                z,
+                velocity: wall.velocity.z.f64(),
+                target_pressure: p.pressure.f64(),
+                pressure: self.wall_reaction[p.wall].z.f64() / p.area.f64(),
+            }
+        });
+        let piston_ke = self.piston.map_or(0.0, |p| 0.5 * p.mass.f64() * self.walls[p.wall].velocity.z.f64().powi(2));
+        Stats {
+            step: self.step,
+            time: self.time,
+            ke_translational: gs.ke_t,
+            ke_rotational: gs.ke_r,
+            elastic_energy: ps.elastic + gs.wall_elastic,
+            gravity_energy: gs.pe_g,
+            piston_ke,
+            external_work: self.external_work,
+            momentum: gs.momentum,
+            angular_momentum: gs.angular,
+            contacts: ps.contacts,
+            wall_contacts: gs.wall_contacts,
+            clamped: ps.clamped,
+            coordination: 2.0 * ps.contacts as f64 / n,
+            max_overlap,
+            max_overlap_grain,
+            unbalanced_force,
+            non_finite_grain: self.body.iter().position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|i| self.id[i]),
+            rebuilds: self.rebuilds,
+            walls,
+            piston,
+        }
+    }
+
+    fn frame(&self, contacts: bool) -> Frame {
+        Frame {
+            time: self.time,
+            id: self.id.clone(),
+            position: self.body.iter().map(|b| b.pos.f64()).collect(),
+            radius: self.prop.iter().map(|p| p.radius.f64()).collect(),
+            velocity: self.body.iter().map(|b| b.vel.f64()).collect(),
+            angular_velocity: self.body.iter().map(|b| b.omega.f64()).collect(),
+            orientation: self.orientation.as_ref().map(|q| q.iter().map(|q| [q[0].f64(), q[1].f64(), q[2].f64(), q[3].f64()]).collect()),
+            contacts: contacts.then(|| {
+                (0..self.pairs.len())
+                    .filter_map(|k| {
+                        let (h, _) = self.pair_overlap(k);
+                        (h > T::ZERO).then(|| {
+                            let spring = if self.slots.layout.tangential { self.slots.load(&self.hist[k * self.slots.stride..]).tangential } else { Vec3::ZERO };
+                            ContactRecord {
+                                i: self.id[self.pairs.owner[k] as usize],
+                                j: self.id[self.pairs.partner[k] as usize],
+                                overlap: h.f64(),
+                                normal_force: self.out[k].f_n.f64(),
+                                force: self.out[k].f_i.f64(),
+                                tangential_spring: spring.f64(),
+                            }
+                        })
+                    })
+                    .collect()
+            }),
+        }
+    }
+
+    fn set_piston_pressure(&mut self, pressure: f64) {
+        if let Some(p) = &mut self.piston {
+            p.pressure = T::of(pressure);
+        }
+    }
+}

@@ -1,0 +1,46 @@
+//! `pair_force`: one invocation computes the force of one listed pair, once, in canonical
+//! order (owner = lower permanent id = i), and reads and writes its history.
+
+use super::pairs::PairList;
+use super::state::{Body, HistorySlots, Props};
+use crate::model::{contact_force, Bodies, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs};
+use crate::real::Real;
+
+/// What every invocation of a force pass shares.
+#[derive(Clone, Copy, Debug)]
+pub struct ForceContext<'a, T> {
+    /// Contact law per slot.
+    pub model: &'a ContactModel<T>,
+    /// Pair coefficients, `[material_i * n_materials + material_j]`.
+    pub coeffs: &'a [PairCoeffs<T>],
+    /// Number of materials.
+    pub n_materials: usize,
+    /// History block layout.
+    pub slots: HistorySlots,
+    /// Time since the previous force evaluation (s).
+    pub elapsed: T,
+}
+
+/// `pair_force` for pair `k`. A listed pair that does not touch exerts nothing and has its
+/// history zeroed (a contact that separates forgets its springs).
+#[inline]
+pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, hist: &mut [T]) -> ContactForce<T> {
+    let i = pairs.owner[k] as usize;
+    let j = pairs.partner[k] as usize;
+    let (bi, bj, pi, pj) = (&body[i], &body[j], &prop[i], &prop[j]);
+    let d = bi.pos - bj.pos;
+    let dist2 = d.norm2();
+    let reach = pi.radius + pj.radius;
+    if dist2 >= reach * reach {
+        hist.fill(T::ZERO);
+        return ContactForce::default();
+    }
+    let geo = Geometry::grain_grain(d, dist2.sqrt(), pi.radius, pj.radius, pi.mass, pj.mass);
+    let kin = Kinematics { v_i: bi.vel, v_j: bj.vel, w_i: bi.omega, w_j: bj.omega };
+    let bodies = Bodies { m_i: pi.mass, inertia_i: pi.inertia, m_j: pj.mass, inertia_j: pj.inertia, j_is_wall: false };
+    let c = &ctx.coeffs[pi.material as usize * ctx.n_materials + pj.material as usize];
+    let mut h = ctx.slots.load(hist);
+    let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
+    ctx.slots.store(&h, hist);
+    f
+}

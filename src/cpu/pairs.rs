@@ -1,0 +1,111 @@
+//! The pair list (CSR by owner, with the reverse index the gather reads) and
+//! `remap_history`, which carries per-contact history across a rebuild.
+
+use super::grid::{detect_pairs, CellGrid};
+use super::reduce::chunked;
+use super::state::{Body, Props};
+use crate::real::Real;
+use rayon::prelude::*;
+
+/// Candidate pairs, each listed once under its owner (the lower permanent id).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PairList {
+    /// `owner_start[i]..owner_start[i + 1]` are the pairs grain `i` owns.
+    pub owner_start: Vec<u32>,
+    /// Owner grain of each pair.
+    pub owner: Vec<u32>,
+    /// Partner grain of each pair (higher permanent id), ascending id within an owner.
+    pub partner: Vec<u32>,
+    /// `rev_start[j]..rev_start[j + 1]` index `rev_pair` for the pairs where `j` is partner.
+    pub rev_start: Vec<u32>,
+    /// Pair indices grouped by partner, ascending within a partner.
+    pub rev_pair: Vec<u32>,
+}
+
+impl PairList {
+    /// Number of pairs.
+    pub fn len(&self) -> usize {
+        self.owner.len()
+    }
+    /// True when there are no pairs.
+    pub fn is_empty(&self) -> bool {
+        self.owner.is_empty()
+    }
+
+    /// Runs `detect_pairs` for every grain and assembles the list. Returns the first grain
+    /// (index, count) that owns more than `capacity` pairs, if any.
+    pub fn detect<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[u32], grid: &CellGrid<T>, skin: T, capacity: usize) -> Result<Self, (usize, usize)> {
+        let n = body.len();
+        let parts = chunked(n, |r| {
+            let mut counts = Vec::with_capacity(r.len());
+            let mut partners = Vec::new();
+            for i in r {
+                let before = partners.len();
+                detect_pairs(i, body, prop, id, grid, skin, &mut partners);
+                counts.push((partners.len() - before) as u32);
+            }
+            (counts, partners)
+        });
+        let mut list = PairList { owner_start: Vec::with_capacity(n + 1), ..Default::default() };
+        list.owner_start.push(0);
+        for (counts, partners) in parts {
+            for c in counts {
+                let i = list.owner_start.len() - 1;
+                if c as usize > capacity {
+                    return Err((i, c as usize));
+                }
+                list.owner.extend(std::iter::repeat_n(i as u32, c as usize));
+                list.owner_start.push(list.owner_start[i] + c);
+            }
+            list.partner.extend(partners);
+        }
+        list.build_reverse(n);
+        Ok(list)
+    }
+
+    /// Counting sort of pair indices by partner (stable, so ascending within a partner).
+    fn build_reverse(&mut self, n: usize) {
+        self.rev_start = vec![0; n + 1];
+        for &j in &self.partner {
+            self.rev_start[j as usize + 1] += 1;
+        }
+        for j in 0..n {
+            self.rev_start[j + 1] += self.rev_start[j];
+        }
+        let mut cursor = self.rev_start[..n].to_vec();
+        self.rev_pair = vec![0; self.partner.len()];
+        for (k, &j) in self.partner.iter().enumerate() {
+            self.rev_pair[cursor[j as usize] as usize] = k as u32;
+            cursor[j as usize] += 1;
+        }
+    }
+
+    /// Index of the pair (owner `i`, partner with permanent id `partner_id`), if listed.
+    #[inline]
+    pub fn find(&self, i: usize, partner_id: u32, id: &[u32]) -> Option<usize> {
+        let (a, b) = (self.owner_start[i] as usize, self.owner_start[i + 1] as usize);
+        self.partner[a..b].binary_search_by_key(&partner_id, |&j| id[j as usize]).ok().map(|k| a + k)
+    }
+}
+
+/// `remap_history` for new pair `k`: copies the history block of the same pair (owner and
+/// partner's permanent id, as DEM-Engine's persistent map matches them) from the old list,
+/// or zeroes it for a pair that is new.
+#[inline]
+pub fn remap_history<T: Real>(k: usize, new: &PairList, old: &PairList, old_hist: &[T], id: &[u32], stride: usize, out: &mut [T]) {
+    let i = new.owner[k] as usize;
+    let j = new.partner[k] as usize;
+    match old.find(i, id[j], id) {
+        Some(o) => out.copy_from_slice(&old_hist[o * stride..(o + 1) * stride]),
+        None => out.fill(T::ZERO),
+    }
+}
+
+/// Runs `remap_history` over every new pair.
+pub fn remap_all<T: Real>(new: &PairList, old: &PairList, old_hist: &[T], id: &[u32], stride: usize) -> Vec<T> {
+    let mut hist = vec![T::ZERO; new.len() * stride];
+    if stride > 0 {
+        hist.par_chunks_mut(stride).with_min_len(256).enumerate().for_each(|(k, out)| remap_history(k, new, old, old_hist, id, stride, out));
+    }
+    hist
+}

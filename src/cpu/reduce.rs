@@ -1,0 +1,13 @@
+//! Deterministic parallel reductions: work is cut into fixed chunks whose partial results are
+//! combined in chunk order, so sums are bitwise identical on any number of threads.
+
+use rayon::prelude::*;
+use std::ops::Range;
+
+/// Items per chunk of a reduction.
+pub const CHUNK: usize = 2048;
+
+/// Maps `f` over fixed chunks of `0..n` in parallel and returns the results in chunk order.
+pub fn chunked<R: Send, F: Fn(Range<usize>) -> R + Sync + Send>(n: usize, f: F) -> Vec<R> {
+    (0..n.div_ceil(CHUNK)).into_par_iter().map(|c| f(c * CHUNK..((c + 1) * CHUNK).min(n))).collect()
+}

@@ -1,0 +1,88 @@
+//! Per-grain arrays of the CPU engine. The CPU keeps the data one kernel invocation reads
+//! together (array of structures: one or two cache lines per grain); the GPU keeps
+//! structures of arrays.
+
+use crate::model::{History, HistoryLayout};
+use crate::real::{Real, Vec3};
+
+/// Kinematic state of a grain.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Body<T> {
+    /// Centre position (m).
+    pub pos: Vec3<T>,
+    /// Velocity (m/s).
+    pub vel: Vec3<T>,
+    /// Angular velocity, world frame (rad/s).
+    pub omega: Vec3<T>,
+}
+
+/// Constant properties of a grain.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Props<T> {
+    /// Radius (m).
+    pub radius: T,
+    /// Mass (kg).
+    pub mass: T,
+    /// Moment of inertia `2/5 m R^2` (kg m^2).
+    pub inertia: T,
+    /// Material index.
+    pub material: u32,
+}
+
+/// Force and torque on a grain (N, N m).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Load<T> {
+    /// Force (N).
+    pub force: Vec3<T>,
+    /// Torque (N m).
+    pub torque: Vec3<T>,
+}
+
+/// Where each history block sits in a contact's fixed-stride slot.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct HistorySlots {
+    /// Which blocks exist.
+    pub layout: HistoryLayout,
+    /// Offset of the tangential spring.
+    pub tangential: usize,
+    /// Offset of the rolling spring.
+    pub rolling: usize,
+    /// Reals per contact.
+    pub stride: usize,
+}
+
+impl HistorySlots {
+    /// Packs the blocks a layout uses, in slot order (tangential, rolling).
+    pub fn new(layout: HistoryLayout) -> Self {
+        let tangential = 0;
+        let rolling = if layout.tangential { 3 } else { 0 };
+        let stride = rolling + if layout.rolling { 3 } else { 0 };
+        HistorySlots { layout, tangential, rolling, stride }
+    }
+
+    /// Reads one contact's history (absent blocks read as zero).
+    #[inline(always)]
+    pub fn load<T: Real>(&self, s: &[T]) -> History<T> {
+        let v = |o: usize| Vec3::new(s[o], s[o + 1], s[o + 2]);
+        History {
+            tangential: if self.layout.tangential { v(self.tangential) } else { Vec3::ZERO },
+            rolling: if self.layout.rolling { v(self.rolling) } else { Vec3::ZERO },
+        }
+    }
+
+    /// Writes one contact's history.
+    #[inline(always)]
+    pub fn store<T: Real>(&self, h: &History<T>, s: &mut [T]) {
+        let mut put = |o: usize, v: Vec3<T>| {
+            s[o] = v.x;
+            s[o + 1] = v.y;
+            s[o + 2] = v.z;
+        };
+        if self.layout.tangential {
+            put(self.tangential, h.tangential);
+        }
+        if self.layout.rolling {
+            put(self.rolling, h.rolling);
+        }
+    }
+}

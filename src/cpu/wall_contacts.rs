@@ -1,0 +1,56 @@
+//! `wall_contacts`: one invocation computes the contacts of one grain with every wall, with
+//! the same laws as grain-grain contacts (the wall is a partner of infinite radius and mass).
+
+use super::pair_force::ForceContext;
+use super::state::{Body, Load, Props};
+use crate::model::{contact_force, Bodies, Geometry, Kinematics};
+use crate::real::{Real, Vec3};
+use crate::walls::WallGeom;
+
+/// A wall as the force pass sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WallState<T> {
+    /// Surface now.
+    pub geom: WallGeom<T>,
+    /// Velocity (m/s).
+    pub velocity: Vec3<T>,
+    /// Material index.
+    pub material: u32,
+}
+
+/// `wall_contacts` for grain `i`. `hist` holds the grain's history blocks, one per wall;
+/// the force each wall receives is added to `reaction[w]` and its contact count to
+/// `count[w]`. Returns the load on the grain.
+#[inline]
+pub fn wall_contacts<T: Real>(
+    b: &Body<T>,
+    p: &Props<T>,
+    walls: &[WallState<T>],
+    ctx: &ForceContext<T>,
+    hist: &mut [T],
+    reaction: &mut [Vec3<T>],
+    count: &mut [u64],
+) -> Load<T> {
+    let mut load = Load::default();
+    let stride = ctx.slots.stride;
+    for (w, wall) in walls.iter().enumerate() {
+        let h_slot = &mut hist[w * stride..(w + 1) * stride];
+        let (n, dist) = wall.geom.frame(b.pos);
+        if dist >= p.radius {
+            h_slot.fill(T::ZERO);
+            continue;
+        }
+        let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
+        let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
+        let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
+        let c = &ctx.coeffs[wall.material as usize * ctx.n_materials + p.material as usize];
+        let mut h = ctx.slots.load(h_slot);
+        let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
+        ctx.slots.store(&h, h_slot);
+        load.force += f.f_i;
+        load.torque += f.t_i;
+        reaction[w] -= f.f_i;
+        count[w] += 1;
+    }
+    load
+}

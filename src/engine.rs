@@ -1,0 +1,179 @@
+//! What the host loop needs from a backend: advance, read a few statistics, take a frame.
+
+use serde::Serialize;
+
+/// Why a run stopped early.
+#[derive(Debug, thiserror::Error)]
+pub enum SimError {
+    /// A grain owns more pairs than the neighbour capacity.
+    #[error(
+        "neighbour capacity exceeded at step {step}: grain {grain} has {count} neighbour pairs, above simulation.max_neighbours = {capacity}; fix: raise simulation.max_neighbours to at least {count} (or lower simulation.skin)"
+    )]
+    Capacity {
+        /// Step at which the list was built.
+        step: u64,
+        /// Permanent id of the grain.
+        grain: u32,
+        /// Pairs it owns.
+        count: usize,
+        /// The capacity.
+        capacity: usize,
+    },
+    /// The state became non-finite, overlaps ran away, or energy grew with no input.
+    #[error("unstable at step {step} (t = {time:.6e} s): {what} (grain {grain}); fix: lower simulation.dt to {suggested_dt:.3e} s or less")]
+    Unstable {
+        /// Step at which it was seen.
+        step: u64,
+        /// Simulated time (s).
+        time: f64,
+        /// What was seen.
+        what: String,
+        /// Permanent id of the grain concerned.
+        grain: u32,
+        /// A step that should be stable (s).
+        suggested_dt: f64,
+    },
+}
+
+/// Force on one wall and, for the piston, its state.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct WallStats {
+    /// Wall name.
+    pub name: String,
+    /// Total force the grains exert on the wall (N).
+    pub force: [f64; 3],
+    /// Grains touching it.
+    pub contacts: u64,
+}
+
+/// The piston's state.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PistonStats {
+    /// Height (m).
+    pub z: f64,
+    /// Vertical velocity (m/s).
+    pub velocity: f64,
+    /// Target pressure (Pa).
+    pub target_pressure: f64,
+    /// Pressure the grains exert on it: upward grain force / area (Pa).
+    pub pressure: f64,
+}
+
+/// Statistics read back every `stats_interval` steps.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Stats {
+    /// Steps taken since the start.
+    pub step: u64,
+    /// Simulated time (s).
+    pub time: f64,
+    /// Translational kinetic energy (J).
+    pub ke_translational: f64,
+    /// Rotational kinetic energy (J).
+    pub ke_rotational: f64,
+    /// Elastic energy in the normal springs of touching pairs and wall contacts (J).
+    pub elastic_energy: f64,
+    /// Gravitational potential energy `-sum m g.r` (J).
+    pub gravity_energy: f64,
+    /// Kinetic energy of the piston (J).
+    pub piston_ke: f64,
+    /// Work done on the system by the piston's target pressure since the start (J).
+    pub external_work: f64,
+    /// Total linear momentum of the grains (kg m/s).
+    pub momentum: [f64; 3],
+    /// Total angular momentum of the grains about the origin (kg m^2/s).
+    pub angular_momentum: [f64; 3],
+    /// Grain-grain pairs touching.
+    pub contacts: u64,
+    /// Grain-wall contacts.
+    pub wall_contacts: u64,
+    /// Touching pairs whose damping the no-pull clamp cut off at the last force evaluation.
+    pub clamped: u64,
+    /// Mean grain-grain contacts per grain, `2 contacts / N`.
+    pub coordination: f64,
+    /// Largest overlap over the smaller radius of the pair (-).
+    pub max_overlap: f64,
+    /// Grain with the largest overlap.
+    pub max_overlap_grain: u32,
+    /// Mean |net force| on a grain over mean |contact force| (-); 0 when nothing acts.
+    pub unbalanced_force: f64,
+    /// First grain whose position or velocity is not finite.
+    pub non_finite_grain: Option<u32>,
+    /// Neighbour-list rebuilds since the start.
+    pub rebuilds: u64,
+    /// Per-wall forces.
+    pub walls: Vec<WallStats>,
+    /// The piston, if any.
+    pub piston: Option<PistonStats>,
+}
+
+impl Stats {
+    /// Kinetic energy, translational and rotational (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        self.ke_translational + self.ke_rotational
+    }
+    /// Kinetic + elastic + gravitational + piston kinetic energy minus the external work (J):
+    /// constant without dissipation, never growing with it.
+    pub fn mechanical_energy(&self) -> f64 {
+        self.kinetic_energy() + self.elastic_energy + self.gravity_energy + self.piston_ke - self.external_work
+    }
+}
+
+/// One recorded instant: what an MCAP frame holds.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Frame {
+    /// Simulated time (s).
+    pub time: f64,
+    /// Permanent grain ids.
+    pub id: Vec<u32>,
+    /// Centre positions (m).
+    pub position: Vec<[f64; 3]>,
+    /// Radii (m).
+    pub radius: Vec<f64>,
+    /// Velocities (m/s).
+    pub velocity: Vec<[f64; 3]>,
+    /// Angular velocities (rad/s).
+    pub angular_velocity: Vec<[f64; 3]>,
+    /// Orientation quaternions (scalar first), when the scene tracks orientation.
+    pub orientation: Option<Vec<[f64; 4]>>,
+    /// Touching grain pairs with their forces, when asked for.
+    pub contacts: Option<Vec<ContactRecord>>,
+}
+
+/// One touching pair.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct ContactRecord {
+    /// Permanent id of grain i (the lower id).
+    pub i: u32,
+    /// Permanent id of grain j.
+    pub j: u32,
+    /// Overlap (m).
+    pub overlap: f64,
+    /// Normal force magnitude (N, compressive positive).
+    pub normal_force: f64,
+    /// Total force on i (N).
+    pub force: [f64; 3],
+    /// Tangential spring `xi` (m), zero when the model keeps none.
+    pub tangential_spring: [f64; 3],
+}
+
+/// A backend the host loop can drive.
+pub trait Engine {
+    /// "cpu" or "gpu".
+    fn backend(&self) -> &'static str;
+    /// "f32" or "f64".
+    fn precision(&self) -> &'static str;
+    /// Number of grains.
+    fn grain_count(&self) -> usize;
+    /// Steps taken so far.
+    fn steps(&self) -> u64;
+    /// Simulated time (s).
+    fn time(&self) -> f64;
+    /// Advances `n` steps.
+    fn advance(&mut self, n: u64) -> Result<(), SimError>;
+    /// Reads the statistics back.
+    fn stats(&mut self) -> Stats;
+    /// Copies the grain state out.
+    fn frame(&self, contacts: bool) -> Frame;
+    /// Sets the piston's target pressure (Pa); no effect without a piston.
+    fn set_piston_pressure(&mut self, pressure: f64);
+}

@@ -1,0 +1,16 @@
+//! `grains`: granular dynamics (DEM) of spherical grains.
+//!
+//! A scene ([`scene`]) is validated into SI units, an engine ([`cpu`]) advances it with the
+//! contact laws of [`model`], and the host loop ([`protocol`]) drives stages and records
+//! statistics and frames ([`output`]).
+
+pub mod analysis;
+pub mod cpu;
+pub mod engine;
+pub mod model;
+pub mod output;
+pub mod protocol;
+pub mod real;
+pub mod scene;
+pub mod timestep;
+pub mod walls;

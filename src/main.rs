@@ -1,0 +1,14 @@
+//! `grains` command line: parse, run, print the error, exit non-zero on failure.
+
+mod cli;
+mod commands;
+
+use clap::Parser;
+
+fn main() {
+    let cli = cli::Cli::parse();
+    if let Err(e) = commands::dispatch(cli) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}

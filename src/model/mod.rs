@@ -1,0 +1,390 @@
+//! Contact sub-models as pure functions, composed in a fixed order:
+//! geometry -> normal (elastic + damping, no-pull clamp) -> tangential -> rolling -> twisting.
+//!
+//! Every law follows `PHYSICS.md`. Conventions: the normal `n` points from partner `j` to grain
+//! `i`; the overlap `h > 0` in contact; forces and torques are "on i" unless named `_j`.
+//! A wall is a partner with infinite radius and mass (`R_eff = R_i`, `m_eff = m_i`) that does
+//! not spin.
+//!
+//! A scene picks one law per slot ([`ContactModel`]); a slot set to `None` is skipped before
+//! any arithmetic, and its history is not allocated (see [`HistoryLayout`]).
+
+mod geometry;
+mod normal;
+mod rolling;
+mod tangential;
+mod twisting;
+
+pub use geometry::{Bodies, Geometry, Kinematics};
+pub use normal::{normal_damping, normal_elastic, normal_force, restitution_beta};
+pub use rolling::rolling_sds;
+pub use tangential::{mindlin_tangential, oquendo_tangential, rotate_into_plane};
+pub use twisting::twisting_torque;
+
+use crate::real::{Real, Vec3};
+
+/// Elastic normal law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum NormalLaw<T> {
+    /// Hertz: `F = 4/3 sqrt(R_eff) V_eff h^(3/2)` (seed 000 eq. 1).
+    Hertz,
+    /// Linear spring: `F = k_n h`, `k_n` in N/m.
+    Linear {
+        /// Spring stiffness (N/m).
+        k_n: T,
+    },
+}
+
+/// Normal dissipation law, added to the elastic force before the no-pull clamp.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DampingLaw<T> {
+    /// No normal dissipation.
+    None,
+    /// The papers' nonlinear damping `-m_eff gamma_n sqrt(h) v_n` (seed 000 eq. 1),
+    /// `gamma_n` (s^-1 m^-1/2) from the materials.
+    Papers,
+    /// Viscous damping tuned to a restitution coefficient `e` from the materials, as LIGGGHTS'
+    /// `coefficientRestitution` (Hertz: `eta = 2 sqrt(5/6) |beta| sqrt(S_n m_eff)`,
+    /// `S_n = 2 V_eff sqrt(R_eff h)`; linear: `eta = 2 |beta| sqrt(k_n m_eff)`,
+    /// `beta = ln e / sqrt(ln^2 e + pi^2)`).
+    Restitution,
+    /// Constant viscous coefficient `c_n` (N s/m): `-c_n v_n`.
+    Viscous {
+        /// Dashpot coefficient (N s/m).
+        c_n: T,
+    },
+}
+
+/// How the tangential spring stiffness `k_t` (N/m) is set.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TangentialStiffness<T> {
+    /// Mindlin: `k_t = 8 G_eff sqrt(R_eff h)` (Hertz normal law only).
+    Mindlin,
+    /// A fixed ratio to the normal secant stiffness `F_elastic / h`.
+    RatioToNormal(T),
+}
+
+/// Tangential law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TangentialLaw<T> {
+    /// Frictionless.
+    None,
+    /// Seed 000's three regimes: sliding (`|v_t| > v_slip`, `mu_k`), rolling
+    /// (`|v_r| > v_roll`, `theta_r`), static (history spring up to `mu_s`, slips at `mu_k`).
+    Oquendo {
+        /// Sliding threshold on the contact-point tangential speed (m/s).
+        v_slip: T,
+        /// Rolling threshold on the objective rolling speed (m/s).
+        v_roll: T,
+        /// Static spring stiffness.
+        stiffness: TangentialStiffness<T>,
+    },
+    /// Standard Hertz-Mindlin with history and one Coulomb `mu` (the materials' `mu_s`), as
+    /// LAMMPS `tangential mindlin` / LIGGGHTS `tangential history`.
+    Mindlin {
+        /// Tangential damping as a fraction of the normal damping coefficient (LAMMPS
+        /// `x_gammat`; 0.9075 reproduces LIGGGHTS for nu = 0.3).
+        damping_ratio: T,
+        /// Spring stiffness.
+        stiffness: TangentialStiffness<T>,
+    },
+}
+
+/// Rolling-resistance law (the momentum-conserving alternative to seed 000's rolling regime).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RollingLaw<T> {
+    /// No rolling resistance.
+    None,
+    /// Elastic-plastic spring-dashpot on the rolling displacement (as LAMMPS `rolling sds`):
+    /// `F_r = -k_r psi - gamma_r v_rl`, capped at `mu_r F_n`; torque on i `R_eff n x F_r`.
+    Sds {
+        /// Rolling stiffness (N/m).
+        k_r: T,
+        /// Rolling damping (N s/m).
+        gamma_r: T,
+        /// Rolling friction coefficient (-).
+        mu_r: T,
+    },
+}
+
+/// Twisting law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TwistingLaw {
+    /// No twisting torque.
+    None,
+    /// Seed 000 eq. 2: `tau_i = -4 pi gamma_nt m_eff R_eff h w_n`.
+    Oquendo,
+}
+
+/// The law chosen for each slot of a scene's contacts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactModel<T> {
+    /// Elastic normal law.
+    pub normal: NormalLaw<T>,
+    /// Normal dissipation.
+    pub damping: DampingLaw<T>,
+    /// Tangential law.
+    pub tangential: TangentialLaw<T>,
+    /// Rolling resistance.
+    pub rolling: RollingLaw<T>,
+    /// Twisting torque.
+    pub twisting: TwistingLaw,
+}
+
+impl<T: Real> ContactModel<T> {
+    /// The per-contact history this model needs.
+    pub fn history_layout(&self) -> HistoryLayout {
+        HistoryLayout {
+            tangential: !matches!(self.tangential, TangentialLaw::None),
+            rolling: !matches!(self.rolling, RollingLaw::None),
+        }
+    }
+}
+
+/// Which per-contact history blocks exist. Each block is one world-frame 3-vector (m) per
+/// contact; a block a model does not use is not allocated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct HistoryLayout {
+    /// Accumulated tangential spring displacement `xi` (m).
+    pub tangential: bool,
+    /// Accumulated rolling displacement `psi` (m).
+    pub rolling: bool,
+}
+
+/// Per-contact history, world frame, zero when a contact forms.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct History<T> {
+    /// Tangential spring displacement `xi` (m).
+    pub tangential: Vec3<T>,
+    /// Rolling spring displacement `psi` (m).
+    pub rolling: Vec3<T>,
+}
+
+/// Coefficients of one pair of materials (see [`PairCoeffs::mix`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairCoeffs<T> {
+    /// `V_eff = V_i V_j / (V_i + V_j)` (Pa), `V = E / (1 - nu^2)`.
+    pub v_eff: T,
+    /// Mindlin `G_eff`: `1/G_eff = (2 - nu_i)/G_i + (2 - nu_j)/G_j` (Pa).
+    pub g_eff: T,
+    /// Static friction coefficient (-).
+    pub mu_s: T,
+    /// Kinetic friction coefficient (-).
+    pub mu_k: T,
+    /// `tan(theta_r)` of the rolling angle (-).
+    pub tan_roll: T,
+    /// Papers' normal damping `gamma_n` (s^-1 m^-1/2).
+    pub gamma_n: T,
+    /// Twisting damping `gamma_nt` (s^-1).
+    pub gamma_nt: T,
+    /// `|beta|` of the restitution coefficient (see [`restitution_beta`]).
+    pub beta: T,
+}
+
+/// The mechanical constants of one material, in SI units.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MaterialConstants {
+    /// Young's modulus (Pa).
+    pub youngs_modulus: f64,
+    /// Poisson ratio (-).
+    pub poisson_ratio: f64,
+    /// Static friction coefficient (-).
+    pub mu_s: f64,
+    /// Kinetic friction coefficient (-).
+    pub mu_k: f64,
+    /// Rolling angle `theta_r` (rad).
+    pub rolling_angle: f64,
+    /// `gamma_n` (s^-1 m^-1/2).
+    pub gamma_n: f64,
+    /// `gamma_nt` (s^-1).
+    pub gamma_nt: f64,
+    /// Restitution coefficient (-), used by [`DampingLaw::Restitution`].
+    pub restitution: f64,
+}
+
+impl MaterialConstants {
+    /// `V = E / (1 - nu^2)` (Pa).
+    pub fn stiffness(&self) -> f64 {
+        self.youngs_modulus / (1.0 - self.poisson_ratio * self.poisson_ratio)
+    }
+    /// Shear modulus `G = E / (2 (1 + nu))` (Pa).
+    pub fn shear_modulus(&self) -> f64 {
+        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+    }
+}
+
+impl<T: Real> PairCoeffs<T> {
+    /// Coefficients for a contact between materials `a` and `b`. Elastic constants combine
+    /// as PHYSICS.md rules; friction, damping and restitution take the arithmetic mean of the
+    /// two materials (equal materials give their own values).
+    pub fn mix(a: &MaterialConstants, b: &MaterialConstants) -> Self {
+        let (va, vb) = (a.stiffness(), b.stiffness());
+        let g_inv = (2.0 - a.poisson_ratio) / a.shear_modulus() + (2.0 - b.poisson_ratio) / b.shear_modulus();
+        let mean = |x: f64, y: f64| 0.5 * (x + y);
+        PairCoeffs {
+            v_eff: T::of(va * vb / (va + vb)),
+            g_eff: T::of(1.0 / g_inv),
+            mu_s: T::of(mean(a.mu_s, b.mu_s)),
+            mu_k: T::of(mean(a.mu_k, b.mu_k)),
+            tan_roll: T::of(mean(a.rolling_angle, b.rolling_angle).tan()),
+            gamma_n: T::of(mean(a.gamma_n, b.gamma_n)),
+            gamma_nt: T::of(mean(a.gamma_nt, b.gamma_nt)),
+            beta: T::of(restitution_beta(mean(a.restitution, b.restitution))),
+        }
+    }
+}
+
+/// The force and torque one contact exerts on its two partners.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactForce<T> {
+    /// Force on i (N).
+    pub f_i: Vec3<T>,
+    /// Force on j (N); `-f_i` except in seed 000's rolling regime.
+    pub f_j: Vec3<T>,
+    /// Torque on i (N m).
+    pub t_i: Vec3<T>,
+    /// Torque on j (N m).
+    pub t_j: Vec3<T>,
+    /// Normal force magnitude after the clamp (N, compressive positive).
+    pub f_n: T,
+    /// True when the no-pull clamp removed an attractive damping force.
+    pub clamped: bool,
+}
+
+/// Composes the sub-models for one touching contact (`geo.h > 0`), updating its history.
+///
+/// `elapsed` is the time (s) since the previous force evaluation: the tangential and rolling
+/// springs grow by the relative velocity times `elapsed`.
+#[inline]
+pub fn contact_force<T: Real>(
+    model: &ContactModel<T>,
+    c: &PairCoeffs<T>,
+    geo: &Geometry<T>,
+    kin: &Kinematics<T>,
+    bodies: &Bodies<T>,
+    hist: &mut History<T>,
+    elapsed: T,
+) -> ContactForce<T> {
+    let v_rel = kin.v_i - kin.v_j;
+    let v_n = v_rel.dot(geo.n);
+    let (f_el, k_secant) = normal_elastic(&model.normal, c, geo);
+    let eta_n = normal_damping(&model.damping, &model.normal, c, geo);
+    let (f_n, clamped) = normal_force(f_el, eta_n, v_n);
+    let mut out = ContactForce { f_i: geo.n * f_n, f_j: geo.n * (-f_n), f_n, clamped, ..Default::default() };
+
+    match model.tangential {
+        TangentialLaw::None => {}
+        TangentialLaw::Oquendo { v_slip, v_roll, stiffness } => {
+            let k_t = tangential_stiffness(&stiffness, c, geo, k_secant);
+            let t = oquendo_tangential(c, geo, kin, bodies, f_n, k_t, v_slip, v_roll, &mut hist.tangential, elapsed);
+            out.f_i += t.f_i;
+            out.f_j += t.f_j;
+            out.t_i += t.t_i;
+            out.t_j += t.t_j;
+        }
+        TangentialLaw::Mindlin { damping_ratio, stiffness } => {
+            let k_t = tangential_stiffness(&stiffness, c, geo, k_secant);
+            let f_t = mindlin_tangential(c.mu_s, geo, kin, f_n, k_t, eta_n * damping_ratio, &mut hist.tangential, elapsed);
+            out.f_i += f_t;
+            out.f_j -= f_t;
+            // Lever arms to the contact point: -R'_i n on i, +R'_j n on j (force -f_t).
+            out.t_i -= geo.n.cross(f_t) * geo.rp_i;
+            out.t_j -= geo.n.cross(f_t) * geo.rp_j;
+        }
+    }
+    if let RollingLaw::Sds { k_r, gamma_r, mu_r } = model.rolling {
+        let tau = rolling_sds(k_r, gamma_r, mu_r, geo, kin, f_n, &mut hist.rolling, elapsed);
+        out.t_i += tau;
+        out.t_j -= tau;
+    }
+    if let TwistingLaw::Oquendo = model.twisting {
+        let tau = twisting_torque(c.gamma_nt, geo, kin);
+        out.t_i += tau;
+        out.t_j -= tau;
+    }
+    out
+}
+
+/// `k_t` (N/m) for the current overlap.
+#[inline]
+fn tangential_stiffness<T: Real>(s: &TangentialStiffness<T>, c: &PairCoeffs<T>, geo: &Geometry<T>, k_secant: T) -> T {
+    match *s {
+        TangentialStiffness::Mindlin => T::of(8.0) * c.g_eff * (geo.r_eff * geo.h).sqrt(),
+        TangentialStiffness::RatioToNormal(r) => r * k_secant,
+    }
+}
+
+/// Elastic potential energy (J) stored in the normal spring of a contact with overlap `h`:
+/// Hertz `8/15 sqrt(R_eff) V_eff h^(5/2)`, linear `k_n h^2 / 2`.
+#[inline]
+pub fn normal_potential<T: Real>(law: &NormalLaw<T>, c: &PairCoeffs<T>, r_eff: T, h: T) -> T {
+    match *law {
+        NormalLaw::Hertz => T::of(8.0 / 15.0) * r_eff.sqrt() * c.v_eff * h * h * h.sqrt(),
+        NormalLaw::Linear { k_n } => T::of(0.5) * k_n * h * h,
+    }
+}
+
+impl ContactModel<f64> {
+    /// The same model in another precision.
+    pub fn cast<U: Real>(&self) -> ContactModel<U> {
+        let u = U::of;
+        let stiffness = |s: TangentialStiffness<f64>| match s {
+            TangentialStiffness::Mindlin => TangentialStiffness::Mindlin,
+            TangentialStiffness::RatioToNormal(r) => TangentialStiffness::RatioToNormal(u(r)),
+        };
+        ContactModel {
+            normal: match self.normal {
+                NormalLaw::Hertz => NormalLaw::Hertz,
+                NormalLaw::Linear { k_n } => NormalLaw::Linear { k_n: u(k_n) },
+            },
+            damping: match self.damping {
+                DampingLaw::None => DampingLaw::None,
+                DampingLaw::Papers => DampingLaw::Papers,
+                DampingLaw::Restitution => DampingLaw::Restitution,
+                DampingLaw::Viscous { c_n } => DampingLaw::Viscous { c_n: u(c_n) },
+            },
+            tangential: match self.tangential {
+                TangentialLaw::None => TangentialLaw::None,
+                TangentialLaw::Oquendo { v_slip, v_roll, stiffness: s } => TangentialLaw::Oquendo { v_slip: u(v_slip), v_roll: u(v_roll), stiffness: stiffness(s) },
+                TangentialLaw::Mindlin { damping_ratio, stiffness: s } => TangentialLaw::Mindlin { damping_ratio: u(damping_ratio), stiffness: stiffness(s) },
+            },
+            rolling: match self.rolling {
+                RollingLaw::None => RollingLaw::None,
+                RollingLaw::Sds { k_r, gamma_r, mu_r } => RollingLaw::Sds { k_r: u(k_r), gamma_r: u(gamma_r), mu_r: u(mu_r) },
+            },
+            twisting: self.twisting,
+        }
+    }
+
+    /// One line naming the law in each slot, for reports.
+    pub fn describe(&self) -> String {
+        let normal = match self.normal {
+            NormalLaw::Hertz => "hertz".to_string(),
+            NormalLaw::Linear { k_n } => format!("linear(k_n={k_n:e} N/m)"),
+        };
+        let damping = match self.damping {
+            DampingLaw::None => "none".to_string(),
+            DampingLaw::Papers => "papers(gamma_n)".to_string(),
+            DampingLaw::Restitution => "restitution(e)".to_string(),
+            DampingLaw::Viscous { c_n } => format!("viscous(c_n={c_n:e} N s/m)"),
+        };
+        let stiff = |s: TangentialStiffness<f64>| match s {
+            TangentialStiffness::Mindlin => "k_t=mindlin".to_string(),
+            TangentialStiffness::RatioToNormal(r) => format!("k_t={r}*k_n"),
+        };
+        let tangential = match self.tangential {
+            TangentialLaw::None => "none".to_string(),
+            TangentialLaw::Oquendo { v_slip, v_roll, stiffness } => format!("oquendo(v_slip={v_slip:e}, v_roll={v_roll:e}, {})", stiff(stiffness)),
+            TangentialLaw::Mindlin { damping_ratio, stiffness } => format!("mindlin(damping_ratio={damping_ratio}, {})", stiff(stiffness)),
+        };
+        let rolling = match self.rolling {
+            RollingLaw::None => "none".to_string(),
+            RollingLaw::Sds { k_r, gamma_r, mu_r } => format!("sds(k_r={k_r:e}, gamma_r={gamma_r:e}, mu_r={mu_r})"),
+        };
+        let twisting = match self.twisting {
+            TwistingLaw::None => "none",
+            TwistingLaw::Oquendo => "oquendo(gamma_nt)",
+        };
+        format!("normal={normal} damping={damping} tangential={tangential} rolling={rolling} twisting={twisting}")
+    }
+}

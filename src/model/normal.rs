@@ -1,0 +1,53 @@
+//! Normal force: elastic law, damping law, no-pull clamp (seed 000 eq. 1, PHYSICS.md).
+
+use super::{DampingLaw, Geometry, NormalLaw, PairCoeffs};
+use crate::real::Real;
+
+/// Elastic normal force magnitude (N, repulsive positive) and the secant stiffness
+/// `F / h` (N/m) that ratio-based tangential springs scale from.
+#[inline(always)]
+pub fn normal_elastic<T: Real>(law: &NormalLaw<T>, c: &PairCoeffs<T>, g: &Geometry<T>) -> (T, T) {
+    match *law {
+        NormalLaw::Hertz => {
+            let k = T::of(4.0 / 3.0) * c.v_eff * (g.r_eff * g.h).sqrt();
+            (k * g.h, k)
+        }
+        NormalLaw::Linear { k_n } => (k_n * g.h, k_n),
+    }
+}
+
+/// Damping coefficient `eta` (kg/s) such that the damping force on i is `-eta v_n n`, with
+/// `v_n = (v_i - v_j).n` (negative while approaching).
+#[inline(always)]
+pub fn normal_damping<T: Real>(law: &DampingLaw<T>, normal: &NormalLaw<T>, c: &PairCoeffs<T>, g: &Geometry<T>) -> T {
+    match *law {
+        DampingLaw::None => T::ZERO,
+        DampingLaw::Papers => g.m_eff * c.gamma_n * g.h.sqrt(),
+        DampingLaw::Restitution => match *normal {
+            NormalLaw::Hertz => {
+                let s_n = T::of(2.0) * c.v_eff * (g.r_eff * g.h).sqrt();
+                T::of(2.0 * (5.0f64 / 6.0).sqrt()) * c.beta * (s_n * g.m_eff).sqrt()
+            }
+            NormalLaw::Linear { k_n } => T::of(2.0) * c.beta * (k_n * g.m_eff).sqrt(),
+        },
+        DampingLaw::Viscous { c_n } => c_n,
+    }
+}
+
+/// Total normal force magnitude `F_el - eta v_n` clamped at zero so that damping never pulls
+/// (PHYSICS.md ruling). Returns the clamped magnitude (N) and whether the clamp acted.
+#[inline(always)]
+pub fn normal_force<T: Real>(f_elastic: T, eta: T, v_n: T) -> (T, bool) {
+    let f = f_elastic - eta * v_n;
+    if f < T::ZERO { (T::ZERO, true) } else { (f, false) }
+}
+
+/// `|beta| = |ln e| / sqrt(ln^2 e + pi^2)` for a restitution coefficient `e` in (0, 1];
+/// 0 for `e >= 1` (no dissipation).
+pub fn restitution_beta(e: f64) -> f64 {
+    if e >= 1.0 || e <= 0.0 {
+        return 0.0;
+    }
+    let l = e.ln();
+    l.abs() / (l * l + std::f64::consts::PI * std::f64::consts::PI).sqrt()
+}

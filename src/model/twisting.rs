@@ -1,0 +1,12 @@
+//! Twisting torque of seed 000 eq. 2.
+
+use super::{Geometry, Kinematics};
+use crate::real::{Real, Vec3};
+
+/// Twisting torque on i (N m), `-4 pi gamma_nt m_eff R_eff h w_n` with
+/// `w_n = ((w_i - w_j).n) n`; the torque on j is its opposite.
+#[inline(always)]
+pub fn twisting_torque<T: Real>(gamma_nt: T, g: &Geometry<T>, k: &Kinematics<T>) -> Vec3<T> {
+    let w_n = g.n * (k.w_i - k.w_j).dot(g.n);
+    w_n * (-T::of(4.0 * std::f64::consts::PI) * gamma_nt * g.m_eff * g.r_eff * g.h)
+}

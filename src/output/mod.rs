@@ -1,0 +1,154 @@
+//! What a run writes: `stats.csv` (every statistics read), `stages.csv` (one row per stage),
+//! `frames.mcap` (see [`mcap`]), `summary.json` (the `--json` object), and a progress bar
+//! on a terminal.
+
+pub mod mcap;
+mod summary;
+
+pub use summary::{check_report, Summary, ESTIMATE_PAIRS_PER_GRAIN};
+
+use crate::engine::{Frame, Stats};
+use crate::protocol::{Recorder, StageResult};
+use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// The header of `stats.csv` and `stages.csv`, before the per-wall force columns.
+const STATS_COLUMNS: &str = "stage,step,time_s,ke_translational_J,ke_rotational_J,elastic_energy_J,gravity_energy_J,external_work_J,contacts,wall_contacts,coordination,clamped,max_overlap,unbalanced_force,rebuilds,piston_z_m,piston_pressure_Pa";
+
+fn stats_header(s: &Stats) -> String {
+    let mut h = STATS_COLUMNS.to_string();
+    for w in &s.walls {
+        for a in ["x", "y", "z"] {
+            h.push_str(&format!(",{}_f{a}_N", w.name));
+        }
+    }
+    h
+}
+
+fn stats_row(stage: &str, s: &Stats) -> String {
+    let (pz, pp) = s.piston.as_ref().map_or((String::new(), String::new()), |p| (format!("{:e}", p.z), format!("{:e}", p.pressure)));
+    let mut row = format!(
+        "{stage},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{:e},{:e},{},{pz},{pp}",
+        s.step,
+        s.time,
+        s.ke_translational,
+        s.ke_rotational,
+        s.elastic_energy,
+        s.gravity_energy,
+        s.external_work,
+        s.contacts,
+        s.wall_contacts,
+        s.coordination,
+        s.clamped,
+        s.max_overlap,
+        s.unbalanced_force,
+        s.rebuilds
+    );
+    for w in &s.walls {
+        row.push_str(&format!(",{:e},{:e},{:e}", w.force[0], w.force[1], w.force[2]));
+    }
+    row
+}
+
+/// A CSV file written row by row and flushed at every stage end.
+struct Csv {
+    path: PathBuf,
+    out: BufWriter<File>,
+    header_written: bool,
+}
+
+impl Csv {
+    fn create(path: PathBuf) -> anyhow::Result<Self> {
+        let out = BufWriter::new(File::create(&path).with_context(|| format!("cannot create {}", path.display()))?);
+        Ok(Csv { path, out, header_written: false })
+    }
+    fn row(&mut self, stage: &str, s: &Stats) -> anyhow::Result<()> {
+        if !self.header_written {
+            writeln!(self.out, "{}", stats_header(s))?;
+            self.header_written = true;
+        }
+        writeln!(self.out, "{}", stats_row(stage, s)).with_context(|| format!("cannot write {}", self.path.display()))
+    }
+    fn flush(&mut self) -> anyhow::Result<()> {
+        self.out.flush().with_context(|| format!("cannot write {}", self.path.display()))
+    }
+}
+
+/// Records a run: files under `--out DIR` when given, a progress bar when asked for.
+pub struct RunRecorder {
+    stats: Option<Csv>,
+    stages: Option<Csv>,
+    frames: Option<mcap::McapRecorder>,
+    bar: ProgressBar,
+    bar_stage: String,
+}
+
+impl RunRecorder {
+    /// Creates the output directory and files (when `out` is given); `progress` draws a bar
+    /// on stderr.
+    pub fn new(out: Option<&Path>, progress: bool) -> anyhow::Result<Self> {
+        let bar = if progress { ProgressBar::new(0) } else { ProgressBar::hidden() };
+        bar.set_style(ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} steps {per_sec} eta {eta}").expect("a valid template").progress_chars("=> "));
+        let (stats, stages, frames) = match out {
+            Some(dir) => {
+                std::fs::create_dir_all(dir).with_context(|| format!("cannot create the output directory {}", dir.display()))?;
+                (
+                    Some(Csv::create(dir.join("stats.csv"))?),
+                    Some(Csv::create(dir.join("stages.csv"))?),
+                    Some(mcap::McapRecorder::create(&dir.join("frames.mcap"))?),
+                )
+            }
+            None => (None, None, None),
+        };
+        Ok(RunRecorder { stats, stages, frames, bar, bar_stage: String::new() })
+    }
+
+    /// Flushes the CSV files and closes the MCAP recording (also what a failed run keeps).
+    pub fn finish(self) -> anyhow::Result<()> {
+        self.bar.finish_and_clear();
+        for mut csv in [self.stats, self.stages].into_iter().flatten() {
+            csv.flush()?;
+        }
+        if let Some(f) = self.frames {
+            f.finish()?;
+        }
+        Ok(())
+    }
+}
+
+impl Recorder for RunRecorder {
+    fn stats(&mut self, stage: &str, s: &Stats) -> anyhow::Result<()> {
+        match &mut self.stats {
+            Some(csv) => csv.row(stage, s),
+            None => Ok(()),
+        }
+    }
+    fn frame(&mut self, f: &Frame) -> anyhow::Result<()> {
+        match &mut self.frames {
+            Some(m) => m.write(f),
+            None => Ok(()),
+        }
+    }
+    fn stage_end(&mut self, r: &StageResult) -> anyhow::Result<()> {
+        if let Some(csv) = &mut self.stages {
+            csv.row(&r.name, &r.stats)?;
+            csv.flush()?;
+        }
+        if let Some(csv) = &mut self.stats {
+            csv.flush()?;
+        }
+        Ok(())
+    }
+    fn progress(&mut self, stage: &str, done: u64, total: u64) {
+        if self.bar_stage != stage {
+            self.bar_stage = stage.to_string();
+            self.bar.reset();
+            self.bar.set_message(stage.to_string());
+            self.bar.set_length(total);
+        }
+        self.bar.set_position(done);
+    }
+}

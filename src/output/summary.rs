@@ -1,0 +1,159 @@
+//! The run summary (`--json`, `summary.json`) and the `check` report.
+
+use crate::analysis::packing_fraction;
+use crate::cpu::HistorySlots;
+use crate::engine::Engine;
+use crate::protocol::StageResult;
+use crate::scene::Scene;
+use serde::Serialize;
+use std::fmt::Write;
+
+/// End-of-run figures.
+#[derive(Clone, Debug, Serialize)]
+pub struct FinalState {
+    /// Kinetic energy, translational + rotational (J).
+    pub kinetic_energy: f64,
+    /// Solid fraction of the bed (see [`packing_fraction`]); null without a container.
+    pub packing_fraction: Option<f64>,
+    /// Grain-grain contacts per grain.
+    pub coordination_number: f64,
+}
+
+/// What `grains run --json` prints and `--out` writes as `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Scene name.
+    pub scene: String,
+    /// Scene file.
+    pub file: String,
+    /// "cpu".
+    pub backend: &'static str,
+    /// "f32" or "f64".
+    pub precision: &'static str,
+    /// Worker threads.
+    pub threads: usize,
+    /// Grain count.
+    pub grains: usize,
+    /// Steps taken.
+    pub steps: u64,
+    /// Time step (s).
+    pub dt: f64,
+    /// Simulated time (s).
+    pub simulated_time: f64,
+    /// Wall-clock time of the stages (s).
+    pub wall_seconds: f64,
+    /// Grains x steps / wall seconds.
+    pub particle_steps_per_second: f64,
+    /// Per-stage results.
+    pub stages: Vec<StageResult>,
+    /// End state.
+    #[serde(rename = "final")]
+    pub final_state: FinalState,
+    /// Validation warnings.
+    pub warnings: Vec<String>,
+}
+
+impl Summary {
+    /// Summarises a finished run.
+    pub fn new(scene: &Scene, engine: &dyn Engine, threads: usize, wall_seconds: f64, stages: Vec<StageResult>) -> Self {
+        let last = stages.last().map(|s| &s.stats);
+        let frame = engine.frame(false);
+        let piston_z = last.and_then(|s| s.piston.as_ref().map(|p| p.z));
+        Summary {
+            scene: scene.name.clone(),
+            file: scene.path.display().to_string(),
+            backend: engine.backend(),
+            precision: engine.precision(),
+            threads,
+            grains: engine.grain_count(),
+            steps: engine.steps(),
+            dt: scene.time_step.dt,
+            simulated_time: engine.time(),
+            wall_seconds,
+            particle_steps_per_second: engine.grain_count() as f64 * engine.steps() as f64 / wall_seconds.max(1e-9),
+            final_state: FinalState {
+                kinetic_energy: last.map_or(0.0, |s| s.kinetic_energy()),
+                packing_fraction: packing_fraction(scene, &frame, piston_z),
+                coordination_number: last.map_or(0.0, |s| s.coordination),
+            },
+            stages,
+            warnings: scene.warnings.clone(),
+        }
+    }
+
+    /// A few lines for a person.
+    pub fn human(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "{}: {} grains, {} steps of {:.3e} s ({:.4e} s simulated) on {} {} x{} in {:.2} s ({:.3e} particle-steps/s)",
+            self.scene, self.grains, self.steps, self.dt, self.simulated_time, self.backend, self.precision, self.threads, self.wall_seconds, self.particle_steps_per_second);
+        for st in &self.stages {
+            let settled = match st.settled {
+                Some(true) => " settled",
+                Some(false) => " NOT settled (duration ran out)",
+                None => "",
+            };
+            let _ = writeln!(s, "  stage {:<12} {:>6} {:>9} steps  t = {:.4e} s  KE/grain = {:.3e} J  unbalanced = {:.3e}  Z = {:.3}  max overlap = {:.3e}{settled}",
+                st.name, st.kind, st.steps, st.time_end, st.ke_per_grain, st.unbalanced_force, st.stats.coordination, st.stats.max_overlap);
+        }
+        let pf = self.final_state.packing_fraction.map_or("n/a".to_string(), |p| format!("{p:.4}"));
+        let _ = writeln!(s, "  final: KE = {:.4e} J, packing fraction = {pf}, coordination = {:.3}", self.final_state.kinetic_energy, self.final_state.coordination_number);
+        s
+    }
+}
+
+/// Pairs per grain assumed by the memory estimate (a dense packing with a 10% skin).
+pub const ESTIMATE_PAIRS_PER_GRAIN: f64 = 6.0;
+
+/// Bytes the CPU engine holds per grain and per pair, for reals of `real` bytes.
+fn engine_bytes(scene: &Scene, real: usize) -> f64 {
+    let stride = HistorySlots::new(scene.model.cast::<f64>().history_layout()).stride;
+    let walls = scene.walls.len();
+    // body 9, props 3 + u32, load 6, wall load 6, built_at 3 reals; id, cell, sorted index.
+    let per_grain = (27 * real + 4 + 12 + walls * stride * real + if scene.track_orientation { 4 * real } else { 0 }) as f64;
+    // owner, partner, reverse index; force record (4 vectors + normal force + flag); history.
+    let per_pair = (12 + 13 * real + 8 + stride * real) as f64;
+    scene.grains.len() as f64 * (per_grain + ESTIMATE_PAIRS_PER_GRAIN * per_pair)
+}
+
+/// The `grains check` report.
+pub fn check_report(scene: &Scene) -> String {
+    let g = &scene.grains;
+    let mut s = String::new();
+    let stat = |v: &[f64]| {
+        let min = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        (min, v.iter().sum::<f64>() / v.len() as f64, max)
+    };
+    let (rmin, rmean, rmax) = stat(&g.radius);
+    let (mmin, mmean, mmax) = stat(&g.mass);
+    let ts = &scene.time_step;
+    let _ = writeln!(s, "scene: {} ({})", scene.name, scene.path.display());
+    if !scene.description.is_empty() {
+        let _ = writeln!(s, "  {}", scene.description);
+    }
+    let _ = writeln!(s, "grains: {}", g.len());
+    for (i, m) in scene.materials.iter().enumerate() {
+        let count = g.material.iter().filter(|&&x| x as usize == i).count();
+        let _ = writeln!(s, "  material {:<10} {count} grains, E = {:e} Pa, nu = {}, mu_s = {}, mu_k = {}", m.name, m.constants.youngs_modulus, m.constants.poisson_ratio, m.constants.mu_s, m.constants.mu_k);
+    }
+    let _ = writeln!(s, "radius (m): min {rmin:.4e}, mean {rmean:.4e}, max {rmax:.4e}");
+    let _ = writeln!(s, "mass (kg): min {mmin:.4e}, mean {mmean:.4e}, max {mmax:.4e}, total {:.4e}", g.mass.iter().sum::<f64>());
+    for w in &scene.walls {
+        let _ = writeln!(s, "wall {}: {:?}", w.name, w.shape);
+    }
+    let _ = writeln!(s, "model: {}", scene.model.describe());
+    let _ = writeln!(s, "integrator: {}", scene.integrator.name());
+    let _ = writeln!(s, "Rayleigh time t_R = {:.4e} s", ts.times.rayleigh);
+    let _ = writeln!(s, "Hertz time t_c = {:.4e} s at {:.3e} m/s", ts.times.collision, ts.times.expected_speed);
+    let _ = writeln!(s, "dt = {:.4e} s ({}; {:.3} t_R, t_c/{:.1})", ts.dt, if ts.auto { "auto" } else { "given" }, ts.dt / ts.times.rayleigh, ts.times.collision / ts.dt);
+    let _ = writeln!(s, "skin = {:.4e} m, stats every {} steps, neighbour capacity {}", scene.skin, scene.stats_interval, scene.max_neighbours);
+    for st in &scene.stages {
+        let _ = writeln!(s, "stage {}: {:?} for at most {:e} s ({} steps)", st.name, st.kind, st.duration, (st.duration / ts.dt).round());
+    }
+    let mib = |b: f64| b / (1024.0 * 1024.0);
+    let _ = writeln!(s, "memory estimate (cpu, {ESTIMATE_PAIRS_PER_GRAIN} pairs/grain): {:.1} MiB in f64, {:.1} MiB in f32", mib(engine_bytes(scene, 8)), mib(engine_bytes(scene, 4)));
+    for w in &scene.warnings {
+        let _ = writeln!(s, "warning: {w}");
+    }
+    s
+}

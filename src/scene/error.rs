@@ -1,0 +1,77 @@
+//! Scene errors: one line naming the file, the key, the value and the fix.
+
+use std::path::{Path, PathBuf};
+
+/// Why a scene file was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{file}: cannot read the scene: {source}; fix: check the path")]
+    Read {
+        /// Scene file.
+        file: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The TOML is malformed or has an unknown key or a value of the wrong type.
+    #[error("{file} line {line}: {message}; fix: {fix}")]
+    Syntax {
+        /// Scene file.
+        file: PathBuf,
+        /// 1-based line of the offending key or value.
+        line: usize,
+        /// What the parser said.
+        message: String,
+        /// How to fix it.
+        fix: String,
+    },
+    /// A value is out of range or inconsistent with the rest of the scene.
+    #[error("{file}: {key} = {value}: {problem}; fix: {fix}")]
+    Invalid {
+        /// Scene file.
+        file: PathBuf,
+        /// Dotted path of the key, e.g. `grain[2].radius`.
+        key: String,
+        /// The value as given.
+        value: String,
+        /// What is wrong with it.
+        problem: String,
+        /// How to fix it.
+        fix: String,
+    },
+}
+
+impl SceneError {
+    /// A TOML parse error, located by line.
+    pub fn syntax(file: &Path, text: &str, err: &toml::de::Error) -> Self {
+        let line = err.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1).unwrap_or(0);
+        let message = err.message().replace('\n', " ").trim().to_string();
+        let fix = if message.contains("unknown field") {
+            "correct the key's spelling or remove it (the README's scene reference lists every key)"
+        } else if message.contains("missing field") {
+            "add the key (the README's scene reference gives its unit and meaning)"
+        } else {
+            "correct the value to the type the README's scene reference gives"
+        };
+        SceneError::Syntax { file: file.to_path_buf(), line, message, fix: fix.to_string() }
+    }
+}
+
+/// Builds [`SceneError::Invalid`] values for one file.
+pub struct Complainer<'a> {
+    /// The scene file being validated.
+    pub file: &'a Path,
+}
+
+impl Complainer<'_> {
+    /// An invalid value of `key`.
+    pub fn invalid(&self, key: impl Into<String>, value: impl std::fmt::Display, problem: impl Into<String>, fix: impl Into<String>) -> SceneError {
+        SceneError::Invalid {
+            file: self.file.to_path_buf(),
+            key: key.into(),
+            value: value.to_string(),
+            problem: problem.into(),
+            fix: fix.into(),
+        }
+    }
+}

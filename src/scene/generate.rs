@@ -1,0 +1,162 @@
+//! Random sequential addition: grains placed one by one at random, rejected when they
+//! overlap a grain already placed. Deterministic for a given scene seed.
+
+use super::error::Complainer;
+use super::schema::{GeneratorSpec, RegionSpec};
+use super::{sphere_mass, Grains, SceneError};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::collections::HashMap;
+
+/// Attempts per grain before the region counts as full.
+pub const MAX_ATTEMPTS: usize = 2000;
+
+/// A uniform grid of already placed grains for overlap queries during placement.
+struct PlacementGrid {
+    cell: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl PlacementGrid {
+    fn key(&self, p: [f64; 3]) -> [i64; 3] {
+        [(p[0] / self.cell).floor() as i64, (p[1] / self.cell).floor() as i64, (p[2] / self.cell).floor() as i64]
+    }
+    fn insert(&mut self, i: u32, p: [f64; 3]) {
+        let k = self.key(p);
+        self.cells.entry(k).or_default().push(i);
+    }
+    /// True when a sphere at `p` of radius `r` overlaps a placed grain. Correct while `r` and
+    /// every placed radius are at most `cell / 2`.
+    fn overlaps(&self, grains: &Grains, p: [f64; 3], r: f64) -> bool {
+        let k = self.key(p);
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let Some(list) = self.cells.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) else { continue };
+                    for &j in list {
+                        let q = grains.position[j as usize];
+                        let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
+                        let s = r + grains.radius[j as usize];
+                        if d2 < s * s {
+                            return true;
+                        }
+                    }
+                }
+            }
+        }
+        false
+    }
+}
+
+/// Places generator `k`'s grains into `grains` (after those already there).
+pub(super) fn place(c: &Complainer, k: usize, spec: &GeneratorSpec, material: u16, density: f64, seed: u64, grains: &mut Grains) -> Result<(), SceneError> {
+    let key = |s: &str| format!("generate[{k}].{s}");
+    let d = &spec.diameter;
+    if !(d.min.is_finite() && d.min > 0.0) {
+        return Err(c.invalid(key("diameter.min"), d.min, "must be a positive number", "give the smallest diameter in metres"));
+    }
+    if !(d.max.is_finite() && d.max >= d.min) {
+        return Err(c.invalid(key("diameter.max"), d.max, format!("must be at least diameter.min = {:e}", d.min), "give the largest diameter in metres"));
+    }
+    if spec.count == 0 {
+        return Err(c.invalid(key("count"), 0, "must be at least 1", "give the number of grains"));
+    }
+    if !(spec.random_speed.is_finite() && spec.random_speed >= 0.0) {
+        return Err(c.invalid(key("random_speed"), spec.random_speed, "must be zero or positive", "give a speed in m/s"));
+    }
+    let r_max_all = grains.radius.iter().copied().fold(0.5 * d.max, f64::max);
+    let mut grid = PlacementGrid { cell: 2.0 * r_max_all, cells: HashMap::new() };
+    for i in 0..grains.len() {
+        grid.insert(i as u32, grains.position[i]);
+    }
+    // One stream per generator so that adding a generator leaves the others unchanged.
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(k as u64 + 1)));
+    let mut solid = 0.0;
+    for n in 0..spec.count {
+        let diameter = if d.max > d.min { rng.random_range(d.min..d.max) } else { d.min };
+        let r = 0.5 * diameter;
+        let mut placed = None;
+        for _ in 0..MAX_ATTEMPTS {
+            let p = sample(c, k, &spec.region, r, &mut rng)?;
+            if !grid.overlaps(grains, p, r) {
+                placed = Some(p);
+                break;
+            }
+        }
+        let Some(p) = placed else {
+            let fraction = solid / region_volume(&spec.region);
+            return Err(c.invalid(
+                key("count"),
+                spec.count,
+                format!("only {n} grains fit after {MAX_ATTEMPTS} attempts (solid fraction {fraction:.3}; random insertion jams near 0.3-0.35)"),
+                "enlarge the region or lower the count",
+            ));
+        };
+        let mut v = spec.velocity;
+        if spec.random_speed > 0.0 {
+            let dir = random_direction(&mut rng);
+            for a in 0..3 {
+                v[a] += spec.random_speed * dir[a];
+            }
+        }
+        grid.insert(grains.len() as u32, p);
+        grains.push(r, sphere_mass(r, density), p, v, [0.0; 3], material);
+        solid += 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
+    }
+    Ok(())
+}
+
+fn region_volume(region: &RegionSpec) -> f64 {
+    match *region {
+        RegionSpec::Box { min, max } => (0..3).map(|a| max[a] - min[a]).product(),
+        RegionSpec::Cylinder { radius, z_min, z_max, .. } => std::f64::consts::PI * radius * radius * (z_max - z_min),
+    }
+}
+
+/// A centre for a grain of radius `r` wholly inside the region.
+fn sample(c: &Complainer, k: usize, region: &RegionSpec, r: f64, rng: &mut ChaCha8Rng) -> Result<[f64; 3], SceneError> {
+    let too_small = |what: &str, size: f64| {
+        c.invalid(format!("generate[{k}].region"), format!("{what} {size:e} m"), format!("cannot hold a grain of diameter {:e} m", 2.0 * r), "enlarge the region")
+    };
+    match *region {
+        RegionSpec::Box { min, max } => {
+            let mut p = [0.0; 3];
+            for a in 0..3 {
+                let (lo, hi) = (min[a] + r, max[a] - r);
+                if !(hi >= lo) {
+                    return Err(too_small("side", max[a] - min[a]));
+                }
+                p[a] = if hi > lo { rng.random_range(lo..hi) } else { lo };
+            }
+            Ok(p)
+        }
+        RegionSpec::Cylinder { center, radius, z_min, z_max } => {
+            let rr = radius - r;
+            if !(rr >= 0.0) {
+                return Err(too_small("radius", radius));
+            }
+            if !(z_max - r >= z_min + r) {
+                return Err(too_small("height", z_max - z_min));
+            }
+            let z = if z_max - r > z_min + r { rng.random_range(z_min + r..z_max - r) } else { z_min + r };
+            loop {
+                let (x, y) = (rng.random_range(-1.0..1.0f64), rng.random_range(-1.0..1.0f64));
+                if x * x + y * y <= 1.0 {
+                    return Ok([center[0] + rr * x, center[1] + rr * y, z]);
+                }
+            }
+        }
+    }
+}
+
+/// A unit vector uniform on the sphere (rejection from the cube).
+fn random_direction(rng: &mut ChaCha8Rng) -> [f64; 3] {
+    loop {
+        let v: [f64; 3] = [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
+        let n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if n2 > 1e-6 && n2 <= 1.0 {
+            let n = n2.sqrt();
+            return [v[0] / n, v[1] / n, v[2] / n];
+        }
+    }
+}

@@ -1,0 +1,749 @@
+//! Scenes: the TOML schema ([`schema`]), its validation into a [`Scene`], and grain generation.
+
+mod error;
+mod generate;
+pub mod schema;
+
+pub use error::SceneError;
+
+use crate::model::{
+    ContactModel, DampingLaw, MaterialConstants, NormalLaw, RollingLaw, TangentialLaw, TangentialStiffness,
+    TwistingLaw,
+};
+use crate::timestep::{self, TimeStep};
+use error::Complainer;
+use schema::{DtSpec, ModelSpec, SceneFile, SimulationSpec, StageSpec, WallSpec};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// A material, validated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name grains and walls refer to.
+    pub name: String,
+    /// Density (kg/m^3); `None` for wall-only materials.
+    pub density: Option<f64>,
+    /// Restitution coefficient as given (`constants.restitution` is 1 when not given).
+    pub restitution: Option<f64>,
+    /// Elastic and frictional constants.
+    pub constants: MaterialConstants,
+}
+
+/// The initial state of every grain, indexed by permanent id.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Grains {
+    /// Radius (m).
+    pub radius: Vec<f64>,
+    /// Mass (kg).
+    pub mass: Vec<f64>,
+    /// Centre position (m).
+    pub position: Vec<[f64; 3]>,
+    /// Velocity (m/s).
+    pub velocity: Vec<[f64; 3]>,
+    /// Angular velocity (rad/s).
+    pub angular_velocity: Vec<[f64; 3]>,
+    /// Index into [`Scene::materials`].
+    pub material: Vec<u16>,
+}
+
+impl Grains {
+    /// Number of grains.
+    pub fn len(&self) -> usize {
+        self.radius.len()
+    }
+    /// True when there are no grains.
+    pub fn is_empty(&self) -> bool {
+        self.radius.is_empty()
+    }
+    fn push(&mut self, radius: f64, mass: f64, position: [f64; 3], velocity: [f64; 3], angular_velocity: [f64; 3], material: u16) {
+        self.radius.push(radius);
+        self.mass.push(mass);
+        self.position.push(position);
+        self.velocity.push(velocity);
+        self.angular_velocity.push(angular_velocity);
+        self.material.push(material);
+    }
+}
+
+/// Shape and motion of a wall.
+#[derive(Clone, Debug, PartialEq)]
+pub enum WallShape {
+    /// Fixed plane through `point` with unit `normal` pointing into the domain.
+    Plane {
+        /// A point on the plane (m).
+        point: [f64; 3],
+        /// Unit normal into the domain.
+        normal: [f64; 3],
+    },
+    /// Fixed vertical cylinder, grains inside.
+    Cylinder {
+        /// Axis (x, y) (m).
+        center: [f64; 2],
+        /// Radius (m).
+        radius: f64,
+    },
+    /// Horizontal plate facing down, driven by a target pressure.
+    Piston {
+        /// Initial height (m).
+        z: f64,
+        /// Target pressure (Pa).
+        pressure: f64,
+        /// Mass (kg).
+        mass: f64,
+        /// Area the pressure acts on (m^2).
+        area: f64,
+    },
+}
+
+/// A wall, validated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Wall {
+    /// Name in reports, e.g. `wall[0]` or `wall[1].bottom`.
+    pub name: String,
+    /// Geometry and motion.
+    pub shape: WallShape,
+    /// Index into [`Scene::materials`].
+    pub material: u16,
+}
+
+/// Time integration scheme (seed 000 sec. 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// Velocity Verlet: one force evaluation per step.
+    VelocityVerlet,
+    /// Optimised velocity Verlet (seed 000 eqs. 11-15), `xi = 0.1931833275037836`, two force
+    /// evaluations per step.
+    OptimizedVerlet,
+}
+
+impl Integrator {
+    /// Name as written in scenes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::VelocityVerlet => "velocity_verlet",
+            Integrator::OptimizedVerlet => "optimized_verlet",
+        }
+    }
+}
+
+/// What a stage waits for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StageKind {
+    /// Deposition under gravity until settled.
+    Fill,
+    /// Relaxation until settled.
+    Settle,
+    /// A fixed duration.
+    Run,
+}
+
+/// One stage of the host loop's program.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stage {
+    /// Name in reports.
+    pub name: String,
+    /// What ends the stage.
+    pub kind: StageKind,
+    /// Run: the duration (s); fill/settle: the longest wait (s).
+    pub duration: f64,
+    /// Settled when the kinetic energy per grain (J) is below this ...
+    pub ke_per_grain: f64,
+    /// ... and the unbalanced-force ratio is below this (-).
+    pub unbalanced_force: f64,
+    /// Piston target pressure during the stage (Pa), if it changes.
+    pub piston_pressure: Option<f64>,
+}
+
+/// What `--out` records.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Output {
+    /// Simulated time between MCAP frames (s); 0 for one frame per stage end.
+    pub frame_interval: f64,
+    /// Record contact forces in frames.
+    pub contact_forces: bool,
+}
+
+/// A validated scene, in SI units and `f64`; engines convert to their precision.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Name in reports.
+    pub name: String,
+    /// One line saying what it is for.
+    pub description: String,
+    /// Materials.
+    pub materials: Vec<Material>,
+    /// Initial grain state.
+    pub grains: Grains,
+    /// Walls.
+    pub walls: Vec<Wall>,
+    /// Gravity (m/s^2).
+    pub gravity: [f64; 3],
+    /// Contact law per slot.
+    pub model: ContactModel<f64>,
+    /// Time integration scheme.
+    pub integrator: Integrator,
+    /// The time step and the times it was chosen from.
+    pub time_step: TimeStep,
+    /// Verlet skin (m).
+    pub skin: f64,
+    /// Steps between statistics reads.
+    pub stats_interval: u64,
+    /// Pairs a grain may own before the run stops with a capacity error.
+    pub max_neighbours: usize,
+    /// Overlap / smaller radius at which a run stops as unstable.
+    pub max_overlap: f64,
+    /// Integrate orientation quaternions.
+    pub track_orientation: bool,
+    /// Host-loop program.
+    pub stages: Vec<Stage>,
+    /// Recording options.
+    pub output: Output,
+    /// Warnings found while validating (e.g. a time step above the recommended fraction).
+    pub warnings: Vec<String>,
+}
+
+/// Default sliding and rolling thresholds of seed 000's tangential regimes (m/s).
+pub const DEFAULT_V_THRESHOLD: f64 = 1e-4;
+/// Default tangential-to-normal stiffness ratio for the linear law (the classic 2/7).
+pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
+/// Default settle criterion on the unbalanced-force ratio.
+pub const DEFAULT_UNBALANCED_FORCE: f64 = 0.01;
+/// Default settle speed, as a fraction of `sqrt(|g| d_mean)`.
+pub const DEFAULT_SETTLE_SPEED_FRACTION: f64 = 1e-3;
+
+/// Reads and validates a scene file.
+pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read { file: path.to_path_buf(), source })?;
+    parse(path, &text)
+}
+
+/// Validates scene text as if read from `path`.
+pub fn parse(path: &Path, text: &str) -> Result<Scene, SceneError> {
+    let file: SceneFile = toml::from_str(text).map_err(|e| SceneError::syntax(path, text, &e))?;
+    validate(path, file)
+}
+
+fn positive(c: &Complainer, key: &str, v: f64, fix: &str) -> Result<f64, SceneError> {
+    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(c.invalid(key, v, "must be a positive number", fix)) }
+}
+
+fn non_negative(c: &Complainer, key: &str, v: f64, fix: &str) -> Result<f64, SceneError> {
+    if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(c.invalid(key, v, "must be zero or positive", fix)) }
+}
+
+fn finite3(c: &Complainer, key: &str, v: [f64; 3]) -> Result<[f64; 3], SceneError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(v)
+    } else {
+        Err(c.invalid(key, format!("{v:?}"), "must be three finite numbers", "give finite values in SI units"))
+    }
+}
+
+fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
+    let c = Complainer { file: path };
+    let mut warnings = Vec::new();
+    let materials = validate_materials(&c, &f)?;
+    let index: HashMap<&str, u16> = materials.iter().enumerate().map(|(i, m)| (m.name.as_str(), i as u16)).collect();
+    let material_of = |key: String, name: &str| -> Result<u16, SceneError> {
+        index.get(name).copied().ok_or_else(|| {
+            let known: Vec<&str> = materials.iter().map(|m| m.name.as_str()).collect();
+            c.invalid(key, format!("\"{name}\""), "names no [[material]]", format!("use one of {known:?} or add a [[material]] with this name"))
+        })
+    };
+    let grain_density = |key: String, m: u16| -> Result<f64, SceneError> {
+        materials[m as usize].density.ok_or_else(|| {
+            c.invalid(key, format!("\"{}\"", materials[m as usize].name), "grain material has no density", "add `density` (kg/m^3) to that [[material]]")
+        })
+    };
+
+    let seed = f.seed.unwrap_or(1);
+    let mut grains = Grains::default();
+    for (i, g) in f.grains.iter().enumerate() {
+        let key = |k: &str| format!("grain[{i}].{k}");
+        let m = material_of(key("material"), &g.material)?;
+        let rho = grain_density(key("material"), m)?;
+        let r = positive(&c, &key("radius"), g.radius, "give the radius in metres, e.g. 5e-4")?;
+        let p = finite3(&c, &key("position"), g.position)?;
+        let v = finite3(&c, &key("velocity"), g.velocity)?;
+        let w = finite3(&c, &key("angular_velocity"), g.angular_velocity)?;
+        grains.push(r, sphere_mass(r, rho), p, v, w, m);
+    }
+    let walls = validate_walls(&c, &f, &material_of)?;
+    for (k, spec) in f.generators.iter().enumerate() {
+        let key = |s: &str| format!("generate[{k}].{s}");
+        let m = material_of(key("material"), &spec.material)?;
+        let rho = grain_density(key("material"), m)?;
+        generate::place(&c, k, spec, m, rho, seed, &mut grains)?;
+    }
+    if grains.is_empty() {
+        return Err(c.invalid("grain", "[]", "the scene has no grains", "add [[grain]] or [[generate]] tables"));
+    }
+    let walls = finish_walls(&c, walls, &grains)?;
+    check_overlaps(&c, &f, &grains, &walls)?;
+
+    let model = validate_model(&c, &f.model, &materials, &grains, &walls)?;
+    let sim = &f.simulation;
+    let gravity = finite3(&c, "simulation.gravity", sim.gravity)?;
+    let integrator = match sim.integrator.as_deref().unwrap_or("velocity_verlet") {
+        "velocity_verlet" => Integrator::VelocityVerlet,
+        "optimized_verlet" => Integrator::OptimizedVerlet,
+        other => {
+            return Err(c.invalid("simulation.integrator", format!("\"{other}\""), "unknown integrator", "use \"velocity_verlet\" or \"optimized_verlet\""));
+        }
+    };
+    let d_mean = 2.0 * grains.radius.iter().sum::<f64>() / grains.len() as f64;
+    let skin = match sim.skin {
+        Some(s) => positive(&c, "simulation.skin", s, "give the skin in metres, e.g. 0.1 x the mean diameter")?,
+        None => 0.1 * d_mean,
+    };
+    let time_step = choose_time_step(&c, sim, &materials, &grains, &walls, &model, gravity, &mut warnings)?;
+    let stats_interval = sim.stats_interval.unwrap_or(500);
+    if stats_interval == 0 {
+        return Err(c.invalid("simulation.stats_interval", 0, "must be at least 1", "give a number of steps, e.g. 500"));
+    }
+    let max_neighbours = sim.max_neighbours.unwrap_or(32);
+    if max_neighbours == 0 {
+        return Err(c.invalid("simulation.max_neighbours", 0, "must be at least 1", "give a capacity, e.g. 32"));
+    }
+    let max_overlap = match sim.max_overlap {
+        Some(v) => positive(&c, "simulation.max_overlap", v, "give a fraction of the radius, e.g. 0.2")?,
+        None => 0.2,
+    };
+    let stages = validate_stages(&c, &f.stages, &grains, gravity, d_mean, &walls)?;
+    let output = Output {
+        frame_interval: non_negative(&c, "output.frame_interval", f.output.frame_interval, "give seconds, or 0 for a frame per stage")?,
+        contact_forces: f.output.contact_forces,
+    };
+    let name = f.name.clone().unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
+    Ok(Scene {
+        path: path.to_path_buf(),
+        name,
+        description: f.description.clone().unwrap_or_default(),
+        materials,
+        grains,
+        walls,
+        gravity,
+        model,
+        integrator,
+        time_step,
+        skin,
+        stats_interval,
+        max_neighbours,
+        max_overlap,
+        track_orientation: sim.track_orientation,
+        stages,
+        output,
+        warnings,
+    })
+}
+
+/// Mass (kg) of a sphere of radius `r` (m) and density `rho` (kg/m^3).
+pub fn sphere_mass(r: f64, rho: f64) -> f64 {
+    4.0 / 3.0 * std::f64::consts::PI * r * r * r * rho
+}
+
+fn validate_materials(c: &Complainer, f: &SceneFile) -> Result<Vec<Material>, SceneError> {
+    let mut out: Vec<Material> = Vec::new();
+    for (i, m) in f.materials.iter().enumerate() {
+        let key = |k: &str| format!("material[{i}].{k}");
+        if out.iter().any(|o| o.name == m.name) {
+            return Err(c.invalid(key("name"), format!("\"{}\"", m.name), "is used by an earlier material", "give each material its own name"));
+        }
+        let density = match m.density {
+            Some(d) => Some(positive(c, &key("density"), d, "give the density in kg/m^3, e.g. 2650")?),
+            None => None,
+        };
+        let youngs_modulus = positive(c, &key("youngs_modulus"), m.youngs_modulus, "give Young's modulus in Pa, e.g. 7e7")?;
+        if !(0.0..0.5).contains(&m.poisson_ratio) {
+            return Err(c.invalid(key("poisson_ratio"), m.poisson_ratio, "must lie in [0, 0.5)", "give a Poisson ratio such as 0.3"));
+        }
+        let mu_s = non_negative(c, &key("mu_s"), m.mu_s, "give a friction coefficient such as 0.5")?;
+        let mu_k = non_negative(c, &key("mu_k"), m.mu_k.unwrap_or(mu_s), "give a friction coefficient such as 0.4")?;
+        if !(0.0..90.0).contains(&m.rolling_angle) {
+            return Err(c.invalid(key("rolling_angle"), m.rolling_angle, "must lie in [0, 90) degrees", "give the rolling angle in degrees, e.g. 5"));
+        }
+        let gamma_n = non_negative(c, &key("gamma_n"), m.gamma_n, "give gamma_n in s^-1 m^-1/2, or 0")?;
+        let gamma_nt = non_negative(c, &key("gamma_nt"), m.gamma_nt, "give gamma_nt in s^-1, or 0")?;
+        if let Some(e) = m.restitution.filter(|e| !(*e > 0.0 && *e <= 1.0)) {
+            return Err(c.invalid(key("restitution"), e, "must lie in (0, 1]", "give a restitution coefficient such as 0.5"));
+        }
+        out.push(Material {
+            name: m.name.clone(),
+            density,
+            restitution: m.restitution,
+            constants: MaterialConstants {
+                youngs_modulus,
+                poisson_ratio: m.poisson_ratio,
+                mu_s,
+                mu_k,
+                rolling_angle: m.rolling_angle.to_radians(),
+                gamma_n,
+                gamma_nt,
+                restitution: m.restitution.unwrap_or(1.0),
+            },
+        });
+    }
+    if out.is_empty() {
+        return Err(c.invalid("material", "[]", "the scene has no [[material]]", "add a [[material]] table with name, density, youngs_modulus and poisson_ratio"));
+    }
+    Ok(out)
+}
+
+/// Walls before the piston's defaults are known.
+struct PendingWall {
+    wall: Wall,
+    piston_mass: Option<f64>,
+    piston_area: Option<f64>,
+}
+
+fn validate_walls(
+    c: &Complainer,
+    f: &SceneFile,
+    material_of: &dyn Fn(String, &str) -> Result<u16, SceneError>,
+) -> Result<Vec<PendingWall>, SceneError> {
+    let mut out = Vec::new();
+    let plain = |name: String, shape: WallShape, material: u16| PendingWall { wall: Wall { name, shape, material }, piston_mass: None, piston_area: None };
+    for (i, w) in f.walls.iter().enumerate() {
+        let key = |k: &str| format!("wall[{i}].{k}");
+        match w {
+            WallSpec::Plane { material, point, normal } => {
+                let m = material_of(key("material"), material)?;
+                let point = finite3(c, &key("point"), *point)?;
+                let normal = finite3(c, &key("normal"), *normal)?;
+                let len = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
+                if len == 0.0 {
+                    return Err(c.invalid(key("normal"), format!("{normal:?}"), "is the zero vector", "give the direction into the domain, e.g. [0, 0, 1]"));
+                }
+                let normal = [normal[0] / len, normal[1] / len, normal[2] / len];
+                out.push(plain(format!("wall[{i}]"), WallShape::Plane { point, normal }, m));
+            }
+            WallSpec::Box { material, min, max, open_top } => {
+                let m = material_of(key("material"), material)?;
+                let (lo, hi) = (finite3(c, &key("min"), *min)?, finite3(c, &key("max"), *max)?);
+                if (0..3).any(|k| hi[k] <= lo[k]) {
+                    return Err(c.invalid(key("max"), format!("{hi:?}"), format!("must exceed min {lo:?} on every axis"), "give the upper corner above the lower one"));
+                }
+                let faces: [(&str, [f64; 3], [f64; 3]); 6] = [
+                    ("bottom", lo, [0.0, 0.0, 1.0]),
+                    ("top", hi, [0.0, 0.0, -1.0]),
+                    ("x_min", lo, [1.0, 0.0, 0.0]),
+                    ("x_max", hi, [-1.0, 0.0, 0.0]),
+                    ("y_min", lo, [0.0, 1.0, 0.0]),
+                    ("y_max", hi, [0.0, -1.0, 0.0]),
+                ];
+                for (face, point, normal) in faces {
+                    if *open_top && face == "top" {
+                        continue;
+                    }
+                    out.push(plain(format!("wall[{i}].{face}"), WallShape::Plane { point, normal }, m));
+                }
+            }
+            WallSpec::Cylinder { material, center, radius } => {
+                let m = material_of(key("material"), material)?;
+                let radius = positive(c, &key("radius"), *radius, "give the radius in metres")?;
+                out.push(plain(format!("wall[{i}]"), WallShape::Cylinder { center: *center, radius }, m));
+            }
+            WallSpec::Piston { material, z, pressure, mass, area } => {
+                let m = material_of(key("material"), material)?;
+                if !z.is_finite() {
+                    return Err(c.invalid(key("z"), z, "must be finite", "give the initial height in metres"));
+                }
+                let pressure = non_negative(c, &key("pressure"), *pressure, "give the pressure in Pa")?;
+                let piston_mass = mass.map(|v| positive(c, &key("mass"), v, "give the mass in kg or leave it out")).transpose()?;
+                let piston_area = area.map(|v| positive(c, &key("area"), v, "give the area in m^2 or leave it out")).transpose()?;
+                if out.iter().any(|p: &PendingWall| matches!(p.wall.shape, WallShape::Piston { .. })) {
+                    return Err(c.invalid(key("type"), "\"piston\"", "a scene has at most one piston", "remove the extra piston"));
+                }
+                out.push(PendingWall {
+                    wall: Wall { name: format!("wall[{i}]"), shape: WallShape::Piston { z: *z, pressure, mass: 0.0, area: 0.0 }, material: m },
+                    piston_mass,
+                    piston_area,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Fills in the piston's default mass (total grain mass) and area (cross-section of the
+/// cylinder, or of a box's side walls).
+fn finish_walls(c: &Complainer, pending: Vec<PendingWall>, grains: &Grains) -> Result<Vec<Wall>, SceneError> {
+    let section = cross_section(pending.iter().map(|p| &p.wall.shape));
+    let total_mass: f64 = grains.mass.iter().sum();
+    let mut out = Vec::with_capacity(pending.len());
+    for p in pending {
+        let mut wall = p.wall;
+        if let WallShape::Piston { mass, area, .. } = &mut wall.shape {
+            *mass = p.piston_mass.unwrap_or(total_mass);
+            *area = match p.piston_area.or(section) {
+                Some(a) => a,
+                None => {
+                    return Err(c.invalid(format!("{}.area", wall.name), "(none)", "the piston's area cannot be inferred without a cylinder or box wall", "give `area` in m^2"));
+                }
+            };
+        }
+        out.push(wall);
+    }
+    Ok(out)
+}
+
+/// Horizontal cross-section (m^2) of a container: a cylinder wall's, or that of the four side
+/// planes of a box; `None` when the walls do not bound one.
+pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone) -> Option<f64> {
+    let cylinder = shapes.clone().find_map(|s| match *s {
+        WallShape::Cylinder { radius, .. } => Some(std::f64::consts::PI * radius * radius),
+        _ => None,
+    });
+    cylinder.or_else(|| {
+        let side = |n: [f64; 3]| {
+            shapes.clone().find_map(|s| match *s {
+                WallShape::Plane { point, normal } if normal == n => Some(point),
+                _ => None,
+            })
+        };
+        let (x0, x1) = (side([1.0, 0.0, 0.0])?, side([-1.0, 0.0, 0.0])?);
+        let (y0, y1) = (side([0.0, 1.0, 0.0])?, side([0.0, -1.0, 0.0])?);
+        Some((x1[0] - x0[0]) * (y1[1] - y0[1]))
+    })
+}
+
+/// Signed distance (m) from a point to a wall's surface at its initial position, positive on
+/// the grains' side.
+pub fn wall_distance(shape: &WallShape, p: [f64; 3]) -> f64 {
+    crate::walls::WallGeom::<f64>::of(shape).frame(crate::real::Vec3::of(p)).1
+}
+
+/// Grains may not start overlapping a wall or (listed grains) each other: the first step
+/// would release the stored energy at once.
+fn check_overlaps(c: &Complainer, f: &SceneFile, grains: &Grains, walls: &[Wall]) -> Result<(), SceneError> {
+    let listed = f.grains.len();
+    let origin = |i: usize| {
+        if i < listed {
+            format!("grain[{i}].position")
+        } else {
+            let mut k = i - listed;
+            let mut g = 0;
+            while k >= f.generators[g].count {
+                k -= f.generators[g].count;
+                g += 1;
+            }
+            format!("generate[{g}] grain {k}")
+        }
+    };
+    for i in 0..grains.len() {
+        for w in walls {
+            let d = wall_distance(&w.shape, grains.position[i]);
+            if d < grains.radius[i] {
+                return Err(c.invalid(
+                    origin(i),
+                    format!("{:?}", grains.position[i]),
+                    format!("the grain (radius {:e} m) overlaps {} by {:e} m", grains.radius[i], w.name, grains.radius[i] - d),
+                    "move the grain or its generator's region inside the walls",
+                ));
+            }
+        }
+    }
+    for i in 0..listed {
+        for j in 0..i {
+            let d2: f64 = (0..3).map(|k| (grains.position[i][k] - grains.position[j][k]).powi(2)).sum();
+            if d2.sqrt() < grains.radius[i] + grains.radius[j] {
+                return Err(c.invalid(origin(i), format!("{:?}", grains.position[i]), format!("overlaps grain[{j}]"), "place listed grains apart"));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains: &Grains, walls: &[Wall]) -> Result<ContactModel<f64>, SceneError> {
+    let law = |v: &Option<String>, default: &str| v.clone().unwrap_or_else(|| default.to_string());
+    let unused = |key: &str, set: bool, law: &str| -> Result<(), SceneError> {
+        if set {
+            Err(c.invalid(format!("model.{key}"), "(set)", format!("is not used by the chosen laws ({law})"), format!("remove `{key}` or choose the law that uses it")))
+        } else {
+            Ok(())
+        }
+    };
+    let need = |key: &str, v: Option<f64>, why: &str| -> Result<f64, SceneError> {
+        match v {
+            Some(x) => positive(c, &format!("model.{key}"), x, why),
+            None => Err(c.invalid(format!("model.{key}"), "(missing)", "is required by the chosen law", why.to_string())),
+        }
+    };
+    let normal_name = law(&m.normal, "hertz");
+    let normal = match normal_name.as_str() {
+        "hertz" => {
+            unused("k_n", m.k_n.is_some(), "normal = \"hertz\"")?;
+            NormalLaw::Hertz
+        }
+        "linear" => NormalLaw::Linear { k_n: need("k_n", m.k_n, "give the linear stiffness k_n in N/m")? },
+        other => return Err(c.invalid("model.normal", format!("\"{other}\""), "unknown normal law", "use \"hertz\" or \"linear\"")),
+    };
+    let damping_name = law(&m.damping, "none");
+    let damping = match damping_name.as_str() {
+        "none" => DampingLaw::None,
+        "papers" => DampingLaw::Papers,
+        "restitution" => {
+            // Every material in contact needs its restitution coefficient.
+            let used: Vec<u16> = grains.material.iter().copied().chain(walls.iter().map(|w| w.material)).collect();
+            if let Some((i, _)) = materials.iter().enumerate().find(|(i, mat)| used.contains(&(*i as u16)) && mat.restitution.is_none()) {
+                return Err(c.invalid(format!("material[{i}].restitution"), "(missing)", "damping = \"restitution\" needs it", "add `restitution` in (0, 1] to the material"));
+            }
+            DampingLaw::Restitution
+        }
+        "viscous" => DampingLaw::Viscous { c_n: need("c_n", m.c_n, "give the dashpot coefficient c_n in N s/m")? },
+        other => return Err(c.invalid("model.damping", format!("\"{other}\""), "unknown damping law", "use \"none\", \"papers\", \"restitution\" or \"viscous\"")),
+    };
+    if !matches!(damping, DampingLaw::Viscous { .. }) {
+        unused("c_n", m.c_n.is_some(), &format!("damping = \"{damping_name}\""))?;
+    }
+    if matches!(damping, DampingLaw::Papers) && materials.iter().all(|x| x.constants.gamma_n == 0.0) {
+        return Err(c.invalid("model.damping", "\"papers\"", "no material sets gamma_n, so it would not damp", "set `gamma_n` (s^-1 m^-1/2) in the [[material]] tables or use damping = \"none\""));
+    }
+    let stiffness = |kt: Option<f64>| -> Result<TangentialStiffness<f64>, SceneError> {
+        match (kt, normal) {
+            (Some(r), _) => Ok(TangentialStiffness::RatioToNormal(positive(c, "model.kt_ratio", r, "give a ratio such as 2/7")?)),
+            (None, NormalLaw::Hertz) => Ok(TangentialStiffness::Mindlin),
+            (None, NormalLaw::Linear { .. }) => Ok(TangentialStiffness::RatioToNormal(DEFAULT_LINEAR_KT_RATIO)),
+        }
+    };
+    let tangential_name = law(&m.tangential, "none");
+    let tangential = match tangential_name.as_str() {
+        "none" => {
+            for (k, set) in [("v_slip", m.v_slip.is_some()), ("v_roll", m.v_roll.is_some()), ("kt_ratio", m.kt_ratio.is_some()), ("tangential_damping_ratio", m.tangential_damping_ratio.is_some())] {
+                unused(k, set, "tangential = \"none\"")?;
+            }
+            TangentialLaw::None
+        }
+        "oquendo" => {
+            unused("tangential_damping_ratio", m.tangential_damping_ratio.is_some(), "tangential = \"oquendo\"")?;
+            TangentialLaw::Oquendo {
+                v_slip: positive(c, "model.v_slip", m.v_slip.unwrap_or(DEFAULT_V_THRESHOLD), "give a small speed in m/s, e.g. 1e-4")?,
+                v_roll: positive(c, "model.v_roll", m.v_roll.unwrap_or(DEFAULT_V_THRESHOLD), "give a small speed in m/s, e.g. 1e-4")?,
+                stiffness: stiffness(m.kt_ratio)?,
+            }
+        }
+        "mindlin" => {
+            unused("v_slip", m.v_slip.is_some(), "tangential = \"mindlin\"")?;
+            unused("v_roll", m.v_roll.is_some(), "tangential = \"mindlin\"")?;
+            for (i, mat) in materials.iter().enumerate() {
+                if mat.constants.mu_k != mat.constants.mu_s {
+                    return Err(c.invalid(format!("material[{i}].mu_k"), mat.constants.mu_k, "the Hertz-Mindlin law has one friction coefficient (mu_s)", "remove mu_k or set it equal to mu_s"));
+                }
+            }
+            TangentialLaw::Mindlin {
+                damping_ratio: non_negative(c, "model.tangential_damping_ratio", m.tangential_damping_ratio.unwrap_or(0.0), "give a fraction such as 0.9075")?,
+                stiffness: stiffness(m.kt_ratio)?,
+            }
+        }
+        other => return Err(c.invalid("model.tangential", format!("\"{other}\""), "unknown tangential law", "use \"none\", \"oquendo\" or \"mindlin\"")),
+    };
+    let rolling_name = law(&m.rolling, "none");
+    let rolling = match rolling_name.as_str() {
+        "none" => {
+            for (k, set) in [("rolling_k", m.rolling_k.is_some()), ("rolling_gamma", m.rolling_gamma.is_some()), ("rolling_mu", m.rolling_mu.is_some())] {
+                unused(k, set, "rolling = \"none\"")?;
+            }
+            RollingLaw::None
+        }
+        "sds" => RollingLaw::Sds {
+            k_r: need("rolling_k", m.rolling_k, "give the rolling stiffness in N/m")?,
+            gamma_r: non_negative(c, "model.rolling_gamma", m.rolling_gamma.unwrap_or(0.0), "give the rolling damping in N s/m")?,
+            mu_r: need("rolling_mu", m.rolling_mu, "give the rolling friction coefficient, e.g. 0.05")?,
+        },
+        other => return Err(c.invalid("model.rolling", format!("\"{other}\""), "unknown rolling law", "use \"none\" or \"sds\"")),
+    };
+    let twisting_name = law(&m.twisting, "none");
+    let twisting = match twisting_name.as_str() {
+        "none" => TwistingLaw::None,
+        "oquendo" => TwistingLaw::Oquendo,
+        other => return Err(c.invalid("model.twisting", format!("\"{other}\""), "unknown twisting law", "use \"none\" or \"oquendo\"")),
+    };
+    Ok(ContactModel { normal, damping, tangential, rolling, twisting })
+}
+
+#[allow(clippy::too_many_arguments, reason = "validation needs the whole scene")]
+fn choose_time_step(
+    c: &Complainer,
+    sim: &SimulationSpec,
+    materials: &[Material],
+    grains: &Grains,
+    walls: &[Wall],
+    model: &ContactModel<f64>,
+    gravity: [f64; 3],
+    warnings: &mut Vec<String>,
+) -> Result<TimeStep, SceneError> {
+    let expected_speed = match sim.expected_speed {
+        Some(v) => positive(c, "simulation.expected_speed", v, "give a speed in m/s")?,
+        None => timestep::default_expected_speed(grains, gravity),
+    };
+    let times = timestep::characteristic_times(materials, grains, walls, model, expected_speed);
+    match sim.dt.unwrap_or(DtSpec::Auto) {
+        DtSpec::Auto => Ok(TimeStep::auto(times)),
+        DtSpec::Seconds(dt) => {
+            let dt = positive(c, "simulation.dt", dt, "give the step in seconds or \"auto\"")?;
+            let ts = TimeStep::given(dt, times);
+            if let Some(limit) = ts.exceeds_limit() {
+                return Err(c.invalid("simulation.dt", dt, format!("is above the stability limit {limit}"), format!("use dt <= {:.3e} s or \"auto\" ({:.3e} s)", ts.safe_limit(), ts.auto_dt())));
+            }
+            if let Some(w) = ts.warning() {
+                warnings.push(format!("{}: simulation.dt = {dt:e}: {w}", c.file.display()));
+            }
+            Ok(ts)
+        }
+    }
+}
+
+fn validate_stages(c: &Complainer, specs: &[StageSpec], grains: &Grains, gravity: [f64; 3], d_mean: f64, walls: &[Wall]) -> Result<Vec<Stage>, SceneError> {
+    let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
+    let m_mean = grains.mass.iter().sum::<f64>() / grains.len() as f64;
+    let has_piston = walls.iter().any(|w| matches!(w.shape, WallShape::Piston { .. }));
+    let mut out = Vec::new();
+    for (i, s) in specs.iter().enumerate() {
+        let key = |k: &str| format!("stage[{i}].{k}");
+        let kind = match s.kind.as_str() {
+            "fill" => StageKind::Fill,
+            "settle" => StageKind::Settle,
+            "run" => StageKind::Run,
+            other => return Err(c.invalid(key("kind"), format!("\"{other}\""), "unknown stage kind", "use \"fill\", \"settle\" or \"run\"")),
+        };
+        let duration = positive(c, &key("duration"), s.duration, "give the (longest) stage time in seconds")?;
+        if kind == StageKind::Fill && g == 0.0 {
+            return Err(c.invalid(key("kind"), "\"fill\"", "deposition needs gravity", "set simulation.gravity or use kind = \"settle\""));
+        }
+        if kind == StageKind::Run {
+            for (k, set) in [("ke_per_grain", s.ke_per_grain.is_some()), ("unbalanced_force", s.unbalanced_force.is_some())] {
+                if set {
+                    return Err(c.invalid(key(k), "(set)", "is a settle criterion; a \"run\" stage ends after its duration", format!("remove `{k}` or use kind = \"settle\"")));
+                }
+            }
+        }
+        let ke_per_grain = match s.ke_per_grain {
+            Some(v) => positive(c, &key("ke_per_grain"), v, "give an energy in J")?,
+            None if kind == StageKind::Run => 0.0,
+            None if g > 0.0 => {
+                let v = DEFAULT_SETTLE_SPEED_FRACTION * (g * d_mean).sqrt();
+                0.5 * m_mean * v * v
+            }
+            None => return Err(c.invalid(key("ke_per_grain"), "(missing)", "has no default without gravity", "give the settled kinetic energy per grain in J")),
+        };
+        let unbalanced_force = match s.unbalanced_force {
+            Some(v) => positive(c, &key("unbalanced_force"), v, "give a ratio such as 0.01")?,
+            None => DEFAULT_UNBALANCED_FORCE,
+        };
+        let piston_pressure = match s.piston_pressure {
+            Some(_) if !has_piston => {
+                return Err(c.invalid(key("piston_pressure"), "(set)", "the scene has no piston", "add a [[wall]] with type = \"piston\" or remove the key"));
+            }
+            Some(p) => Some(non_negative(c, &key("piston_pressure"), p, "give the pressure in Pa")?),
+            None => None,
+        };
+        let name = s.name.clone().unwrap_or_else(|| format!("{}{}", s.kind, i));
+        out.push(Stage { name, kind, duration, ke_per_grain, unbalanced_force, piston_pressure });
+    }
+    if out.is_empty() {
+        return Err(c.invalid("stage", "[]", "the scene has no [[stage]]", "add e.g. [[stage]] kind = \"run\" duration = 1e-3"));
+    }
+    Ok(out)
+}

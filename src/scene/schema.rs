@@ -1,0 +1,348 @@
+//! The TOML scene schema, as written by users. Every key is documented with its unit; unknown
+//! keys are rejected. [`super::load`] turns a file into a validated [`super::Scene`].
+//!
+//! Keep the README's scene reference in step with this file.
+
+use serde::Deserialize;
+
+/// A whole scene file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Scene name used in reports (default: the file stem).
+    pub name: Option<String>,
+    /// One line saying what the scene is for.
+    pub description: Option<String>,
+    /// Seed of every random choice of the scene (grain sizes, placement, velocities). Default 1.
+    pub seed: Option<u64>,
+    /// `[[material]]` tables.
+    #[serde(default, rename = "material")]
+    pub materials: Vec<MaterialSpec>,
+    /// `[[grain]]` tables: grains given one by one.
+    #[serde(default, rename = "grain")]
+    pub grains: Vec<GrainSpec>,
+    /// `[[generate]]` tables: grains placed at random.
+    #[serde(default, rename = "generate")]
+    pub generators: Vec<GeneratorSpec>,
+    /// `[[wall]]` tables.
+    #[serde(default, rename = "wall")]
+    pub walls: Vec<WallSpec>,
+    /// `[model]`: the contact law per slot.
+    #[serde(default)]
+    pub model: ModelSpec,
+    /// `[simulation]`: gravity, integrator, time step, neighbour search, safety limits.
+    #[serde(default)]
+    pub simulation: SimulationSpec,
+    /// `[[stage]]` tables: the host loop's program, run in order.
+    #[serde(default, rename = "stage")]
+    pub stages: Vec<StageSpec>,
+    /// `[output]`: what `--out DIR` records.
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+/// `[[material]]`: one grain or wall material.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialSpec {
+    /// Name that grains and walls refer to.
+    pub name: String,
+    /// Density (kg/m^3). Required for grain materials; walls have infinite mass.
+    pub density: Option<f64>,
+    /// Young's modulus E (Pa).
+    pub youngs_modulus: f64,
+    /// Poisson ratio nu (-), in [0, 0.5).
+    pub poisson_ratio: f64,
+    /// Static friction coefficient mu_s (-). Default 0. The Hertz-Mindlin law uses it as its
+    /// single Coulomb coefficient.
+    #[serde(default)]
+    pub mu_s: f64,
+    /// Kinetic (sliding) friction coefficient mu_k (-). Default: mu_s.
+    pub mu_k: Option<f64>,
+    /// Rolling angle theta_r (degrees) of seed 000's rolling regime. Default 0.
+    #[serde(default)]
+    pub rolling_angle: f64,
+    /// Normal damping gamma_n (s^-1 m^-1/2) of `damping = "papers"`. Default 0.
+    #[serde(default)]
+    pub gamma_n: f64,
+    /// Twisting damping gamma_nt (s^-1) of `twisting = "oquendo"`. Default 0.
+    #[serde(default)]
+    pub gamma_nt: f64,
+    /// Restitution coefficient (-), in (0, 1], of `damping = "restitution"`.
+    pub restitution: Option<f64>,
+}
+
+/// `[[grain]]`: one grain.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GrainSpec {
+    /// Material name.
+    pub material: String,
+    /// Radius (m).
+    pub radius: f64,
+    /// Centre position (m).
+    pub position: [f64; 3],
+    /// Velocity (m/s). Default 0.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Angular velocity (rad/s). Default 0.
+    #[serde(default)]
+    pub angular_velocity: [f64; 3],
+}
+
+/// `[[generate]]`: grains of one material placed at random without overlap in a region.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GeneratorSpec {
+    /// Material name.
+    pub material: String,
+    /// Number of grains.
+    pub count: usize,
+    /// Diameters, uniform in `[min, max]` (m); `min = max` for equal grains.
+    pub diameter: RangeSpec,
+    /// Where the centres go; each grain lies wholly inside the region.
+    pub region: RegionSpec,
+    /// Velocity of every grain (m/s). Default 0.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Speed (m/s) added in a random direction per grain (a gas). Default 0.
+    #[serde(default)]
+    pub random_speed: f64,
+}
+
+/// A closed interval.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RangeSpec {
+    /// Lower bound.
+    pub min: f64,
+    /// Upper bound.
+    pub max: f64,
+}
+
+/// A region of space.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
+pub enum RegionSpec {
+    /// Axis-aligned box.
+    Box {
+        /// Lower corner (m).
+        min: [f64; 3],
+        /// Upper corner (m).
+        max: [f64; 3],
+    },
+    /// Vertical cylinder (axis along z).
+    Cylinder {
+        /// Axis position (x, y) (m).
+        center: [f64; 2],
+        /// Radius (m).
+        radius: f64,
+        /// Bottom (m).
+        z_min: f64,
+        /// Top (m).
+        z_max: f64,
+    },
+}
+
+/// `[[wall]]`: a rigid boundary made of `material`.
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case", deny_unknown_fields)]
+pub enum WallSpec {
+    /// Infinite plane; grains live on the side its normal points to.
+    Plane {
+        /// Material name.
+        material: String,
+        /// A point on the plane (m).
+        point: [f64; 3],
+        /// Normal pointing into the domain (any length).
+        normal: [f64; 3],
+    },
+    /// Five or six planes bounding an axis-aligned box; grains live inside.
+    Box {
+        /// Material name.
+        material: String,
+        /// Lower corner (m).
+        min: [f64; 3],
+        /// Upper corner (m).
+        max: [f64; 3],
+        /// Leave out the top (z = max) plane. Default false.
+        #[serde(default)]
+        open_top: bool,
+    },
+    /// Vertical cylindrical side wall (axis along z, infinite height); grains live inside.
+    Cylinder {
+        /// Material name.
+        material: String,
+        /// Axis position (x, y) (m).
+        center: [f64; 2],
+        /// Radius (m).
+        radius: f64,
+    },
+    /// Horizontal plate facing down whose height follows Newton's law under the grains' push
+    /// and a target pressure (stages may change the pressure).
+    Piston {
+        /// Material name.
+        material: String,
+        /// Initial height (m).
+        z: f64,
+        /// Target pressure (Pa), pushing down on the grains. Default 0.
+        #[serde(default)]
+        pressure: f64,
+        /// Mass (kg). Default: the total grain mass.
+        mass: Option<f64>,
+        /// Area (m^2) the pressure acts on. Default: the cross-section of the scene's cylinder
+        /// wall or box.
+        area: Option<f64>,
+    },
+}
+
+/// `[model]`: the contact law chosen per slot, with the parameters of the chosen laws.
+/// A parameter of a law not chosen is an error.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// "hertz" (default) or "linear".
+    pub normal: Option<String>,
+    /// "none" (default), "papers", "restitution" or "viscous".
+    pub damping: Option<String>,
+    /// "none" (default), "oquendo" or "mindlin".
+    pub tangential: Option<String>,
+    /// "none" (default) or "sds".
+    pub rolling: Option<String>,
+    /// "none" (default) or "oquendo".
+    pub twisting: Option<String>,
+    /// Linear normal stiffness k_n (N/m), `normal = "linear"`.
+    pub k_n: Option<f64>,
+    /// Viscous coefficient c_n (N s/m), `damping = "viscous"`.
+    pub c_n: Option<f64>,
+    /// Sliding threshold (m/s), `tangential = "oquendo"`. Default 1e-4.
+    pub v_slip: Option<f64>,
+    /// Rolling threshold (m/s), `tangential = "oquendo"`. Default 1e-4.
+    pub v_roll: Option<f64>,
+    /// Tangential spring as a ratio of the normal secant stiffness (-). Default: Mindlin
+    /// `8 G_eff sqrt(R_eff h)` for Hertz, 2/7 for linear.
+    pub kt_ratio: Option<f64>,
+    /// Tangential damping as a fraction of the normal damping coefficient (-),
+    /// `tangential = "mindlin"`. Default 0.
+    pub tangential_damping_ratio: Option<f64>,
+    /// Rolling stiffness k_r (N/m), `rolling = "sds"`.
+    pub rolling_k: Option<f64>,
+    /// Rolling damping gamma_r (N s/m), `rolling = "sds"`. Default 0.
+    pub rolling_gamma: Option<f64>,
+    /// Rolling friction coefficient mu_r (-), `rolling = "sds"`.
+    pub rolling_mu: Option<f64>,
+}
+
+/// A time step: a number of seconds or "auto".
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DtSpec {
+    /// Pick from the Rayleigh and Hertz times.
+    Auto,
+    /// This many seconds.
+    Seconds(f64),
+}
+
+impl<'de> Deserialize<'de> for DtSpec {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = DtSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a time step in seconds or \"auto\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<DtSpec, E> {
+                Ok(DtSpec::Seconds(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<DtSpec, E> {
+                Ok(DtSpec::Seconds(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<DtSpec, E> {
+                if v == "auto" { Ok(DtSpec::Auto) } else { Err(E::invalid_value(serde::de::Unexpected::Str(v), &self)) }
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+/// `[simulation]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SimulationSpec {
+    /// Gravity (m/s^2). Default [0, 0, -9.81].
+    #[serde(default = "default_gravity")]
+    pub gravity: [f64; 3],
+    /// "velocity_verlet" (default; one force evaluation per step) or "optimized_verlet"
+    /// (seed 000 eqs. 11-15, two evaluations per step).
+    pub integrator: Option<String>,
+    /// Time step (s) or "auto" (default): the smaller of 0.1 t_R and t_c / 50.
+    pub dt: Option<DtSpec>,
+    /// Largest speed expected in a collision (m/s), for the Hertz time t_c. Default: the
+    /// largest initial speed or the free-fall speed over the grains' height, whichever is larger.
+    pub expected_speed: Option<f64>,
+    /// Verlet skin (m): pairs closer than R_i + R_j + skin are listed; the list is rebuilt when
+    /// a grain has moved skin/2. Default: 0.1 x the mean diameter.
+    pub skin: Option<f64>,
+    /// Steps between statistics reads (kinetic energy, overlaps, wall forces). Default 500.
+    pub stats_interval: Option<u64>,
+    /// Neighbour capacity per grain (pairs a grain owns); exceeding it is an error. Default 32.
+    pub max_neighbours: Option<usize>,
+    /// Overlap, as a fraction of the smaller radius, at which a run is stopped as unstable.
+    /// Default 0.2.
+    pub max_overlap: Option<f64>,
+    /// Integrate orientation quaternions (Omelyan's norm-preserving update). Default false.
+    #[serde(default)]
+    pub track_orientation: bool,
+}
+
+fn default_gravity() -> [f64; 3] {
+    [0.0, 0.0, -9.81]
+}
+
+impl Default for SimulationSpec {
+    fn default() -> Self {
+        SimulationSpec {
+            gravity: default_gravity(),
+            integrator: None,
+            dt: None,
+            expected_speed: None,
+            skin: None,
+            stats_interval: None,
+            max_neighbours: None,
+            max_overlap: None,
+            track_orientation: false,
+        }
+    }
+}
+
+/// `[[stage]]`: one step of the host loop's program.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StageSpec {
+    /// Name used in reports. Default: the kind and its position.
+    pub name: Option<String>,
+    /// "fill" (deposition under gravity until settled), "settle" (until settled) or "run"
+    /// (for a duration).
+    pub kind: String,
+    /// "run": simulated time (s). "fill"/"settle": the most time to wait (s).
+    pub duration: f64,
+    /// "fill"/"settle": kinetic energy per grain (J) below which the sample counts as settled.
+    /// Default: that of a grain of mean mass moving at 1e-3 sqrt(|g| d_mean).
+    pub ke_per_grain: Option<f64>,
+    /// "fill"/"settle": unbalanced-force ratio (mean net force on a grain over mean contact
+    /// force) below which the sample counts as settled. Default 0.01.
+    pub unbalanced_force: Option<f64>,
+    /// Target pressure (Pa) of the scene's piston during this stage. Default: unchanged.
+    pub piston_pressure: Option<f64>,
+}
+
+/// `[output]`.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Simulated time (s) between MCAP frames; 0 (default) records one frame at each stage end.
+    #[serde(default)]
+    pub frame_interval: f64,
+    /// Record contact forces in the MCAP frames. Default false.
+    #[serde(default)]
+    pub contact_forces: bool,
+}

@@ -1,0 +1,57 @@
+//! Wall geometry shared by the scene checks and the engines.
+
+use crate::real::{Real, Vec3};
+use crate::scene::WallShape;
+
+/// The surface of a wall at one instant, in the engine's precision.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum WallGeom<T> {
+    /// Plane through `point` with unit `normal` into the domain.
+    Plane {
+        /// A point on the plane (m).
+        point: Vec3<T>,
+        /// Unit normal into the domain.
+        normal: Vec3<T>,
+    },
+    /// Vertical cylinder around (`cx`, `cy`), grains inside.
+    Cylinder {
+        /// Axis x (m).
+        cx: T,
+        /// Axis y (m).
+        cy: T,
+        /// Radius (m).
+        radius: T,
+    },
+    /// Horizontal plate at height `z` facing down.
+    Piston {
+        /// Height (m).
+        z: T,
+    },
+}
+
+impl<T: Real> WallGeom<T> {
+    /// The surface of a scene wall at its initial position.
+    pub fn of(shape: &WallShape) -> Self {
+        match *shape {
+            WallShape::Plane { point, normal } => WallGeom::Plane { point: Vec3::of(point), normal: Vec3::of(normal) },
+            WallShape::Cylinder { center, radius } => WallGeom::Cylinder { cx: T::of(center[0]), cy: T::of(center[1]), radius: T::of(radius) },
+            WallShape::Piston { z, .. } => WallGeom::Piston { z: T::of(z) },
+        }
+    }
+
+    /// Unit normal from the wall to a point `p` (m), and the signed distance (m) from the
+    /// surface to `p`, positive on the grains' side.
+    #[inline(always)]
+    pub fn frame(&self, p: Vec3<T>) -> (Vec3<T>, T) {
+        match *self {
+            WallGeom::Plane { point, normal } => (normal, (p - point).dot(normal)),
+            WallGeom::Cylinder { cx, cy, radius } => {
+                let (dx, dy) = (p.x - cx, p.y - cy);
+                let rho = (dx * dx + dy * dy).sqrt();
+                let n = if rho > T::ZERO { Vec3::new(-dx / rho, -dy / rho, T::ZERO) } else { Vec3::new(-T::ONE, T::ZERO, T::ZERO) };
+                (n, radius - rho)
+            }
+            WallGeom::Piston { z } => (Vec3::new(T::ZERO, T::ZERO, -T::ONE), z - p.z),
+        }
+    }
+}
