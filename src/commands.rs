@@ -14,9 +14,6 @@ use std::time::Instant;
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Run { scene, backend, precision, out, json, threads } => {
-            if let Some(n) = threads {
-                rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("cannot start the worker threads")?;
-            }
             let scene = scene::load(&scene)?;
             if !json {
                 for w in &scene.warnings {
@@ -24,10 +21,13 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 }
             }
             let Backend::Cpu = backend;
-            match precision {
+            // The whole run happens on a worker of the pool, so that the kernels' parallel
+            // loops split work among workers instead of waking them from outside every time.
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start the worker threads")?;
+            pool.install(|| match precision {
                 Precision::F32 => run::<f32>(&scene, out.as_deref(), json),
                 Precision::F64 => run::<f64>(&scene, out.as_deref(), json),
-            }
+            })
         }
         Command::Check { scene } => {
             let scene = scene::load(&scene)?;

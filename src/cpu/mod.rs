@@ -28,7 +28,7 @@ use gather::gather;
 use grid::{hash_cells, CellGrid};
 use pair_force::{pair_force, ForceContext};
 use rayon::prelude::*;
-use reduce::{chunked, CHUNK};
+use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS};
 use wall_contacts::{wall_contacts, WallState};
 
 /// Seed 000's optimised velocity Verlet parameter (eqs. 11-15).
@@ -227,12 +227,12 @@ impl<T: Real> CpuEngine<T> {
         let (pairs, body, prop) = (&self.pairs, &self.body, &self.prop);
         let stride = self.slots.stride;
         if stride == 0 {
-            self.out.par_iter_mut().with_min_len(512).enumerate().for_each(|(k, o)| *o = pair_force(k, pairs, body, prop, &ctx, &mut []));
+            self.out.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(k, o)| *o = pair_force(k, pairs, body, prop, &ctx, &mut []));
         } else {
             self.out
                 .par_iter_mut()
                 .zip(self.hist.par_chunks_mut(stride))
-                .with_min_len(512)
+                .with_min_len(PAR_MIN_ITEMS)
                 .enumerate()
                 .for_each(|(k, (o, h))| *o = pair_force(k, pairs, body, prop, &ctx, h));
         }
@@ -242,14 +242,14 @@ impl<T: Real> CpuEngine<T> {
             self.wall_count = count;
         }
         let (out, wall_load, gravity) = (&self.out, &self.wall_load, self.gravity);
-        self.load.par_iter_mut().with_min_len(512).enumerate().for_each(|(i, l)| *l = gather(i, pairs, out, &wall_load[i], &prop[i], gravity));
+        self.load.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, l)| *l = gather(i, pairs, out, &wall_load[i], &prop[i], gravity));
         self.forces_valid = true;
     }
 
     /// Kick of every grain and of the piston by `tau` (s).
     fn kick(&mut self, tau: T) {
         let (load, prop) = (&self.load, &self.prop);
-        self.body.par_iter_mut().with_min_len(1024).enumerate().for_each(|(i, b)| integrate::kick(b, &load[i], &prop[i], tau));
+        self.body.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, b)| integrate::kick(b, &load[i], &prop[i], tau));
         if let Some(p) = self.piston {
             let push = self.wall_reaction[p.wall].z - p.pressure * p.area;
             self.walls[p.wall].velocity.z += push * tau / p.mass;
@@ -263,11 +263,12 @@ impl<T: Real> CpuEngine<T> {
             .body
             .par_chunks_mut(CHUNK)
             .zip(self.built_at.par_chunks(CHUNK))
+            .with_min_len(PAR_MIN_CHUNKS)
             .map(|(bodies, at)| bodies.iter_mut().zip(at).map(|(b, at)| integrate::drift(b, *at, tau)).fold(T::ZERO, T::max))
             .collect();
         if let Some(q) = &mut self.orientation {
             let body = &self.body;
-            q.par_iter_mut().with_min_len(1024).enumerate().for_each(|(i, q)| *q = integrate::rotate(*q, body[i].omega, tau));
+            q.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, q)| *q = integrate::rotate(*q, body[i].omega, tau));
         }
         if let Some(p) = self.piston {
             let wall = &mut self.walls[p.wall];
@@ -347,9 +348,9 @@ fn wall_pass<T: Real>(
         (reaction, count)
     };
     let parts: Vec<(Vec<Vec3<T>>, Vec<u64>)> = if per_grain == 0 {
-        wall_load.par_chunks_mut(CHUNK).enumerate().map(|(c, loads)| run(c, loads, &mut [])).collect()
+        wall_load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, loads)| run(c, loads, &mut [])).collect()
     } else {
-        wall_load.par_chunks_mut(CHUNK).zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).enumerate().map(|(c, (loads, hist))| run(c, loads, hist)).collect()
+        wall_load.par_chunks_mut(CHUNK).zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, (loads, hist))| run(c, loads, hist)).collect()
     };
     let mut reaction = vec![Vec3::ZERO; n_walls];
     let mut count = vec![0u64; n_walls];

@@ -83,6 +83,9 @@ impl PairList {
     /// Index of the pair (owner `i`, partner with permanent id `partner_id`), if listed.
     #[inline]
     pub fn find(&self, i: usize, partner_id: u32, id: &[u32]) -> Option<usize> {
+        if i + 1 >= self.owner_start.len() {
+            return None;
+        }
         let (a, b) = (self.owner_start[i] as usize, self.owner_start[i + 1] as usize);
         self.partner[a..b].binary_search_by_key(&partner_id, |&j| id[j as usize]).ok().map(|k| a + k)
     }
@@ -105,7 +108,7 @@ pub fn remap_history<T: Real>(k: usize, new: &PairList, old: &PairList, old_hist
 pub fn remap_all<T: Real>(new: &PairList, old: &PairList, old_hist: &[T], id: &[u32], stride: usize) -> Vec<T> {
     let mut hist = vec![T::ZERO; new.len() * stride];
     if stride > 0 {
-        hist.par_chunks_mut(stride).with_min_len(256).enumerate().for_each(|(k, out)| remap_history(k, new, old, old_hist, id, stride, out));
+        hist.par_chunks_mut(stride).with_min_len(super::reduce::PAR_MIN_ITEMS).enumerate().for_each(|(k, out)| remap_history(k, new, old, old_hist, id, stride, out));
     }
     hist
 }
