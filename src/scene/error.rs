@@ -6,12 +6,12 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
     /// The file could not be read.
-    #[error("{file}: cannot read the scene: {source}; fix: check the path")]
+    #[error("{file}: cannot read the scene: {reason}; fix: check the path")]
     Read {
         /// Scene file.
         file: PathBuf,
         /// The I/O error.
-        source: std::io::Error,
+        reason: std::io::Error,
     },
     /// The TOML is malformed or has an unknown key or a value of the wrong type.
     #[error("{file} line {line}: {message}; fix: {fix}")]
@@ -45,7 +45,10 @@ impl SceneError {
     /// A TOML parse error, located by line.
     pub fn syntax(file: &Path, text: &str, err: &toml::de::Error) -> Self {
         let line = err.span().map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1).unwrap_or(0);
-        let message = err.message().replace('\n', " ").trim().to_string();
+        // Name the table the key sits in: the last header above the offending line.
+        let table = text.lines().take(line).filter(|l| l.trim_start().starts_with('[')).last().map(|h| format!(" in {}", h.trim()));
+        let key = text.lines().nth(line.saturating_sub(1)).and_then(|l| l.split_once('=')).map(|(k, _)| format!("key `{}`: ", k.trim()));
+        let message = format!("{}{}{}", key.unwrap_or_default(), err.message().replace('\n', " ").trim(), table.unwrap_or_default());
         let fix = if message.contains("unknown field") {
             "correct the key's spelling or remove it (the README's scene reference lists every key)"
         } else if message.contains("missing field") {

@@ -211,11 +211,11 @@ pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
 /// Default settle criterion on the unbalanced-force ratio.
 pub const DEFAULT_UNBALANCED_FORCE: f64 = 0.01;
 /// Default settle speed, as a fraction of `sqrt(|g| d_mean)`.
-pub const DEFAULT_SETTLE_SPEED_FRACTION: f64 = 1e-3;
+pub const DEFAULT_SETTLE_SPEED_FRACTION: f64 = 1e-2;
 
 /// Reads and validates a scene file.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Read { file: path.to_path_buf(), source })?;
+    let text = std::fs::read_to_string(path).map_err(|reason| SceneError::Read { file: path.to_path_buf(), reason })?;
     parse(path, &text)
 }
 
@@ -539,7 +539,7 @@ fn check_overlaps(c: &Complainer, f: &SceneFile, grains: &Grains, walls: &[Wall]
                 return Err(c.invalid(
                     origin(i),
                     format!("{:?}", grains.position[i]),
-                    format!("the grain (radius {:e} m) overlaps {} by {:e} m", grains.radius[i], w.name, grains.radius[i] - d),
+                    format!("the grain (radius {:.4e} m) overlaps {} by {:.4e} m", grains.radius[i], w.name, grains.radius[i] - d),
                     "move the grain or its generator's region inside the walls",
                 ));
             }

@@ -326,7 +326,7 @@ pub struct StageSpec {
     /// "run": simulated time (s). "fill"/"settle": the most time to wait (s).
     pub duration: f64,
     /// "fill"/"settle": kinetic energy per grain (J) below which the sample counts as settled.
-    /// Default: that of a grain of mean mass moving at 1e-3 sqrt(|g| d_mean).
+    /// Default: that of a grain of mean mass moving at 1e-2 sqrt(|g| d_mean) (1 mm/s for 1 mm grains).
     pub ke_per_grain: Option<f64>,
     /// "fill"/"settle": unbalanced-force ratio (mean net force on a grain over mean contact
     /// force) below which the sample counts as settled. Default 0.01.

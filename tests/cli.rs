@@ -1,0 +1,169 @@
+//! The `grains` command line: every shipped scene checks, the short ones run with physics
+//! checked from the JSON summary, outputs are complete, and bad scenes get a one-line error.
+
+mod common;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Energy change allowed over an elastic two-sphere collision (dt = t_c/50: about 1e-4).
+const ELASTIC_ENERGY_TOLERANCE: f64 = 1e-3;
+/// Slide-to-roll speed ratio tolerance (see tests/sliding.rs).
+const ROLLING_TOLERANCE: f64 = 0.01;
+
+fn grains(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_grains")).args(args).env("RUST_BACKTRACE", "0").output().expect("grains runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn shipped_scenes() -> Vec<std::path::PathBuf> {
+    let mut v: Vec<_> = std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn every_shipped_scene_checks_with_a_time_step_below_the_safe_limit() {
+    let scenes = shipped_scenes();
+    assert!(scenes.len() >= 5, "{scenes:?}");
+    for p in scenes {
+        let o = grains(&["check", p.to_str().unwrap()]);
+        assert!(o.status.success(), "{}: {}", p.display(), stderr(&o));
+        let scene = common::shipped(p.file_name().unwrap().to_str().unwrap());
+        let ts = scene.time_step;
+        assert!(ts.dt <= ts.safe_limit(), "{}: dt {} above {}", p.display(), ts.dt, ts.safe_limit());
+        assert!(stdout(&o).contains("Rayleigh time") && stdout(&o).contains("memory estimate"), "{}", stdout(&o));
+    }
+}
+
+fn run_json(scene: &str, extra: &[&str]) -> serde_json::Value {
+    let path = common::scene_path(scene);
+    let mut args = vec!["run", path.to_str().unwrap(), "--json"];
+    args.extend_from_slice(extra);
+    let o = grains(&args);
+    assert!(o.status.success(), "{scene}: {}", stderr(&o));
+    serde_json::from_str(&stdout(&o)).unwrap_or_else(|e| panic!("{scene}: stdout is not one JSON object ({e}): {}", stdout(&o)))
+}
+
+#[test]
+fn two_spheres_run_conserves_energy_in_both_precisions() {
+    let scene = common::shipped("two_spheres.toml");
+    let ke0: f64 = (0..2).map(|i| 0.5 * scene.grains.mass[i] * scene.grains.velocity[i][0].powi(2)).sum();
+    for precision in ["f64", "f32"] {
+        let j = run_json("two_spheres.toml", &["--precision", precision]);
+        for key in ["scene", "backend", "precision", "grains", "steps", "dt", "wall_seconds", "particle_steps_per_second", "stages", "final"] {
+            assert!(j.get(key).is_some(), "summary lacks {key}: {j}");
+        }
+        assert_eq!(j["precision"], precision);
+        let ke = j["final"]["kinetic_energy"].as_f64().unwrap();
+        println!("{precision}: KE after the collision / before = {:.6}", ke / ke0);
+        assert!((ke / ke0 - 1.0).abs() < ELASTIC_ENERGY_TOLERANCE);
+    }
+}
+
+#[test]
+fn sphere_on_plane_run_ends_rolling_at_five_sevenths() {
+    let j = run_json("sphere_on_plane.toml", &[]);
+    let ke = j["stages"][0]["stats"]["ke_translational"].as_f64().unwrap();
+    let m = common::shipped("sphere_on_plane.toml").grains.mass[0];
+    let ratio = (2.0 * ke / m).sqrt() / 0.5;
+    assert!((ratio / (5.0 / 7.0) - 1.0).abs() < ROLLING_TOLERANCE, "v/v0 = {ratio}");
+}
+
+#[test]
+fn out_dir_holds_summary_stats_and_frames_that_match_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = common::scene_path("elastic_gas.toml");
+    let o = grains(&["run", path.to_str().unwrap(), "--out", dir.path().to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap()).unwrap();
+    let stats = std::fs::read_to_string(dir.path().join("stats.csv")).unwrap();
+    let rows: Vec<&str> = stats.lines().collect();
+    let steps = summary["steps"].as_u64().unwrap();
+    let interval = common::shipped("elastic_gas.toml").stats_interval;
+    assert_eq!(rows.len() as u64 - 1, steps.div_ceil(interval), "one row per statistics read");
+    // The elastic gas conserves energy: the CSV's first and last rows agree.
+    let energy = |row: &str| -> f64 { row.split(',').skip(3).take(3).map(|x| x.parse::<f64>().unwrap()).sum() };
+    let (e0, e1) = (energy(rows[1]), energy(rows[rows.len() - 1]));
+    assert!((e1 / e0 - 1.0).abs() < ELASTIC_ENERGY_TOLERANCE, "{e0} -> {e1}");
+    // The MCAP's last /grains frame holds the final positions; count its messages.
+    let bytes = std::fs::read(dir.path().join("frames.mcap")).unwrap();
+    let mut frames = 0;
+    let mut last = None;
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        if m.channel.topic == "/grains" {
+            frames += 1;
+            last = Some(serde_json::from_slice::<serde_json::Value>(&m.data).unwrap());
+        }
+    }
+    let last = last.expect("at least one frame");
+    assert_eq!(frames, 1, "frame_interval = 0 records one frame per stage");
+    assert_eq!(last["position"].as_array().unwrap().len(), 50);
+    assert!((last["time"].as_f64().unwrap() - summary["simulated_time"].as_f64().unwrap()).abs() < 1e-12);
+}
+
+/// Writes `text` as a scene, checks it, and returns the one line of stderr.
+fn refused(name: &str, text: &str) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(name);
+    std::fs::write(&path, text).unwrap();
+    for cmd in ["check", "run"] {
+        let o = grains(&[cmd, path.to_str().unwrap()]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(1), "{cmd} {name}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert!(err.starts_with("error: ") && err.contains("fix: "), "{err}");
+        assert!(err.contains(name), "names the file: {err}");
+    }
+    let o = grains(&["check", path.to_str().unwrap()]);
+    stderr(&o)
+}
+
+fn two_spheres() -> String {
+    std::fs::read_to_string(common::scene_path("two_spheres.toml")).unwrap()
+}
+
+#[test]
+fn malformed_scenes_get_one_line_naming_the_key_and_the_fix() {
+    let base = two_spheres();
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("unknown_key.toml", base.replace("poisson_ratio = 0.3", "poisson_ratio = 0.3\nfrictoin = 0.5"), "frictoin"),
+        ("negative_radius.toml", base.replacen("radius = 5.0e-4", "radius = -5.0e-4", 1), "grain[0].radius"),
+        ("missing_material.toml", base.replacen("material = \"glass\"\nradius", "material = \"steel\"\nradius", 1), "grain[0].material"),
+        ("dt_above_limit.toml", base.replace("dt = \"auto\"", "dt = 1.0e-4"), "simulation.dt"),
+        (
+            "grain_in_wall.toml",
+            base.replace("[model]", "[[wall]]\ntype = \"plane\"\nmaterial = \"glass\"\npoint = [0.0, 0.0, 1.0e-4]\nnormal = [0.0, 0.0, 1.0]\n\n[model]"),
+            "overlaps wall[0]",
+        ),
+        ("wrong_type.toml", base.replace("duration = 2.5e-3", "duration = \"long\""), "duration"),
+        ("unused_parameter.toml", base.replace("damping = \"none\"", "damping = \"none\"\nc_n = 1.0"), "model.c_n"),
+    ];
+    for (name, text, key) in cases {
+        let err = refused(name, &text);
+        println!("{err}");
+        assert!(err.contains(key), "{name}: must name {key}: {err}");
+    }
+}
+
+#[test]
+fn a_missing_file_is_one_line_too() {
+    let o = grains(&["check", "no/such/scene.toml"]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = stderr(&o);
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("no/such/scene.toml") && err.contains("fix: "), "{err}");
+}
