@@ -18,7 +18,7 @@ pub const BULK_MARGIN_DIAMETERS: f64 = 2.0;
 pub fn packing_fraction(scene: &Scene, frame: &Frame, piston_z: Option<f64>) -> Option<f64> {
     let area = cross_section(scene.walls.iter().map(|w| &w.shape))?;
     let floor = scene.walls.iter().find_map(|w| match w.shape {
-        WallShape::Plane { point, normal } if normal == [0.0, 0.0, 1.0] => Some(point[2]),
+        WallShape::Plane { point, normal: [0.0, 0.0, 1.0] } => Some(point[2]),
         _ => None,
     })?;
     let n = frame.radius.len();

@@ -12,9 +12,9 @@ use crate::real::{Real, Vec3};
 pub fn gather<T: Real>(i: usize, pairs: &PairList, out: &[ContactForce<T>], wall: &Load<T>, p: &Props<T>, gravity: Vec3<T>) -> Load<T> {
     let mut force = gravity * p.mass;
     let mut torque = Vec3::ZERO;
-    for k in pairs.owner_start[i] as usize..pairs.owner_start[i + 1] as usize {
-        force += out[k].f_i;
-        torque += out[k].t_i;
+    for o in &out[pairs.owner_start[i] as usize..pairs.owner_start[i + 1] as usize] {
+        force += o.f_i;
+        torque += o.t_i;
     }
     for &k in &pairs.rev_pair[pairs.rev_start[i] as usize..pairs.rev_start[i + 1] as usize] {
         force += out[k as usize].f_j;

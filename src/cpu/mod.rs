@@ -433,8 +433,8 @@ impl<T: Real> Engine for CpuEngine<T> {
                 let w = b.omega.f64();
                 let ii = p.inertia.f64();
                 let mv = [m * v[0], m * v[1], m * v[2]];
-                for a in 0..3 {
-                    s.momentum[a] += mv[a];
+                for (p, q) in s.momentum.iter_mut().zip(mv) {
+                    *p += q;
                 }
                 s.angular[0] += x[1] * mv[2] - x[2] * mv[1] + ii * w[0];
                 s.angular[1] += x[2] * mv[0] - x[0] * mv[2] + ii * w[1];

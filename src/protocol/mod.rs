@@ -87,11 +87,9 @@ fn run_stage(
         guard.check(&stats, dt)?;
         rec.stats(&stage.name, &stats)?;
         rec.progress(&stage.name, done, total);
-        if let Some(t) = next_frame {
-            if engine.time() >= *t {
-                rec.frame(&engine.frame(scene.output.contact_forces))?;
-                *t += scene.output.frame_interval;
-            }
+        if let Some(t) = next_frame.as_mut().filter(|t| engine.time() >= **t) {
+            rec.frame(&engine.frame(scene.output.contact_forces))?;
+            *t += scene.output.frame_interval;
         }
         if settles && stats.kinetic_energy() / n < stage.ke_per_grain && stats.unbalanced_force < stage.unbalanced_force {
             settled = true;
