@@ -31,7 +31,8 @@ struct Collision {
 /// from the overlap sampled every step (crossing times by linear interpolation, as the peers).
 fn collide(dt: f64, damping: &str) -> Collision {
     let text = std::fs::read_to_string(common::scene_path("two_spheres.toml")).unwrap();
-    let text = text.replace("dt = \"auto\"", &format!("dt = {dt:e}")).replace("damping = \"none\"", damping);
+    let text = text.replace("dt = \"auto\"", &format!("dt = {dt:e}"));
+    let text = if damping.starts_with("normal") { text.replace("normal = \"hertz\"\ndamping = \"none\"", damping) } else { text.replace("damping = \"none\"", damping) };
     let text = if damping.contains("papers") || damping.contains("restitution") {
         text.replace("poisson_ratio = 0.3", &format!("poisson_ratio = 0.3\n{}", damping_material(damping)))
     } else {
@@ -174,4 +175,20 @@ fn restitution_law_matches_an_accurate_integration_of_the_same_contact() {
     assert!((coarse.restitution / e_ref - 1.0).abs() < DAMPED_TOLERANCE);
     assert!((coarse.contact_time / tc_ref - 1.0).abs() < DAMPED_TOLERANCE);
     assert!((fine.restitution - e_ref).abs() < (coarse.restitution - e_ref).abs(), "the error must fall with dt");
+}
+
+/// The linear spring (k_n) as the alternative normal law: an undamped contact lasts half a
+/// period, `pi sqrt(m_eff / k_n)`, and returns the approach speed.
+#[test]
+fn linear_spring_contact_lasts_half_a_period() {
+    let k_n = 1000.0;
+    let text = std::fs::read_to_string(common::scene_path("two_spheres.toml")).unwrap().replace("normal = \"hertz\"", &format!("normal = \"linear\"\nk_n = {k_n}"));
+    let scene = common::parse(&text);
+    let m_eff = scene.grains.mass[0] / 2.0;
+    let expect = std::f64::consts::PI * (m_eff / k_n).sqrt();
+    assert!((scene.time_step.times.collision / expect - 1.0).abs() < 1e-12, "check's collision time is the linear one");
+    let c = collide(scene.time_step.dt, "normal = \"linear\"\nk_n = 1000.0\ndamping = \"none\"");
+    println!("linear: contact {:.5e} s, theory {expect:.5e} s, e = {:.6}", c.contact_time, c.restitution);
+    assert!((c.contact_time / expect - 1.0).abs() < HERTZ_TOLERANCE);
+    assert!((c.restitution - 1.0).abs() < HERTZ_TOLERANCE);
 }

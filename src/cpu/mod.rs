@@ -53,6 +53,8 @@ pub struct CpuEngine<T: Real> {
     n_materials: usize,
     gravity: Vec3<T>,
     dt: T,
+    /// Step suggested when the state turns non-finite (s).
+    suggested_dt: f64,
     integrator: Integrator,
     skin: T,
     cutoff: T,
@@ -132,6 +134,7 @@ impl<T: Real> CpuEngine<T> {
             n_materials,
             gravity: Vec3::of(scene.gravity),
             dt: T::of(scene.time_step.dt),
+            suggested_dt: crate::protocol::suggested_dt(scene),
             integrator: scene.integrator,
             skin: T::of(scene.skin),
             cutoff: T::of(2.0 * r_max + scene.skin),
@@ -191,7 +194,7 @@ impl<T: Real> CpuEngine<T> {
             time: self.time,
             what: "non-finite position or velocity".into(),
             grain: self.id[grain],
-            suggested_dt: 0.5 * self.dt.f64(),
+            suggested_dt: self.suggested_dt,
         }
     }
 

@@ -18,7 +18,7 @@ mod twisting;
 pub use geometry::{Bodies, Geometry, Kinematics};
 pub use normal::{normal_damping, normal_elastic, normal_force, restitution_beta};
 pub use rolling::rolling_sds;
-pub use tangential::{mindlin_tangential, oquendo_tangential, rotate_into_plane};
+pub use tangential::{contact_tangential_velocity, mindlin_tangential, oquendo_tangential, rotate_into_plane, TangentialOut};
 pub use twisting::twisting_torque;
 
 use crate::real::{Real, Vec3};
@@ -386,5 +386,118 @@ impl ContactModel<f64> {
             TwistingLaw::Oquendo => "oquendo(gamma_nt)",
         };
         format!("normal={normal} damping={damping} tangential={tangential} rolling={rolling} twisting={twisting}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The laws against values computed by hand from PHYSICS.md.
+    use super::*;
+
+    /// Relative tolerance for hand-computed values (f64 round-off and printed digits).
+    const HAND: f64 = 1e-9;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= HAND * b.abs().max(1e-300)
+    }
+
+    fn sand() -> MaterialConstants {
+        MaterialConstants { youngs_modulus: 7.0e7, poisson_ratio: 0.3, mu_s: 0.5, mu_k: 0.4, rolling_angle: 0.1, gamma_n: 1.0e5, gamma_nt: 20.0, restitution: 0.5 }
+    }
+
+    /// Two 0.5 mm grains of 1.3875e-6 kg along x, overlapping by 1 um.
+    fn pair() -> (PairCoeffs<f64>, Geometry<f64>) {
+        let c = PairCoeffs::mix(&sand(), &sand());
+        let g = Geometry::grain_grain(Vec3::new(0.999e-3, 0.0, 0.0), 0.999e-3, 5.0e-4, 5.0e-4, 1.3875e-6, 1.3875e-6);
+        (c, g)
+    }
+
+    #[test]
+    fn pair_coefficients_combine_as_physics_md_rules() {
+        let (c, _) = pair();
+        // V = 7e7 / 0.91 = 7.6923e7 Pa, V_eff = V / 2; G = 7e7 / 2.6, G_eff = G / (2 (2 - 0.3)).
+        assert!(close(c.v_eff, 7.0e7 / 0.91 / 2.0));
+        assert!(close(c.g_eff, 7.0e7 / 2.6 / 3.4));
+        assert!(close(c.tan_roll, 0.1f64.tan()));
+        // beta(0.5) = ln 2 / sqrt(ln^2 2 + pi^2)
+        assert!(close(c.beta, 0.693147180559945 / (0.480453013918201 + 9.869604401089358f64).sqrt()));
+    }
+
+    #[test]
+    fn geometry_puts_the_contact_point_per_seed_000_eq_3() {
+        let (_, g) = pair();
+        assert!(close(g.h, 1.0e-6));
+        assert!(close(g.r_eff, 2.5e-4) && close(g.m_eff, 1.3875e-6 / 2.0));
+        // Equal grains: z = h/2 each, R' = R - h/2, R'_eff = R'/2.
+        assert!(close(g.rp_i, 5.0e-4 - 0.5e-6) && close(g.rp_j, 5.0e-4 - 0.5e-6) && close(g.rp_eff, (5.0e-4 - 0.5e-6) / 2.0));
+        assert_eq!(g.n, Vec3::new(1.0, 0.0, 0.0));
+        let w = Geometry::grain_wall(Vec3::new(0.0, 0.0, 1.0), 4.99e-4, 5.0e-4, 1.0);
+        assert!(close(w.h, 1.0e-6) && close(w.rp_i, 4.99e-4) && w.rp_j == 0.0 && close(w.r_eff, 5.0e-4));
+    }
+
+    #[test]
+    fn hertz_force_damping_and_clamp() {
+        let (c, g) = pair();
+        let (f, k) = normal_elastic(&NormalLaw::Hertz, &c, &g);
+        // 4/3 sqrt(2.5e-4) 3.846153846e7 (1e-6)^1.5
+        let hand = 4.0 / 3.0 * 0.015811388300841896 * (7.0e7 / 0.91 / 2.0) * 1.0e-9;
+        assert!(close(f, hand) && close(k, hand / 1.0e-6));
+        // m_eff gamma_n sqrt(h) = 6.9375e-7 * 1e5 * 1e-3
+        assert!(close(normal_damping(&DampingLaw::Papers, &NormalLaw::Hertz, &c, &g), 6.9375e-7 * 1.0e5 * 1.0e-3));
+        assert_eq!(normal_force(1.0, 2.0, -0.25), (1.5, false));
+        assert_eq!(normal_force(1.0, 2.0, 1.0), (0.0, true));
+        assert!(close(normal_potential(&NormalLaw::Hertz, &c, g.r_eff, g.h), 0.4 * hand * 1.0e-6));
+    }
+
+    #[test]
+    fn twisting_torque_opposes_the_relative_spin_about_the_normal() {
+        let (c, g) = pair();
+        let k = Kinematics { w_i: Vec3::new(3.0, 5.0, 0.0), w_j: Vec3::new(-1.0, 0.0, 7.0), ..Default::default() };
+        let t = twisting_torque(c.gamma_nt, &g, &k);
+        // -4 pi gamma_nt m_eff R_eff h (w_i - w_j).n n, (w_i - w_j).n = 4
+        let hand = -4.0 * std::f64::consts::PI * 20.0 * 6.9375e-7 * 2.5e-4 * 1.0e-6 * 4.0;
+        assert!(close(t.x, hand) && t.y == 0.0 && t.z == 0.0);
+    }
+
+    #[test]
+    fn a_spring_rotated_into_the_tangent_plane_keeps_its_length() {
+        let n = Vec3::new(0.6, 0.8, 0.0);
+        let s = rotate_into_plane(Vec3::new(1.0, 2.0, 3.0), n);
+        assert!(s.dot(n).abs() < 1e-15);
+        assert!(close(s.norm(), 14f64.sqrt()));
+    }
+
+    #[test]
+    fn mindlin_caps_at_coulomb_and_resets_the_spring_to_the_cap() {
+        let (c, g) = pair();
+        let k = Kinematics::default();
+        let mut xi = Vec3::new(0.0, 1.0e-3, 0.0); // far beyond the Coulomb limit
+        let f = mindlin_tangential(c.mu_s, &g, &k, 2.0e-3, 1.0e3, 0.0, &mut xi, 0.0);
+        assert!(close(f.norm(), 0.5 * 2.0e-3));
+        assert!(f.y < 0.0, "opposes the spring");
+        assert!(close(xi.norm() * 1.0e3, 0.5 * 2.0e-3));
+    }
+
+    #[test]
+    fn oquendo_regimes_are_chosen_by_the_slip_and_rolling_speeds() {
+        let (c, g) = pair();
+        let b = Bodies { m_i: 1.3875e-6, inertia_i: 0.4 * 1.3875e-6 * 2.5e-7, m_j: 1.3875e-6, inertia_j: 0.4 * 1.3875e-6 * 2.5e-7, j_is_wall: false };
+        let f_n = 1.0e-3;
+        // Sliding: v_t = 0.01 m/s along y > v_slip: F = -mu_k F_n t on i, opposite on j.
+        let k = Kinematics { v_i: Vec3::new(0.0, 0.01, 0.0), ..Default::default() };
+        let mut xi = Vec3::ZERO;
+        let o = oquendo_tangential(&c, &g, &k, &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, &mut xi, 1.0e-6);
+        assert!(close(o.f_i.y, -0.4 * f_n) && o.f_j == -o.f_i);
+        // Static: no relative motion, the spring gives -k_t xi.
+        let mut xi = Vec3::new(0.0, 1.0e-7, 0.0);
+        let o = oquendo_tangential(&c, &g, &Kinematics::default(), &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, &mut xi, 1.0e-6);
+        assert!(close(o.f_i.y, -1.0e-4));
+        // Rolling: counter-spinning grains, no slip at the contact, v_r > v_roll: eq. 8 on both.
+        let k = Kinematics { w_i: Vec3::new(0.0, 0.0, 10.0), w_j: Vec3::new(0.0, 0.0, -10.0), ..Default::default() };
+        let mut xi = Vec3::ZERO;
+        let o = oquendo_tangential(&c, &g, &k, &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, &mut xi, 1.0e-6);
+        let rp = g.rp_i;
+        let each = f_n * c.tan_roll / (1.0 + b.inertia_i / (b.m_i * rp * rp));
+        assert!(close(o.f_i.norm(), each) && o.f_i == o.f_j, "same force on both grains");
     }
 }

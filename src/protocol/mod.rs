@@ -12,6 +12,11 @@ use serde::Serialize;
 /// steps.
 pub const ENERGY_GROWTH_TOLERANCE: f64 = 0.5;
 
+/// The step suggested after an instability: half the step, and no more than `auto` would pick.
+pub fn suggested_dt(scene: &Scene) -> f64 {
+    (0.5 * scene.time_step.dt).min(scene.time_step.auto_dt())
+}
+
 /// What a stage did.
 #[derive(Clone, Debug, Serialize)]
 pub struct StageResult {
@@ -84,7 +89,7 @@ fn run_stage(
         engine.advance(chunk)?;
         done += chunk;
         stats = engine.stats();
-        guard.check(&stats, dt)?;
+        guard.check(&stats)?;
         rec.stats(&stage.name, &stats)?;
         rec.progress(&stage.name, done, total);
         if let Some(t) = next_frame.as_mut().filter(|t| engine.time() >= **t) {
@@ -121,6 +126,7 @@ fn run_stage(
 /// The stability checks made at every statistics read.
 struct Guard {
     max_overlap: f64,
+    suggested_dt: f64,
     energy0: f64,
     kinetic_elastic0: f64,
     gravity0: f64,
@@ -128,11 +134,11 @@ struct Guard {
 
 impl Guard {
     fn new(scene: &Scene, s: &Stats) -> Self {
-        Guard { max_overlap: scene.max_overlap, energy0: s.mechanical_energy(), kinetic_elastic0: s.kinetic_energy() + s.elastic_energy, gravity0: s.gravity_energy }
+        Guard { max_overlap: scene.max_overlap, suggested_dt: suggested_dt(scene), energy0: s.mechanical_energy(), kinetic_elastic0: s.kinetic_energy() + s.elastic_energy, gravity0: s.gravity_energy }
     }
 
-    fn check(&self, s: &Stats, dt: f64) -> Result<(), SimError> {
-        let unstable = |what: String, grain: u32| SimError::Unstable { step: s.step, time: s.time, what, grain, suggested_dt: 0.5 * dt };
+    fn check(&self, s: &Stats) -> Result<(), SimError> {
+        let unstable = |what: String, grain: u32| SimError::Unstable { step: s.step, time: s.time, what, grain, suggested_dt: self.suggested_dt };
         if let Some(g) = s.non_finite_grain {
             return Err(unstable("non-finite position or velocity".into(), g));
         }
