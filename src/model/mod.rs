@@ -420,7 +420,8 @@ mod tests {
         assert!(close(c.g_eff, 7.0e7 / 2.6 / 3.4));
         assert!(close(c.tan_roll, 0.1f64.tan()));
         // beta(0.5) = ln 2 / sqrt(ln^2 2 + pi^2)
-        assert!(close(c.beta, 0.693147180559945 / (0.480453013918201 + 9.869604401089358f64).sqrt()));
+        let (ln2, pi) = (std::f64::consts::LN_2, std::f64::consts::PI);
+        assert!(close(c.beta, ln2 / (ln2 * ln2 + pi * pi).sqrt()));
     }
 
     #[test]
