@@ -9,6 +9,7 @@ pub mod cpu;
 pub mod engine;
 pub mod model;
 pub mod output;
+pub mod periodic;
 pub mod protocol;
 pub mod real;
 pub mod scene;

@@ -16,7 +16,7 @@ pub const BULK_MARGIN_DIAMETERS: f64 = 2.0;
 /// the volume of grains whose centres lie more than [`BULK_MARGIN_DIAMETERS`] from the floor
 /// and the top, over the band's volume. Shallower beds count every grain over the whole span.
 pub fn packing_fraction(scene: &Scene, frame: &Frame, piston_z: Option<f64>) -> Option<f64> {
-    let area = cross_section(scene.walls.iter().map(|w| &w.shape))?;
+    let area = cross_section(scene.walls.iter().map(|w| &w.shape), &scene.periodic)?;
     let floor = scene.walls.iter().find_map(|w| match w.shape {
         WallShape::Plane { point, normal: [0.0, 0.0, 1.0] } => Some(point[2]),
         _ => None,

@@ -3,17 +3,21 @@
 
 use super::reduce::chunked;
 use super::state::{Body, Props};
+use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 
-/// A uniform grid over the grains' bounding box with grains sorted by cell.
+/// A uniform grid over the grains' bounding box (or the period, along a wrapping axis) with
+/// grains sorted by cell.
 #[derive(Clone, Debug, Default)]
 pub struct CellGrid<T> {
     /// Lower corner (m).
     pub origin: Vec3<T>,
-    /// Cell edge (m), at least the largest pair cut-off.
-    pub cell: T,
+    /// Cell edges (m), each at least the largest pair cut-off.
+    pub cell: [T; 3],
     /// Cells per axis.
     pub dims: [u32; 3],
+    /// Axes that wrap around.
+    pub wraps: [bool; 3],
     /// `cell_start[c]..cell_start[c + 1]` indexes `cell_grains` for cell `c`.
     pub cell_start: Vec<u32>,
     /// Grain indices sorted by cell, ascending within a cell.
@@ -27,7 +31,7 @@ impl<T: Real> CellGrid<T> {
     /// Cell coordinates of a position, clamped to the grid.
     #[inline(always)]
     pub fn coords(&self, p: Vec3<T>) -> [u32; 3] {
-        let q = [(p.x - self.origin.x) / self.cell, (p.y - self.origin.y) / self.cell, (p.z - self.origin.z) / self.cell];
+        let q = [(p.x - self.origin.x) / self.cell[0], (p.y - self.origin.y) / self.cell[1], (p.z - self.origin.z) / self.cell[2]];
         let mut c = [0u32; 3];
         for a in 0..3 {
             // `as` saturates: NaN -> 0, +inf -> u32::MAX, then clamped.
@@ -40,12 +44,35 @@ impl<T: Real> CellGrid<T> {
     pub fn index(&self, c: [u32; 3]) -> usize {
         (c[0] as usize) + self.dims[0] as usize * ((c[1] as usize) + self.dims[1] as usize * c[2] as usize)
     }
+    /// The distinct neighbour coordinates of cell coordinate `c` along axis `a` (itself
+    /// included): wrapped on a periodic axis, clipped otherwise. At most 3.
+    #[inline(always)]
+    fn neighbours(&self, c: u32, a: usize) -> ([u32; 3], usize) {
+        let d = self.dims[a];
+        if self.wraps[a] {
+            match d {
+                1 => ([0, 0, 0], 1),
+                2 => ([0, 1, 0], 2),
+                _ => ([(c + d - 1) % d, c, (c + 1) % d], 3),
+            }
+        } else {
+            let lo = c.saturating_sub(1);
+            let hi = (c + 1).min(d - 1);
+            let mut out = [lo, lo, lo];
+            let n = (hi - lo + 1) as usize;
+            for (k, o) in out.iter_mut().enumerate().take(n) {
+                *o = lo + k as u32;
+            }
+            (out, n)
+        }
+    }
 }
 
-/// `hash_cells`: sizes the grid to the grains' bounding box with cells at least `cutoff`
-/// wide, and sorts grain indices by cell (counting sort: count, exclusive scan, stable
-/// scatter). Returns `false` when a position is not finite.
-pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, grid: &mut CellGrid<T>) -> bool {
+/// `hash_cells`: sizes the grid to the grains' bounding box (the period along a wrapping
+/// axis, where positions must already be wrapped) with cells at least `cutoff` wide, and
+/// sorts grain indices by cell (counting sort: count, exclusive scan, stable scatter).
+/// Returns `false` when a position is not finite.
+pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, periodic: &Periodic<T>, grid: &mut CellGrid<T>) -> bool {
     let bounds = chunked(body.len(), |r| {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
@@ -71,18 +98,26 @@ pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, grid: &mut CellGrid<T>) 
             hi[a] = hi[a].max(h[a]);
         }
     }
+    for a in 0..3 {
+        if periodic.on[a] {
+            lo[a] = periodic.lo[a].f64();
+            hi[a] = lo[a] + periodic.len[a].f64();
+        }
+    }
     let mut cell = cutoff.f64();
     let cap = (MAX_CELLS_PER_GRAIN * body.len() as f64).max(64.0);
     let dims = loop {
-        let d: Vec<f64> = (0..3).map(|a| ((hi[a] - lo[a]) / cell).floor() + 1.0).collect();
+        // A wrapping axis has a whole number of cells over its period, each at least `cell`.
+        let d: Vec<f64> = (0..3).map(|a| if periodic.on[a] { ((hi[a] - lo[a]) / cell).floor().max(1.0) } else { ((hi[a] - lo[a]) / cell).floor() + 1.0 }).collect();
         if d[0] * d[1] * d[2] <= cap {
             break [d[0] as u32, d[1] as u32, d[2] as u32];
         }
         cell *= 1.25;
     };
     grid.origin = Vec3::of(lo);
-    grid.cell = T::of(cell);
+    grid.cell = [0, 1, 2].map(|a| T::of(if periodic.on[a] { (hi[a] - lo[a]) / dims[a] as f64 } else { cell }));
     grid.dims = dims;
+    grid.wraps = periodic.on;
     let n_cells = (dims[0] * dims[1] * dims[2]) as usize;
     let cells: Vec<u32> = {
         let g = &*grid;
@@ -107,17 +142,27 @@ pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, grid: &mut CellGrid<T>) 
 }
 
 /// `detect_pairs` for grain `i`: appends to `out` every grain `j` with a higher permanent id
-/// whose surface is within `skin` of i's (`|r_i - r_j| < R_i + R_j + skin`), in ascending id
-/// order, so that the list does not depend on the grid.
+/// whose surface is within `skin` of i's (`|r_i - r_j| < R_i + R_j + skin`, minimum image),
+/// in ascending id order, so that the list does not depend on the grid.
 #[inline]
-pub fn detect_pairs<T: Real>(i: usize, body: &[Body<T>], prop: &[Props<T>], id: &[u32], grid: &CellGrid<T>, skin: T, out: &mut Vec<u32>) {
+pub fn detect_pairs<T: Real>(
+    i: usize,
+    body: &[Body<T>],
+    prop: &[Props<T>],
+    id: &[u32],
+    grid: &CellGrid<T>,
+    periodic: &Periodic<T>,
+    skin: T,
+    out: &mut Vec<u32>,
+) {
     let start = out.len();
     let c = grid.coords(body[i].pos);
-    let lo = |a: usize| c[a].saturating_sub(1);
-    let hi = |a: usize| (c[a] + 1).min(grid.dims[a] - 1);
-    for z in lo(2)..=hi(2) {
-        for y in lo(1)..=hi(1) {
-            for x in lo(0)..=hi(0) {
+    let (xs, nx) = grid.neighbours(c[0], 0);
+    let (ys, ny) = grid.neighbours(c[1], 1);
+    let (zs, nz) = grid.neighbours(c[2], 2);
+    for &z in &zs[..nz] {
+        for &y in &ys[..ny] {
+            for &x in &xs[..nx] {
                 let cell = grid.index([x, y, z]);
                 for &j in &grid.cell_grains[grid.cell_start[cell] as usize..grid.cell_start[cell + 1] as usize] {
                     let j = j as usize;
@@ -125,7 +170,7 @@ pub fn detect_pairs<T: Real>(i: usize, body: &[Body<T>], prop: &[Props<T>], id: 
                         continue;
                     }
                     let reach = prop[i].radius + prop[j].radius + skin;
-                    if (body[i].pos - body[j].pos).norm2() < reach * reach {
+                    if periodic.min_image(body[i].pos - body[j].pos).norm2() < reach * reach {
                         out.push(j as u32);
                     }
                 }

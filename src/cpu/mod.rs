@@ -21,6 +21,7 @@ pub use state::{Body, HistorySlots, Load, Props};
 
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::model::{normal_potential, ContactForce, ContactModel, PairCoeffs};
+use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 use crate::scene::{Integrator, Scene, WallShape};
 use crate::walls::WallGeom;
@@ -59,6 +60,7 @@ pub struct CpuEngine<T: Real> {
     skin: T,
     cutoff: T,
     capacity: usize,
+    periodic: Periodic<T>,
     // Grains, indexed by slot; `id` is the permanent id (equal to the slot: grains are not
     // reordered yet, so history lookups by slot stay valid across rebuilds).
     id: Vec<u32>,
@@ -66,6 +68,8 @@ pub struct CpuEngine<T: Real> {
     prop: Vec<Props<T>>,
     load: Vec<Load<T>>,
     built_at: Vec<Vec3<T>>,
+    /// Periods each grain has been wrapped by (empty without periodic axes).
+    image: Vec<[i32; 3]>,
     orientation: Option<Vec<[T; 4]>>,
     // Walls.
     walls: Vec<WallState<T>>,
@@ -139,8 +143,10 @@ impl<T: Real> CpuEngine<T> {
             skin: T::of(scene.skin),
             cutoff: T::of(2.0 * r_max + scene.skin),
             capacity: scene.max_neighbours,
+            periodic: Periodic::of(&scene.periodic),
             id: (0..n as u32).collect(),
             built_at: body.iter().map(|b| b.pos).collect(),
+            image: if scene.periodic.iter().any(Option::is_some) { vec![[0; 3]; n] } else { Vec::new() },
             body,
             prop,
             load: vec![Load::default(); n],
@@ -170,10 +176,20 @@ impl<T: Real> CpuEngine<T> {
     /// Rebuilds the neighbour list now (`hash_cells`, `detect_pairs`, `remap_history`),
     /// carrying every contact's history over.
     pub fn rebuild(&mut self) -> Result<(), SimError> {
-        if !hash_cells(&self.body, self.cutoff, &mut self.grid) {
+        if self.periodic.any() {
+            let p = self.periodic;
+            self.body.par_iter_mut().zip(self.image.par_iter_mut()).with_min_len(PAR_MIN_ITEMS).for_each(|(b, image)| {
+                let (pos, moved) = p.wrap(b.pos);
+                b.pos = pos;
+                for a in 0..3 {
+                    image[a] += moved[a];
+                }
+            });
+        }
+        if !hash_cells(&self.body, self.cutoff, &self.periodic, &mut self.grid) {
             return Err(self.non_finite_error());
         }
-        let pairs = PairList::detect(&self.body, &self.prop, &self.id, &self.grid, self.skin, self.capacity)
+        let pairs = PairList::detect(&self.body, &self.prop, &self.id, &self.grid, &self.periodic, self.skin, self.capacity)
             .map_err(|(i, count)| SimError::Capacity { step: self.step, grain: self.id[i], count, capacity: self.capacity })?;
         self.hist = pairs::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
         self.pairs = pairs;
@@ -225,7 +241,14 @@ impl<T: Real> CpuEngine<T> {
 
     /// Runs the force passes: `pair_force`, `wall_contacts`, `gather`.
     fn evaluate_forces(&mut self) {
-        let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: self.since_eval };
+        let ctx = ForceContext {
+            model: &self.model,
+            coeffs: &self.coeffs,
+            n_materials: self.n_materials,
+            slots: self.slots,
+            elapsed: self.since_eval,
+            periodic: self.periodic,
+        };
         self.since_eval = T::ZERO;
         let (pairs, body, prop) = (&self.pairs, &self.body, &self.prop);
         let stride = self.slots.stride;
@@ -323,7 +346,7 @@ impl<T: Real> CpuEngine<T> {
     /// Overlap (m) and smaller radius (m) of pair `k`.
     fn pair_overlap(&self, k: usize) -> (T, T) {
         let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
-        let d = (self.body[i].pos - self.body[j].pos).norm();
+        let d = self.periodic.min_image(self.body[i].pos - self.body[j].pos).norm();
         (self.prop[i].radius + self.prop[j].radius - d, self.prop[i].radius.min(self.prop[j].radius))
     }
 }
@@ -429,10 +452,11 @@ impl<T: Real> Engine for CpuEngine<T> {
                 let (b, p, l) = (&self.body[i], &self.prop[i], &self.load[i]);
                 let m = p.mass.f64();
                 let v = b.vel.f64();
-                let x = b.pos.f64();
+                let pos = if self.image.is_empty() { b.pos } else { self.periodic.unwrap(b.pos, self.image[i]) };
+                let x = pos.f64();
                 s.ke_t += 0.5 * m * b.vel.norm2().f64();
                 s.ke_r += 0.5 * p.inertia.f64() * b.omega.norm2().f64();
-                s.pe_g -= m * g.dot(b.pos).f64();
+                s.pe_g -= m * g.dot(pos).f64();
                 let w = b.omega.f64();
                 let ii = p.inertia.f64();
                 let mv = [m * v[0], m * v[1], m * v[2]];

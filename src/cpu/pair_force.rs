@@ -4,6 +4,7 @@
 use super::pairs::PairList;
 use super::state::{Body, HistorySlots, Props};
 use crate::model::{contact_force, Bodies, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs};
+use crate::periodic::Periodic;
 use crate::real::Real;
 
 /// What every invocation of a force pass shares.
@@ -19,6 +20,8 @@ pub struct ForceContext<'a, T> {
     pub slots: HistorySlots,
     /// Time since the previous force evaluation (s).
     pub elapsed: T,
+    /// Wrapping axes.
+    pub periodic: Periodic<T>,
 }
 
 /// `pair_force` for pair `k`. A listed pair that does not touch exerts nothing and has its
@@ -28,7 +31,7 @@ pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &
     let i = pairs.owner[k] as usize;
     let j = pairs.partner[k] as usize;
     let (bi, bj, pi, pj) = (&body[i], &body[j], &prop[i], &prop[j]);
-    let d = bi.pos - bj.pos;
+    let d = ctx.periodic.min_image(bi.pos - bj.pos);
     let dist2 = d.norm2();
     let reach = pi.radius + pj.radius;
     if dist2 >= reach * reach {

@@ -4,6 +4,7 @@
 use super::grid::{detect_pairs, CellGrid};
 use super::reduce::chunked;
 use super::state::{Body, Props};
+use crate::periodic::Periodic;
 use crate::real::Real;
 use rayon::prelude::*;
 
@@ -34,14 +35,22 @@ impl PairList {
 
     /// Runs `detect_pairs` for every grain and assembles the list. Returns the first grain
     /// (index, count) that owns more than `capacity` pairs, if any.
-    pub fn detect<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[u32], grid: &CellGrid<T>, skin: T, capacity: usize) -> Result<Self, (usize, usize)> {
+    pub fn detect<T: Real>(
+        body: &[Body<T>],
+        prop: &[Props<T>],
+        id: &[u32],
+        grid: &CellGrid<T>,
+        periodic: &Periodic<T>,
+        skin: T,
+        capacity: usize,
+    ) -> Result<Self, (usize, usize)> {
         let n = body.len();
         let parts = chunked(n, |r| {
             let mut counts = Vec::with_capacity(r.len());
             let mut partners = Vec::new();
             for i in r {
                 let before = partners.len();
-                detect_pairs(i, body, prop, id, grid, skin, &mut partners);
+                detect_pairs(i, body, prop, id, grid, periodic, skin, &mut partners);
                 counts.push((partners.len() - before) as u32);
             }
             (counts, partners)

@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use std::collections::HashMap;
 
 /// Attempts per grain before the region counts as full.
-pub const MAX_ATTEMPTS: usize = 2000;
+pub const MAX_ATTEMPTS: usize = 20_000;
 
 /// A uniform grid of already placed grains for overlap queries during placement.
 struct PlacementGrid {
@@ -25,9 +25,26 @@ impl PlacementGrid {
         let k = self.key(p);
         self.cells.entry(k).or_default().push(i);
     }
-    /// True when a sphere at `p` of radius `r` overlaps a placed grain. Correct while `r` and
-    /// every placed radius are at most `cell / 2`.
-    fn overlaps(&self, grains: &Grains, p: [f64; 3], r: f64) -> bool {
+    /// True when a sphere at `p` of radius `r` overlaps a placed grain, or a periodic image
+    /// of one. Correct while `r` and every placed radius are at most `cell / 2`.
+    fn overlaps(&self, grains: &Grains, p: [f64; 3], r: f64, periodic: &[Option<[f64; 2]>; 3]) -> bool {
+        let shifts = |a: usize| match periodic[a] {
+            Some([lo, hi]) => vec![0.0, hi - lo, lo - hi],
+            None => vec![0.0],
+        };
+        for sx in shifts(0) {
+            for sy in shifts(1) {
+                for sz in shifts(2) {
+                    if self.overlaps_here(grains, [p[0] + sx, p[1] + sy, p[2] + sz], r) {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    fn overlaps_here(&self, grains: &Grains, p: [f64; 3], r: f64) -> bool {
         let k = self.key(p);
         for dx in -1..=1 {
             for dy in -1..=1 {
@@ -49,7 +66,16 @@ impl PlacementGrid {
 }
 
 /// Places generator `k`'s grains into `grains` (after those already there).
-pub(super) fn place(c: &Complainer, k: usize, spec: &GeneratorSpec, material: u16, density: f64, seed: u64, grains: &mut Grains) -> Result<(), SceneError> {
+pub(super) fn place(
+    c: &Complainer,
+    k: usize,
+    spec: &GeneratorSpec,
+    material: u16,
+    density: f64,
+    seed: u64,
+    periodic: &[Option<[f64; 2]>; 3],
+    grains: &mut Grains,
+) -> Result<(), SceneError> {
     let key = |s: &str| format!("generate[{k}].{s}");
     let d = &spec.diameter;
     if !(d.min.is_finite() && d.min > 0.0) {
@@ -78,7 +104,7 @@ pub(super) fn place(c: &Complainer, k: usize, spec: &GeneratorSpec, material: u1
         let mut placed = None;
         for _ in 0..MAX_ATTEMPTS {
             let p = sample(c, k, &spec.region, r, &mut rng)?;
-            if !grid.overlaps(grains, p, r) {
+            if !grid.overlaps(grains, p, r, periodic) {
                 placed = Some(p);
                 break;
             }

@@ -178,6 +178,8 @@ pub struct Scene {
     pub grains: Grains,
     /// Walls.
     pub walls: Vec<Wall>,
+    /// Wrapping interval `[lo, hi)` (m) of each periodic axis.
+    pub periodic: [Option<[f64; 2]>; 3],
     /// Gravity (m/s^2).
     pub gravity: [f64; 3],
     /// Contact law per slot.
@@ -259,6 +261,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
     };
 
     let seed = f.seed.unwrap_or(1);
+    let periodic = validate_periodic(&c, &f)?;
     let mut grains = Grains::default();
     for (i, g) in f.grains.iter().enumerate() {
         let key = |k: &str| format!("grain[{i}].{k}");
@@ -275,13 +278,14 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         let key = |s: &str| format!("generate[{k}].{s}");
         let m = material_of(key("material"), &spec.material)?;
         let rho = grain_density(key("material"), m)?;
-        generate::place(&c, k, spec, m, rho, seed, &mut grains)?;
+        generate::place(&c, k, spec, m, rho, seed, &periodic, &mut grains)?;
     }
     if grains.is_empty() {
         return Err(c.invalid("grain", "[]", "the scene has no grains", "add [[grain]] or [[generate]] tables"));
     }
-    let walls = finish_walls(&c, walls, &grains)?;
+    let walls = finish_walls(&c, walls, &grains, &periodic)?;
     check_overlaps(&c, &f, &grains, &walls)?;
+    check_periodic(&c, &f, &grains, &periodic, f.simulation.skin)?;
 
     let model = validate_model(&c, &f.model, &materials, &grains, &walls)?;
     let sim = &f.simulation;
@@ -324,6 +328,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         materials,
         grains,
         walls,
+        periodic,
         gravity,
         model,
         integrator,
@@ -469,8 +474,8 @@ fn validate_walls(
 
 /// Fills in the piston's default mass (total grain mass) and area (cross-section of the
 /// cylinder, or of a box's side walls).
-fn finish_walls(c: &Complainer, pending: Vec<PendingWall>, grains: &Grains) -> Result<Vec<Wall>, SceneError> {
-    let section = cross_section(pending.iter().map(|p| &p.wall.shape));
+fn finish_walls(c: &Complainer, pending: Vec<PendingWall>, grains: &Grains, periodic: &[Option<[f64; 2]>; 3]) -> Result<Vec<Wall>, SceneError> {
+    let section = cross_section(pending.iter().map(|p| &p.wall.shape), periodic);
     let total_mass: f64 = grains.mass.iter().sum();
     let mut out = Vec::with_capacity(pending.len());
     for p in pending {
@@ -489,9 +494,9 @@ fn finish_walls(c: &Complainer, pending: Vec<PendingWall>, grains: &Grains) -> R
     Ok(out)
 }
 
-/// Horizontal cross-section (m^2) of a container: a cylinder wall's, or that of the four side
-/// planes of a box; `None` when the walls do not bound one.
-pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone) -> Option<f64> {
+/// Horizontal cross-section (m^2) of a container: a cylinder wall's, or that of the side
+/// planes of a box or the periods of the x and y axes; `None` when nothing bounds one.
+pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone, periodic: &[Option<[f64; 2]>; 3]) -> Option<f64> {
     let cylinder = shapes.clone().find_map(|s| match *s {
         WallShape::Cylinder { radius, .. } => Some(std::f64::consts::PI * radius * radius),
         _ => None,
@@ -503,9 +508,15 @@ pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone) ->
                 _ => None,
             })
         };
-        let (x0, x1) = (side([1.0, 0.0, 0.0])?, side([-1.0, 0.0, 0.0])?);
-        let (y0, y1) = (side([0.0, 1.0, 0.0])?, side([0.0, -1.0, 0.0])?);
-        Some((x1[0] - x0[0]) * (y1[1] - y0[1]))
+        let span = |a: usize, n: [f64; 3]| match periodic[a] {
+            Some([lo, hi]) => Some(hi - lo),
+            None => {
+                let mut m = n;
+                m[a] = -n[a];
+                Some(side(m)?[a] - side(n)?[a])
+            }
+        };
+        Some(span(0, [1.0, 0.0, 0.0])? * span(1, [0.0, 1.0, 0.0])?)
     })
 }
 
@@ -513,6 +524,39 @@ pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone) ->
 /// the grains' side.
 pub fn wall_distance(shape: &WallShape, p: [f64; 3]) -> f64 {
     crate::walls::WallGeom::<f64>::of(shape).frame(crate::real::Vec3::of(p)).1
+}
+
+fn validate_periodic(c: &Complainer, f: &SceneFile) -> Result<[Option<[f64; 2]>; 3], SceneError> {
+    let p = &f.periodic;
+    let mut out = [None; 3];
+    for (a, (name, v)) in [("x", p.x), ("y", p.y), ("z", p.z)].into_iter().enumerate() {
+        if let Some([lo, hi]) = v {
+            if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+                return Err(c.invalid(format!("periodic.{name}"), format!("[{lo}, {hi}]"), "must be [lo, hi] with hi > lo", "give the wrapping interval in metres"));
+            }
+            out[a] = Some([lo, hi]);
+        }
+    }
+    Ok(out)
+}
+
+/// A periodic axis must hold its grains and be long enough that a pair within reach has one
+/// image only: period > 2 (2 R_max + skin).
+fn check_periodic(c: &Complainer, f: &SceneFile, grains: &Grains, periodic: &[Option<[f64; 2]>; 3], skin: Option<f64>) -> Result<(), SceneError> {
+    let r_max = grains.radius.iter().copied().fold(0.0, f64::max);
+    let d_mean = 2.0 * grains.radius.iter().sum::<f64>() / grains.len() as f64;
+    let reach = 2.0 * r_max + skin.unwrap_or(0.1 * d_mean);
+    for (a, name) in ["x", "y", "z"].into_iter().enumerate() {
+        let Some([lo, hi]) = periodic[a] else { continue };
+        if hi - lo <= 2.0 * reach {
+            return Err(c.invalid(format!("periodic.{name}"), format!("[{lo}, {hi}]"), format!("a period of {:.4e} m is too short for contacts of reach {reach:.4e} m", hi - lo), format!("make the period longer than {:.4e} m", 2.0 * reach)));
+        }
+        if let Some(i) = (0..grains.len()).find(|&i| !(grains.position[i][a] >= lo && grains.position[i][a] < hi)) {
+            let key = if i < f.grains.len() { format!("grain[{i}].position") } else { "generate.region".to_string() };
+            return Err(c.invalid(key, format!("{:?}", grains.position[i]), format!("lies outside periodic.{name} = [{lo}, {hi})"), "place grains inside the periodic interval"));
+        }
+    }
+    Ok(())
 }
 
 /// Grains may not start overlapping a wall or (listed grains) each other: the first step

@@ -27,6 +27,9 @@ pub struct SceneFile {
     /// `[[wall]]` tables.
     #[serde(default, rename = "wall")]
     pub walls: Vec<WallSpec>,
+    /// `[periodic]`: axes along which the domain wraps.
+    #[serde(default)]
+    pub periodic: PeriodicSpec,
     /// `[model]`: the contact law per slot.
     #[serde(default)]
     pub model: ModelSpec,
@@ -194,6 +197,19 @@ pub enum WallSpec {
         /// wall or box.
         area: Option<f64>,
     },
+}
+
+/// `[periodic]`: each axis given wraps over `[lo, hi)` (m); grains leaving at `hi` come back
+/// at `lo`, and contacts act across the boundary (minimum image).
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PeriodicSpec {
+    /// `[lo, hi]` of x (m).
+    pub x: Option<[f64; 2]>,
+    /// `[lo, hi]` of y (m).
+    pub y: Option<[f64; 2]>,
+    /// `[lo, hi]` of z (m).
+    pub z: Option<[f64; 2]>,
 }
 
 /// `[model]`: the contact law chosen per slot, with the parameters of the chosen laws.
