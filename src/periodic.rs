@@ -17,8 +17,8 @@ impl<T: Real> Periodic<T> {
     /// From the scene's `[periodic]` intervals (f64, m).
     pub fn of(axes: &[Option<[f64; 2]>; 3]) -> Self {
         let mut p = Periodic { on: [false; 3], lo: [T::ZERO; 3], len: [T::ZERO; 3] };
-        for a in 0..3 {
-            if let Some([lo, hi]) = axes[a] {
+        for (a, axis) in axes.iter().enumerate() {
+            if let Some([lo, hi]) = *axis {
                 p.on[a] = true;
                 p.lo[a] = T::of(lo);
                 p.len[a] = T::of(hi - lo);
