@@ -7,6 +7,8 @@
 pub mod analysis;
 pub mod cpu;
 pub mod engine;
+pub mod gpu;
+pub mod kernels;
 pub mod model;
 pub mod output;
 pub mod periodic;

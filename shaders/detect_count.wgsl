@@ -1,0 +1,34 @@
+// One invocation counts the pairs one grain owns (partners of higher id within reach) and
+// flags a grain over the neighbour capacity.
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> cell_count: array<u32>;
+@group(0) @binding(3) var<storage, read> cell_grains: array<u32>;
+@group(0) @binding(4) var<storage, read_write> pair_start: array<u32>;
+@group(0) @binding(5) var<storage, read_write> control: Control;
+
+@compute @workgroup_size(64)
+fn detect_count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = flat_index(wid, lid, nwg);
+    if (i >= params.n_grains) {
+        return;
+    }
+    let pi = pos[i];
+    let b = neighbour_buckets(pi.xyz);
+    var count = 0u;
+    for (var k = 0u; k < b.n; k++) {
+        let r = bucket_range(b.h[k]);
+        for (var s = r.x; s < r.y; s++) {
+            if (owns(i, cell_grains[s], pi)) {
+                count += 1u;
+            }
+        }
+    }
+    if (count > params.max_neighbours) {
+        if (atomicMin(&control.overflow_grain, i) > i) {
+            atomicStore(&control.overflow_count, count);
+        }
+        count = params.max_neighbours;
+    }
+    pair_start[i] = count;
+}

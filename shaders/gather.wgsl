@@ -1,0 +1,37 @@
+// One invocation sums the load on one grain in a fixed order: gravity, the pairs it owns,
+// the pairs where it is partner, its wall contacts. No float atomics.
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> vel: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> pair_start: array<u32>;
+@group(0) @binding(3) var<storage, read> rev_start: array<u32>;
+@group(0) @binding(4) var<storage, read> rev_pair: array<u32>;
+@group(0) @binding(5) var<storage, read> out_fi: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> out_fj: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> out_ti: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read> out_tj: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read> wall_force: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read> wall_torque: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read_write> force: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read_write> torque: array<vec4<f32>>;
+
+@compute @workgroup_size(64)
+fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = flat_index(wid, lid, nwg);
+    if (i >= params.n_grains) {
+        return;
+    }
+    var f = params.gravity.xyz * vel[i].w;
+    var t = vec3<f32>(0.0);
+    let end = min(pair_start[i + 1u], params.pair_capacity);
+    for (var k = pair_start[i]; k < end; k++) {
+        f += out_fi[k].xyz;
+        t += out_ti[k].xyz;
+    }
+    for (var s = rev_start[i]; s < rev_start[i + 1u]; s++) {
+        let k = rev_pair[s];
+        f += out_fj[k].xyz;
+        t += out_tj[k].xyz;
+    }
+    force[i] = vec4<f32>(f + wall_force[i].xyz, 0.0);
+    torque[i] = vec4<f32>(t + wall_torque[i].xyz, 0.0);
+}

@@ -1,0 +1,75 @@
+// One invocation computes the force of one listed pair, once, in canonical order (owner =
+// lower id = i), reading and writing its history. A pair that does not touch exerts nothing
+// and forgets its springs.
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<uniform> phase: Phase;
+@group(0) @binding(2) var<storage, read> pos: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> vel: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> omega: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> material: array<u32>;
+@group(0) @binding(6) var<storage, read> coeffs: array<PairCoeffs>;
+@group(0) @binding(7) var<storage, read> pair_i: array<u32>;
+@group(0) @binding(8) var<storage, read> pair_j: array<u32>;
+@group(0) @binding(9) var<storage, read_write> hist: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read_write> out_fi: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read_write> out_fj: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read_write> out_ti: array<vec4<f32>>;
+@group(0) @binding(13) var<storage, read_write> out_tj: array<vec4<f32>>;
+@group(0) @binding(14) var<storage, read> control: Control;
+
+fn load_history(k: u32) -> History {
+    var h: History;
+    h.tangential = vec3<f32>(0.0);
+    h.rolling = vec3<f32>(0.0);
+    var b = k * params.hist_blocks;
+    if (HAS_TANGENTIAL_HISTORY) { h.tangential = hist[b].xyz; b += 1u; }
+    if (HAS_ROLLING_HISTORY) { h.rolling = hist[b].xyz; }
+    return h;
+}
+
+fn store_history(k: u32, h: History) {
+    var b = k * params.hist_blocks;
+    if (HAS_TANGENTIAL_HISTORY) { hist[b] = vec4<f32>(h.tangential, 0.0); b += 1u; }
+    if (HAS_ROLLING_HISTORY) { hist[b] = vec4<f32>(h.rolling, 0.0); }
+}
+
+@compute @workgroup_size(64)
+fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let k = flat_index(wid, lid, nwg);
+    if (k >= control.n_pairs) {
+        return;
+    }
+    let i = pair_i[k];
+    let j = pair_j[k];
+    let pi = pos[i];
+    let pj = pos[j];
+    let d = min_image(pi.xyz - pj.xyz);
+    let dist2 = dot(d, d);
+    let reach = pi.w + pj.w;
+    if (dist2 >= reach * reach) {
+        var zero: History;
+        zero.tangential = vec3<f32>(0.0);
+        zero.rolling = vec3<f32>(0.0);
+        store_history(k, zero);
+        out_fi[k] = vec4<f32>(0.0);
+        out_fj[k] = vec4<f32>(0.0);
+        out_ti[k] = vec4<f32>(0.0);
+        out_tj[k] = vec4<f32>(0.0);
+        return;
+    }
+    let vi = vel[i];
+    let vj = vel[j];
+    let wi = omega[i];
+    let wj = omega[j];
+    let g = geometry_grain_grain(d, sqrt(dist2), pi.w, pj.w, vi.w, vj.w);
+    let kin = Kinematics(vi.xyz, vj.xyz, wi.xyz, wj.xyz);
+    let bodies = Bodies(vi.w, wi.w, vj.w, wj.w, false);
+    let c = coeffs[material[i] * params.n_materials + material[j]];
+    var h = load_history(k);
+    let f = contact_force(c, g, kin, bodies, &h, phase.elapsed);
+    store_history(k, h);
+    out_fi[k] = vec4<f32>(f.f_i, f.f_n);
+    out_fj[k] = vec4<f32>(f.f_j, select(0.0, 1.0, f.clamped));
+    out_ti[k] = vec4<f32>(f.t_i, 0.0);
+    out_tj[k] = vec4<f32>(f.t_j, 0.0);
+}

@@ -1,0 +1,65 @@
+// One invocation adds one grain to its workgroup's statistics row: kinetic and gravitational
+// energy, momentum, angular momentum, |net force|, wall contacts, their elastic energy and
+// the largest wall overlap.
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> vel: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> omega: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> force: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> wall_force: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> image: array<vec4<i32>>;
+@group(0) @binding(7) var<storage, read> material: array<u32>;
+@group(0) @binding(8) var<storage, read> coeffs: array<PairCoeffs>;
+@group(0) @binding(9) var<storage, read> walls: array<Wall>;
+@group(0) @binding(10) var<storage, read_write> grain_rows: array<f32>;
+
+var<workgroup> row: array<f32, 1024>;
+
+@compute @workgroup_size(64)
+fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let i = flat_index(wid, lid, nwg);
+    clear_row(lid);
+    if (i < params.n_grains) {
+        let r = lid * STAT_ROW;
+        let p = pos[i];
+        let v = vel[i];
+        let w = omega[i];
+        var x = p.xyz;
+        if (params.periodic_dims.x + params.periodic_dims.y + params.periodic_dims.z > 0u) {
+            x += vec3<f32>(image[i].xyz) * params.periodic_len.xyz;
+        }
+        let mv = v.xyz * v.w;
+        let l = cross(x, mv) + w.xyz * w.w;
+        row[r + 0u] = 0.5 * v.w * dot(v.xyz, v.xyz);
+        row[r + 1u] = 0.5 * w.w * dot(w.xyz, w.xyz);
+        row[r + 2u] = -v.w * dot(params.gravity.xyz, x);
+        row[r + 3u] = mv.x;
+        row[r + 4u] = mv.y;
+        row[r + 5u] = mv.z;
+        row[r + 6u] = l.x;
+        row[r + 7u] = l.y;
+        row[r + 8u] = l.z;
+        row[r + 9u] = length(force[i].xyz);
+        row[r + 10u] = length(wall_force[i].xyz);
+        for (var k = 0u; k < params.n_walls; k++) {
+            let frame = wall_frame(walls[k], p.xyz);
+            let h = p.w - frame.w;
+            if (h > 0.0) {
+                let c = coeffs[walls[k].material * params.n_materials + material[i]];
+                row[r + 11u] += 1.0;
+                row[r + 12u] += normal_potential(c, p.w, h);
+                if (h / p.w > row[r + STAT_MAX]) {
+                    row[r + STAT_MAX] = h / p.w;
+                    row[r + STAT_ARG] = bitcast<f32>(i);
+                }
+            }
+        }
+    }
+    reduce_rows(lid);
+    if (lid == 0u) {
+        let out = (wid.y * nwg.x + wid.x) * STAT_ROW;
+        for (var f = 0u; f < STAT_ROW; f++) {
+            grain_rows[out + f] = row[f];
+        }
+    }
+}

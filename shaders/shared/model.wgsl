@@ -1,0 +1,249 @@
+// Contact sub-models, the WGSL twins of src/model/*.rs. Conventions: n points from j to i;
+// h > 0 in contact; forces and torques are "on i" unless named _j.
+
+// Laws chosen per scene (pipeline-overridable constants, so unused branches fold away).
+override NORMAL_LAW: u32 = 0u;      // 0 hertz, 1 linear
+override DAMPING_LAW: u32 = 0u;     // 0 none, 1 papers, 2 restitution, 3 viscous
+override TANGENTIAL_LAW: u32 = 0u;  // 0 none, 1 oquendo, 2 mindlin
+override ROLLING_LAW: u32 = 0u;     // 0 none, 1 sds
+override TWISTING_LAW: u32 = 0u;    // 0 none, 1 oquendo
+override HAS_TANGENTIAL_HISTORY: bool = false;
+override HAS_ROLLING_HISTORY: bool = false;
+
+struct Geometry {
+    n: vec3<f32>,
+    h: f32,
+    r_eff: f32,
+    m_eff: f32,
+    rp_i: f32,
+    rp_j: f32,
+    rp_eff: f32,
+}
+
+struct Kinematics {
+    v_i: vec3<f32>,
+    v_j: vec3<f32>,
+    w_i: vec3<f32>,
+    w_j: vec3<f32>,
+}
+
+struct Bodies {
+    m_i: f32,
+    inertia_i: f32,
+    m_j: f32,
+    inertia_j: f32,
+    j_is_wall: bool,
+}
+
+struct ContactForce {
+    f_i: vec3<f32>,
+    f_j: vec3<f32>,
+    t_i: vec3<f32>,
+    t_j: vec3<f32>,
+    f_n: f32,
+    clamped: bool,
+}
+
+struct History {
+    tangential: vec3<f32>,
+    rolling: vec3<f32>,
+}
+
+fn geometry_grain_grain(d: vec3<f32>, dist: f32, r_i: f32, r_j: f32, m_i: f32, m_j: f32) -> Geometry {
+    var g: Geometry;
+    g.h = r_i + r_j - dist;
+    g.n = d * (1.0 / dist);
+    let sum = r_i + r_j;
+    g.rp_i = r_i - g.h * r_j / sum;
+    g.rp_j = r_j - g.h * r_i / sum;
+    g.r_eff = r_i * r_j / sum;
+    g.m_eff = m_i * m_j / (m_i + m_j);
+    g.rp_eff = g.rp_i * g.rp_j / (g.rp_i + g.rp_j);
+    return g;
+}
+
+fn geometry_grain_wall(n: vec3<f32>, dist: f32, r_i: f32, m_i: f32) -> Geometry {
+    var g: Geometry;
+    g.n = n;
+    g.h = r_i - dist;
+    g.r_eff = r_i;
+    g.m_eff = m_i;
+    g.rp_i = r_i - g.h;
+    g.rp_j = 0.0;
+    g.rp_eff = g.rp_i;
+    return g;
+}
+
+// Elastic normal force (N) and secant stiffness F/h (N/m).
+fn normal_elastic(c: PairCoeffs, g: Geometry) -> vec2<f32> {
+    if (NORMAL_LAW == 0u) {
+        let k = 4.0 / 3.0 * c.v_eff * sqrt(g.r_eff * g.h);
+        return vec2<f32>(k * g.h, k);
+    }
+    return vec2<f32>(params.k_n * g.h, params.k_n);
+}
+
+// Damping coefficient eta (kg/s): the damping force on i is -eta v_n n.
+fn normal_damping(c: PairCoeffs, g: Geometry) -> f32 {
+    if (DAMPING_LAW == 1u) {
+        return g.m_eff * c.gamma_n * sqrt(g.h);
+    }
+    if (DAMPING_LAW == 2u) {
+        if (NORMAL_LAW == 0u) {
+            let s_n = 2.0 * c.v_eff * sqrt(g.r_eff * g.h);
+            return 2.0 * sqrt(5.0 / 6.0) * c.beta * sqrt(s_n * g.m_eff);
+        }
+        return 2.0 * c.beta * sqrt(params.k_n * g.m_eff);
+    }
+    if (DAMPING_LAW == 3u) {
+        return params.c_n;
+    }
+    return 0.0;
+}
+
+fn rotate_into_plane(s: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let len2 = dot(s, s);
+    if (len2 == 0.0) {
+        return s;
+    }
+    let p = s - n * dot(s, n);
+    let p2 = dot(p, p);
+    if (p2 == 0.0) {
+        return vec3<f32>(0.0);
+    }
+    return p * sqrt(len2 / p2);
+}
+
+fn contact_tangential_velocity(g: Geometry, k: Kinematics) -> vec3<f32> {
+    let v_p = k.v_i - k.v_j - cross(k.w_i * g.rp_i + k.w_j * g.rp_j, g.n);
+    return v_p - g.n * dot(v_p, g.n);
+}
+
+fn tangential_stiffness(c: PairCoeffs, g: Geometry, k_secant: f32) -> f32 {
+    if (params.kt_ratio > 0.0) {
+        return params.kt_ratio * k_secant;
+    }
+    return 8.0 * c.g_eff * sqrt(g.r_eff * g.h);
+}
+
+// Seed 000 eqs. 8-9 for one grain: (force, torque).
+fn rolling_regime(fr: f32, m: f32, inertia: f32, rp: f32, t: vec3<f32>, n: vec3<f32>, out_f: ptr<function, vec3<f32>>, out_t: ptr<function, vec3<f32>>) {
+    let mr2 = m * rp * rp;
+    *out_f = t * (-fr / (1.0 + inertia / mr2));
+    *out_t = cross(t, n) * (rp * fr / (1.0 + mr2 / inertia));
+}
+
+fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr<function, History>, elapsed: f32) -> ContactForce {
+    var out: ContactForce;
+    let v_n = dot(k.v_i - k.v_j, g.n);
+    let el = normal_elastic(c, g);
+    let eta_n = normal_damping(c, g);
+    var f_n = el.x - eta_n * v_n;
+    out.clamped = f_n < 0.0;
+    if (out.clamped) {
+        f_n = 0.0;
+    }
+    out.f_n = f_n;
+    out.f_i = g.n * f_n;
+    out.f_j = -out.f_i;
+    out.t_i = vec3<f32>(0.0);
+    out.t_j = vec3<f32>(0.0);
+
+    if (TANGENTIAL_LAW == 1u) {
+        let k_t = tangential_stiffness(c, g, el.y);
+        let v_t = contact_tangential_velocity(g, k);
+        let speed = length(v_t);
+        var f_i = vec3<f32>(0.0);
+        var f_j = vec3<f32>(0.0);
+        var t_i = vec3<f32>(0.0);
+        var t_j = vec3<f32>(0.0);
+        var regime_done = false;
+        if (speed > params.v_slip) {
+            let f_t = v_t * (-c.mu_k * f_n / speed);
+            if (k_t > 0.0) { (*hist).tangential = f_t * (-1.0 / k_t); } else { (*hist).tangential = vec3<f32>(0.0); }
+            f_i = f_t;
+            f_j = -f_t;
+            t_i = -(cross(g.n, f_t) * g.rp_i);
+            t_j = -(cross(g.n, f_t) * g.rp_j);
+            regime_done = true;
+        }
+        if (!regime_done) {
+            (*hist).tangential = rotate_into_plane((*hist).tangential, g.n) + v_t * elapsed;
+            let v_r = cross(k.w_i - k.w_j, g.n) * g.rp_eff;
+            let roll_speed = length(v_r);
+            if (roll_speed > params.v_roll) {
+                let t = v_r * (1.0 / roll_speed);
+                let fr = f_n * c.tan_roll;
+                rolling_regime(fr, b.m_i, b.inertia_i, g.rp_i, t, g.n, &f_i, &t_i);
+                if (b.j_is_wall) {
+                    f_j = -f_i;
+                } else {
+                    rolling_regime(fr, b.m_j, b.inertia_j, g.rp_j, t, -g.n, &f_j, &t_j);
+                }
+            } else {
+                var f_t = (*hist).tangential * (-k_t);
+                let limit = c.mu_s * f_n;
+                let mag = length(f_t);
+                if (mag > limit) {
+                    f_t = f_t * (c.mu_k * f_n / mag);
+                    if (k_t > 0.0) { (*hist).tangential = f_t * (-1.0 / k_t); } else { (*hist).tangential = vec3<f32>(0.0); }
+                }
+                f_i = f_t;
+                f_j = -f_t;
+                t_i = -(cross(g.n, f_t) * g.rp_i);
+                t_j = -(cross(g.n, f_t) * g.rp_j);
+            }
+        }
+        out.f_i += f_i;
+        out.f_j += f_j;
+        out.t_i += t_i;
+        out.t_j += t_j;
+    }
+    if (TANGENTIAL_LAW == 2u) {
+        let k_t = tangential_stiffness(c, g, el.y);
+        let v_t = contact_tangential_velocity(g, k);
+        (*hist).tangential = rotate_into_plane((*hist).tangential, g.n) + v_t * elapsed;
+        let damp = v_t * (eta_n * params.damping_ratio);
+        var f_t = -((*hist).tangential * k_t) - damp;
+        let limit = c.mu_s * f_n;
+        let mag2 = dot(f_t, f_t);
+        if (mag2 > limit * limit) {
+            f_t = f_t * (limit / sqrt(mag2));
+            if (k_t > 0.0) { (*hist).tangential = (f_t + damp) * (-1.0 / k_t); } else { (*hist).tangential = vec3<f32>(0.0); }
+        }
+        out.f_i += f_t;
+        out.f_j -= f_t;
+        out.t_i -= cross(g.n, f_t) * g.rp_i;
+        out.t_j -= cross(g.n, f_t) * g.rp_j;
+    }
+    if (ROLLING_LAW == 1u) {
+        let v_rl = cross(k.w_i - k.w_j, g.n) * g.r_eff;
+        (*hist).rolling = rotate_into_plane((*hist).rolling, g.n) + v_rl * elapsed;
+        let damp = v_rl * params.gamma_r;
+        var f_r = -((*hist).rolling * params.k_r) - damp;
+        let limit = params.mu_r * f_n;
+        let mag2 = dot(f_r, f_r);
+        if (mag2 > limit * limit) {
+            f_r = f_r * (limit / sqrt(mag2));
+            if (params.k_r > 0.0) { (*hist).rolling = (f_r + damp) * (-1.0 / params.k_r); } else { (*hist).rolling = vec3<f32>(0.0); }
+        }
+        let tau = cross(g.n, f_r) * g.r_eff;
+        out.t_i += tau;
+        out.t_j -= tau;
+    }
+    if (TWISTING_LAW == 1u) {
+        let w_n = g.n * dot(k.w_i - k.w_j, g.n);
+        let tau = w_n * (-4.0 * 3.14159265358979 * c.gamma_nt * g.m_eff * g.r_eff * g.h);
+        out.t_i += tau;
+        out.t_j -= tau;
+    }
+    return out;
+}
+
+// Elastic energy (J) of a normal spring with overlap h.
+fn normal_potential(c: PairCoeffs, r_eff: f32, h: f32) -> f32 {
+    if (NORMAL_LAW == 0u) {
+        return 8.0 / 15.0 * sqrt(r_eff) * c.v_eff * h * h * sqrt(h);
+    }
+    return 0.5 * params.k_n * h * h;
+}

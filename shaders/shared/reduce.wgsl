@@ -1,0 +1,31 @@
+// Fixed-order workgroup reduction of statistics rows (sums, then the largest value and its
+// grain; ties go to the lower grain). Needs `row: array<f32, 1024>` in workgroup memory.
+
+fn reduce_rows(lid: u32) {
+    workgroupBarrier();
+    for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
+        if (lid < stride) {
+            let a = lid * STAT_ROW;
+            let b = (lid + stride) * STAT_ROW;
+            for (var f = 0u; f < STAT_MAX; f++) {
+                row[a + f] += row[b + f];
+            }
+            let va = row[a + STAT_MAX];
+            let vb = row[b + STAT_MAX];
+            let ia = bitcast<u32>(row[a + STAT_ARG]);
+            let ib = bitcast<u32>(row[b + STAT_ARG]);
+            if (vb > va || (vb == va && ib < ia)) {
+                row[a + STAT_MAX] = vb;
+                row[a + STAT_ARG] = row[b + STAT_ARG];
+            }
+        }
+        workgroupBarrier();
+    }
+}
+
+fn clear_row(lid: u32) {
+    for (var f = 0u; f < STAT_ROW; f++) {
+        row[lid * STAT_ROW + f] = 0.0;
+    }
+    row[lid * STAT_ROW + STAT_ARG] = bitcast<f32>(NONE);
+}

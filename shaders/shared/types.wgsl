@@ -1,0 +1,103 @@
+// Structures shared by the kernels. Keep in sync with src/gpu/layout.rs (a test compares
+// sizes and offsets through naga's reflection).
+
+// Scene-wide constants of one engine (uniform).
+struct Params {
+    n_grains: u32,
+    n_walls: u32,
+    n_materials: u32,
+    pair_capacity: u32,
+    hash_size: u32,
+    max_neighbours: u32,
+    piston: u32,          // wall index of the piston, or 0xffffffff
+    hist_blocks: u32,     // vec4 history blocks per contact (tangential, then rolling)
+    gravity: vec4<f32>,   // m/s^2 (xyz)
+    cell: vec4<f32>,      // cell edge per axis (m)
+    periodic_lo: vec4<f32>,
+    periodic_len: vec4<f32>, // period per axis (m); 0 where the axis does not wrap
+    periodic_dims: vec4<u32>, // cells per wrapping axis; 0 where it does not wrap
+    skin: f32,            // m
+    k_n: f32,             // linear normal stiffness (N/m)
+    c_n: f32,             // viscous damping (N s/m)
+    v_slip: f32,          // m/s
+    v_roll: f32,          // m/s
+    kt_ratio: f32,        // k_t / (F_el / h); <= 0 selects Mindlin's k_t
+    damping_ratio: f32,   // eta_t / eta_n (Hertz-Mindlin)
+    k_r: f32,             // rolling stiffness (N/m)
+    gamma_r: f32,         // rolling damping (N s/m)
+    mu_r: f32,            // rolling friction
+    _pad1: f32,
+    _pad2: f32,
+}
+
+// What changes between the dispatches of one step (uniform, dynamic offset).
+struct Phase {
+    tau: f32,      // kick or drift duration (s)
+    elapsed: f32,  // time since the previous force evaluation (s), for the springs
+    _pad0: f32,
+    _pad1: f32,
+}
+
+// Coefficients of a pair of materials, [material_i * n_materials + material_j].
+struct PairCoeffs {
+    v_eff: f32,
+    g_eff: f32,
+    mu_s: f32,
+    mu_k: f32,
+    tan_roll: f32,
+    gamma_n: f32,
+    gamma_nt: f32,
+    beta: f32,
+}
+
+// A wall. kind: 0 plane, 1 cylinder, 2 piston.
+struct Wall {
+    kind: u32,
+    material: u32,
+    _pad0: u32,
+    _pad1: u32,
+    point: vec4<f32>,    // plane: a point; cylinder: axis (x, y); piston: (0, 0, z)
+    normal: vec4<f32>,   // plane: unit normal into the domain; cylinder: w = radius
+    velocity: vec4<f32>, // m/s
+    piston: vec4<f32>,   // mass (kg), area (m^2), target pressure (Pa), external work (J)
+}
+
+// Flags and counters the host reads back with the statistics.
+struct Control {
+    max_disp2: atomic<u32>,    // bits of the largest squared displacement since the build (f32 >= 0)
+    rebuild: u32,              // 1 while this step rebuilds
+    rebuilds: u32,
+    n_pairs: u32,
+    overflow_grain: atomic<u32>, // lowest grain over the neighbour capacity, or 0xffffffff
+    overflow_count: atomic<u32>, // its pair count
+    pair_overflow: u32,        // 1 when the pair list outgrew its buffer
+    non_finite: atomic<u32>,   // lowest grain with a non-finite position, or 0xffffffff
+}
+
+// Workgroup-size indirect dispatch arguments.
+struct DispatchArgs {
+    x: u32,
+    y: u32,
+    z: u32,
+}
+
+const NONE: u32 = 0xffffffffu;
+const WG: u32 = 64u;
+
+// Slots of the indirect dispatch buffer. "if rebuilding" slots are zero on other steps.
+const ARGS_GRAINS: u32 = 0u;        // one invocation per grain, if rebuilding
+const ARGS_HASH: u32 = 1u;          // one per hash bucket, if rebuilding
+const ARGS_HASH_BLOCKS: u32 = 2u;   // scan blocks over the buckets, if rebuilding
+const ARGS_GRAIN_BLOCKS: u32 = 3u;  // scan blocks over n_grains + 1, if rebuilding
+const ARGS_ONE: u32 = 4u;           // one workgroup, if rebuilding
+const ARGS_OLD_PAIRS: u32 = 5u;     // one per pair of the list being replaced, if rebuilding
+const ARGS_PAIRS: u32 = 6u;         // one per current pair, always
+const ARGS_NEW_PAIRS: u32 = 7u;     // one per new pair, if rebuilding
+const ARGS_GRAIN_STARTS: u32 = 8u;  // one per entry of n_grains + 1, if rebuilding
+const ARGS_SLOTS: u32 = 9u;
+
+const MAX_WALLS: u32 = 8u;
+// Per-workgroup rows of the statistics reduction: sums, then (largest overlap, its grain).
+const STAT_ROW: u32 = 16u;
+const STAT_MAX: u32 = 14u;
+const STAT_ARG: u32 = 15u;

@@ -1,0 +1,33 @@
+// One workgroup sums the per-workgroup wall forces in a fixed order into each wall's total
+// (xyz: force the grains exert, w: contacts).
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> wall_partials: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read_write> wall_reaction: array<vec4<f32>>;
+
+var<workgroup> acc: array<vec4<f32>, 512>;
+
+@compute @workgroup_size(64)
+fn wall_reduce(@builtin(local_invocation_index) lid: u32) {
+    let rows = arrayLength(&wall_partials) / MAX_WALLS;
+    for (var w = 0u; w < MAX_WALLS; w++) {
+        var s = vec4<f32>(0.0);
+        for (var r = lid; r < rows; r += WG) {
+            s += wall_partials[r * MAX_WALLS + w];
+        }
+        acc[lid * MAX_WALLS + w] = s;
+    }
+    workgroupBarrier();
+    for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
+        if (lid < stride) {
+            for (var w = 0u; w < MAX_WALLS; w++) {
+                acc[lid * MAX_WALLS + w] += acc[(lid + stride) * MAX_WALLS + w];
+            }
+        }
+        workgroupBarrier();
+    }
+    if (lid == 0u) {
+        for (var w = 0u; w < MAX_WALLS; w++) {
+            wall_reaction[w] = acc[w];
+        }
+    }
+}

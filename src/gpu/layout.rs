@@ -1,0 +1,187 @@
+//! Structures that cross to the GPU, `#[repr(C)]` and Pod. Keep in sync with
+//! `shaders/shared/types.wgsl`; `tests/shaders.rs` checks sizes and offsets against naga's
+//! reflection of the WGSL.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Scene-wide constants (WGSL `Params`, a uniform).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct Params {
+    /// Grains.
+    pub n_grains: u32,
+    /// Walls (at most [`MAX_WALLS`]).
+    pub n_walls: u32,
+    /// Materials.
+    pub n_materials: u32,
+    /// Pairs the pair buffers hold.
+    pub pair_capacity: u32,
+    /// Hash buckets (a power of two).
+    pub hash_size: u32,
+    /// Pairs a grain may own.
+    pub max_neighbours: u32,
+    /// Wall index of the piston, or [`NONE`].
+    pub piston: u32,
+    /// vec4 history blocks per contact.
+    pub hist_blocks: u32,
+    /// Gravity (m/s^2).
+    pub gravity: [f32; 4],
+    /// Cell edge per axis (m).
+    pub cell: [f32; 4],
+    /// Lower bound of each periodic axis (m).
+    pub periodic_lo: [f32; 4],
+    /// Period per axis (m), 0 where it does not wrap.
+    pub periodic_len: [f32; 4],
+    /// Cells per periodic axis, 0 where it does not wrap.
+    pub periodic_dims: [u32; 4],
+    /// Verlet skin (m).
+    pub skin: f32,
+    /// Linear normal stiffness (N/m).
+    pub k_n: f32,
+    /// Viscous damping (N s/m).
+    pub c_n: f32,
+    /// Sliding threshold (m/s).
+    pub v_slip: f32,
+    /// Rolling threshold (m/s).
+    pub v_roll: f32,
+    /// k_t over the normal secant stiffness; <= 0 selects Mindlin.
+    pub kt_ratio: f32,
+    /// Hertz-Mindlin tangential damping ratio.
+    pub damping_ratio: f32,
+    /// Rolling stiffness (N/m).
+    pub k_r: f32,
+    /// Rolling damping (N s/m).
+    pub gamma_r: f32,
+    /// Rolling friction.
+    pub mu_r: f32,
+    /// Padding.
+    pub _pad1: f32,
+    /// Padding.
+    pub _pad2: f32,
+}
+
+/// What changes between dispatches of one step (WGSL `Phase`, uniform with dynamic offset).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct Phase {
+    /// Kick or drift duration (s).
+    pub tau: f32,
+    /// Time since the previous force evaluation (s).
+    pub elapsed: f32,
+    /// Padding.
+    pub _pad0: f32,
+    /// Padding.
+    pub _pad1: f32,
+}
+
+/// Coefficients of a pair of materials (WGSL `PairCoeffs`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct PairCoeffs {
+    /// Pa.
+    pub v_eff: f32,
+    /// Pa.
+    pub g_eff: f32,
+    /// -.
+    pub mu_s: f32,
+    /// -.
+    pub mu_k: f32,
+    /// -.
+    pub tan_roll: f32,
+    /// s^-1 m^-1/2.
+    pub gamma_n: f32,
+    /// s^-1.
+    pub gamma_nt: f32,
+    /// -.
+    pub beta: f32,
+}
+
+/// A wall (WGSL `Wall`). `kind`: 0 plane, 1 cylinder, 2 piston.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct Wall {
+    /// 0 plane, 1 cylinder, 2 piston.
+    pub kind: u32,
+    /// Material index.
+    pub material: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Plane point; cylinder axis (x, y); piston (0, 0, z).
+    pub point: [f32; 4],
+    /// Plane unit normal; cylinder w = radius.
+    pub normal: [f32; 4],
+    /// Velocity (m/s).
+    pub velocity: [f32; 4],
+    /// Piston: mass (kg), area (m^2), target pressure (Pa), external work (J).
+    pub piston: [f32; 4],
+}
+
+/// Flags and counters (WGSL `Control`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]
+pub struct Control {
+    /// Bits of the largest squared displacement since the build.
+    pub max_disp2: u32,
+    /// 1 while the current step rebuilds.
+    pub rebuild: u32,
+    /// Rebuilds so far.
+    pub rebuilds: u32,
+    /// Pairs listed.
+    pub n_pairs: u32,
+    /// Lowest grain over the neighbour capacity, or [`NONE`].
+    pub overflow_grain: u32,
+    /// Its pair count.
+    pub overflow_count: u32,
+    /// 1 when the pair list outgrew its buffer.
+    pub pair_overflow: u32,
+    /// Lowest grain with a non-finite position, or [`NONE`].
+    pub non_finite: u32,
+}
+
+/// Indirect dispatch arguments (WGSL `DispatchArgs`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct DispatchArgs {
+    /// Workgroups along x.
+    pub x: u32,
+    /// Along y.
+    pub y: u32,
+    /// Along z.
+    pub z: u32,
+}
+
+/// "No grain" / "no wall" (WGSL `NONE`).
+pub const NONE: u32 = u32::MAX;
+/// Invocations per workgroup of the per-item kernels (WGSL `WG`).
+pub const WG: u32 = 64;
+/// Walls a GPU scene may have (WGSL `MAX_WALLS`).
+pub const MAX_WALLS: usize = 8;
+/// Reals per statistics row (WGSL `STAT_ROW`).
+pub const STAT_ROW: usize = 16;
+/// Largest element count the two-level scan handles: 2048 blocks of 2048.
+pub const MAX_SCAN: u64 = 2048 * 2048;
+/// Indirect-argument slots (WGSL `ARGS_*`).
+pub mod args {
+    /// One invocation per grain, if rebuilding.
+    pub const GRAINS: u64 = 0;
+    /// One per hash bucket, if rebuilding.
+    pub const HASH: u64 = 1;
+    /// Scan blocks over the buckets, if rebuilding.
+    pub const HASH_BLOCKS: u64 = 2;
+    /// Scan blocks over n_grains + 1, if rebuilding.
+    pub const GRAIN_BLOCKS: u64 = 3;
+    /// One workgroup, if rebuilding.
+    pub const ONE: u64 = 4;
+    /// One per pair being replaced, if rebuilding.
+    pub const OLD_PAIRS: u64 = 5;
+    /// One per current pair, always.
+    pub const PAIRS: u64 = 6;
+    /// One per new pair, if rebuilding.
+    pub const NEW_PAIRS: u64 = 7;
+    /// One per entry of n_grains + 1, if rebuilding.
+    pub const GRAIN_STARTS: u64 = 8;
+    /// Slots.
+    pub const SLOTS: u64 = 9;
+}

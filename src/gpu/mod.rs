@@ -1,0 +1,3 @@
+//! The GPU engine: the kernels in WGSL through wgpu.
+
+pub mod layout;

@@ -1,0 +1,109 @@
+//! The kernel table: every compute kernel of a step, its WGSL source, the shared files it
+//! includes, and its bindings in binding order. The GPU engine builds its pipelines and bind
+//! groups from it; `tests/shaders.rs` checks it against naga's reflection of each shader.
+//! The CPU engine's twins carry the same names (`src/cpu/`: `hash_cells`, `detect_pairs`,
+//! `remap_history`, `pair_force`, `wall_contacts`, `gather`, `integrate::{kick, drift}`);
+//! the GPU-only kernels (scans, scatter, reverse list, reductions) are what a CPU does
+//! serially in a loop.
+
+/// How a kernel uses a binding.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Access {
+    /// `var<uniform>`.
+    Uniform,
+    /// `var<uniform>` at a dynamic offset (the step phase).
+    Phase,
+    /// `var<storage, read>`.
+    Read,
+    /// `var<storage, read_write>`.
+    ReadWrite,
+}
+
+/// A kernel: one WGSL file, one entry point of the same name.
+#[derive(Clone, Copy, Debug)]
+pub struct Kernel {
+    /// Entry point and file name (`shaders/<name>.wgsl`).
+    pub name: &'static str,
+    /// The kernel's WGSL.
+    pub source: &'static str,
+    /// Shared files prepended, in order (`shaders/shared/<name>.wgsl`).
+    pub includes: &'static [&'static str],
+    /// Bindings of group 0, in binding order.
+    pub bindings: &'static [(&'static str, Access)],
+}
+
+/// A shared WGSL file by name.
+pub fn shared(name: &str) -> &'static str {
+    match name {
+        "types" => include_str!("../shaders/shared/types.wgsl"),
+        "dispatch" => include_str!("../shaders/shared/dispatch.wgsl"),
+        "grid" => include_str!("../shaders/shared/grid.wgsl"),
+        "model" => include_str!("../shaders/shared/model.wgsl"),
+        "neighbours" => include_str!("../shaders/shared/neighbours.wgsl"),
+        "walls" => include_str!("../shaders/shared/walls.wgsl"),
+        "reduce" => include_str!("../shaders/shared/reduce.wgsl"),
+        other => panic!("no shared WGSL file {other}"),
+    }
+}
+
+impl Kernel {
+    /// The full WGSL of the kernel: its includes, then its own file.
+    pub fn wgsl(&self) -> String {
+        let mut s = String::new();
+        for inc in self.includes {
+            s.push_str(shared(inc));
+            s.push('\n');
+        }
+        s.push_str(self.source);
+        s
+    }
+}
+
+use Access::{Phase, Read, ReadWrite, Uniform};
+
+const BASE: &[&str] = &["types", "dispatch"];
+const GRID: &[&str] = &["types", "dispatch", "grid"];
+const DETECT: &[&str] = &["types", "dispatch", "grid", "neighbours"];
+const FORCES: &[&str] = &["types", "dispatch", "grid", "model"];
+const WALLS: &[&str] = &["types", "dispatch", "grid", "model", "walls"];
+const STATS: &[&str] = &["types", "dispatch", "grid", "model", "walls", "reduce"];
+
+macro_rules! kernel {
+    ($name:literal, $inc:expr, [$($b:literal: $a:expr),* $(,)?]) => {
+        Kernel { name: $name, source: include_str!(concat!("../shaders/", $name, ".wgsl")), includes: $inc, bindings: &[$(($b, $a)),*] }
+    };
+}
+
+/// Every kernel, in the order a rebuilding step runs them.
+pub const KERNELS: &[Kernel] = &[
+    kernel!("drift", BASE, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "vel": Read, "omega": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "control": ReadWrite]),
+    kernel!("decide_rebuild", BASE, ["params": Uniform, "control": ReadWrite, "args": ReadWrite]),
+    kernel!("save_starts", BASE, ["params": Uniform, "pair_start": Read, "old_start": ReadWrite]),
+    kernel!("save_pairs", BASE, ["params": Uniform, "pair_j": Read, "hist": Read, "old_j": ReadWrite, "old_hist": ReadWrite, "control": Read]),
+    kernel!("clear_cells", BASE, ["params": Uniform, "cell_count": ReadWrite, "cell_fill": ReadWrite]),
+    kernel!("hash_cells", GRID, ["params": Uniform, "pos": ReadWrite, "image": ReadWrite, "built_at": ReadWrite, "cell_of": ReadWrite, "cell_count": ReadWrite, "control": ReadWrite, "pair_start": ReadWrite, "rev_start": ReadWrite, "rev_fill": ReadWrite]),
+    kernel!("scan_blocks", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite]),
+    kernel!("scan_sums", BASE, ["params": Uniform, "block_sums": ReadWrite]),
+    kernel!("scan_add", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite]),
+    kernel!("scatter_cells", BASE, ["params": Uniform, "cell_of": Read, "cell_count": Read, "cell_fill": ReadWrite, "cell_grains": ReadWrite]),
+    kernel!("detect_count", DETECT, ["params": Uniform, "pos": Read, "cell_count": Read, "cell_grains": Read, "pair_start": ReadWrite, "control": ReadWrite]),
+    kernel!("pairs_ready", BASE, ["params": Uniform, "pair_start": Read, "control": ReadWrite, "args": ReadWrite]),
+    kernel!("detect_fill", DETECT, ["params": Uniform, "pos": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Read, "pair_i": ReadWrite, "pair_j": ReadWrite]),
+    kernel!("remap_history", BASE, ["params": Uniform, "pair_i": Read, "pair_j": Read, "old_start": Read, "old_j": Read, "old_hist": Read, "hist": ReadWrite, "control": Read]),
+    kernel!("reverse_count", BASE, ["params": Uniform, "pair_j": Read, "rev_start": ReadWrite, "control": Read]),
+    kernel!("reverse_fill", BASE, ["params": Uniform, "pair_j": Read, "rev_start": Read, "rev_fill": ReadWrite, "rev_pair": ReadWrite, "control": Read]),
+    kernel!("reverse_sort", BASE, ["params": Uniform, "rev_start": Read, "rev_pair": ReadWrite]),
+    kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": ReadWrite, "out_fj": ReadWrite, "out_ti": ReadWrite, "out_tj": ReadWrite, "control": Read]),
+    kernel!("wall_contacts", WALLS, ["params": Uniform, "phase": Phase, "pos": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_force": ReadWrite, "wall_torque": ReadWrite, "wall_partials": ReadWrite]),
+    kernel!("wall_reduce", BASE, ["params": Uniform, "wall_partials": Read, "wall_reaction": ReadWrite]),
+    kernel!("gather", BASE, ["params": Uniform, "vel": Read, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "wall_force": Read, "wall_torque": Read, "force": ReadWrite, "torque": ReadWrite]),
+    kernel!("kick", BASE, ["params": Uniform, "phase": Phase, "vel": ReadWrite, "omega": ReadWrite, "force": Read, "torque": Read, "walls": ReadWrite, "wall_reaction": Read]),
+    kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "vel": Read, "omega": Read, "force": Read, "wall_force": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": ReadWrite]),
+    kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_fj": Read, "control": Read, "pair_rows": ReadWrite]),
+    kernel!("reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": ReadWrite]),
+];
+
+/// The kernel of a name.
+pub fn kernel(name: &str) -> &'static Kernel {
+    KERNELS.iter().find(|k| k.name == name).unwrap_or_else(|| panic!("no kernel {name}"))
+}

@@ -1,0 +1,102 @@
+//! Without a GPU: naga parses and validates every kernel, the kernel table's bindings match
+//! what each shader declares, and the Rust mirrors of the WGSL structures have the same sizes
+//! and field offsets.
+
+use grains::gpu::layout;
+use grains::kernels::{Access, KERNELS};
+use naga::valid::{Capabilities, ValidationFlags, Validator};
+use std::mem::{offset_of, size_of};
+
+fn module(wgsl: &str, name: &str) -> naga::Module {
+    naga::front::wgsl::parse_str(wgsl).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(wgsl)))
+}
+
+#[test]
+fn every_kernel_parses_and_validates() {
+    for k in KERNELS {
+        let src = k.wgsl();
+        let m = module(&src, k.name);
+        Validator::new(ValidationFlags::all(), Capabilities::default())
+            .validate(&m)
+            .unwrap_or_else(|e| panic!("{}: {}", k.name, e.emit_to_string(&src)));
+        assert!(m.entry_points.iter().any(|e| e.name == k.name), "{}: the entry point must carry the kernel's name", k.name);
+        let first = k.source.lines().next().unwrap_or("");
+        assert!(first.starts_with("// One "), "{}: the first line says what one invocation does: {first}", k.name);
+    }
+}
+
+#[test]
+fn the_kernel_table_matches_each_shaders_bindings() {
+    for k in KERNELS {
+        let m = module(&k.wgsl(), k.name);
+        let mut declared: Vec<(u32, String, Access)> = m
+            .global_variables
+            .iter()
+            .filter_map(|(_, v)| {
+                let b = v.binding.as_ref()?;
+                assert_eq!(b.group, 0, "{}: one bind group", k.name);
+                let access = match v.space {
+                    naga::AddressSpace::Uniform if v.name.as_deref() == Some("phase") => Access::Phase,
+                    naga::AddressSpace::Uniform => Access::Uniform,
+                    naga::AddressSpace::Storage { access } if access.contains(naga::StorageAccess::STORE) => Access::ReadWrite,
+                    naga::AddressSpace::Storage { .. } => Access::Read,
+                    other => panic!("{}: unexpected address space {other:?}", k.name),
+                };
+                Some((b.binding, v.name.clone().unwrap_or_default(), access))
+            })
+            .collect();
+        declared.sort_by_key(|d| d.0);
+        let table: Vec<(u32, String, Access)> = k.bindings.iter().enumerate().map(|(i, (n, a))| (i as u32, n.to_string(), *a)).collect();
+        assert_eq!(declared, table, "{}: shader bindings vs the kernel table", k.name);
+    }
+}
+
+/// Size and member offsets of a WGSL struct, by naga's layouter.
+fn wgsl_layout(m: &naga::Module, name: &str) -> (u32, Vec<(String, u32)>) {
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(m.to_ctx()).unwrap();
+    let (handle, ty) = m.types.iter().find(|(_, t)| t.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("no struct {name}"));
+    let naga::TypeInner::Struct { members, span } = &ty.inner else { panic!("{name} is not a struct") };
+    assert_eq!(layouter[handle].size, *span);
+    (*span, members.iter().map(|mm| (mm.name.clone().unwrap_or_default(), mm.offset)).collect())
+}
+
+macro_rules! check_struct {
+    ($m:expr, $ty:ty, $name:literal, [$($field:ident),* $(,)?]) => {{
+        let (size, members) = wgsl_layout($m, $name);
+        assert_eq!(size as usize, size_of::<$ty>(), "{} size", $name);
+        let rust: Vec<(String, u32)> = vec![$((stringify!($field).to_string(), offset_of!($ty, $field) as u32)),*];
+        assert_eq!(members, rust, "{} members and offsets", $name);
+    }};
+}
+
+#[test]
+fn rust_mirrors_match_the_wgsl_structures() {
+    let src = grains::kernels::shared("types");
+    let m = module(&format!("{src}\n@group(0) @binding(0) var<storage, read_write> c: Control;\n@compute @workgroup_size(1) fn main() {{ atomicStore(&c.max_disp2, 0u); }}"), "types");
+    check_struct!(&m, layout::Params, "Params", [
+        n_grains, n_walls, n_materials, pair_capacity, hash_size, max_neighbours, piston, hist_blocks,
+        gravity, cell, periodic_lo, periodic_len, periodic_dims, skin, k_n, c_n, v_slip, v_roll, kt_ratio,
+        damping_ratio, k_r, gamma_r, mu_r, _pad1, _pad2
+    ]);
+    check_struct!(&m, layout::Phase, "Phase", [tau, elapsed, _pad0, _pad1]);
+    check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);
+    check_struct!(&m, layout::Wall, "Wall", [kind, material, _pad0, _pad1, point, normal, velocity, piston]);
+    check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite]);
+    check_struct!(&m, layout::DispatchArgs, "DispatchArgs", [x, y, z]);
+    // Constants the host relies on.
+    let constant = |name: &str| -> u32 {
+        let (_, c) = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("no const {name}"));
+        match m.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            ref e => panic!("{name}: {e:?}"),
+        }
+    };
+    assert_eq!(constant("WG"), layout::WG);
+    assert_eq!(constant("MAX_WALLS") as usize, layout::MAX_WALLS);
+    assert_eq!(constant("STAT_ROW") as usize, layout::STAT_ROW);
+    assert_eq!(constant("NONE"), layout::NONE);
+    for (name, slot) in [("ARGS_GRAINS", layout::args::GRAINS), ("ARGS_HASH", layout::args::HASH), ("ARGS_HASH_BLOCKS", layout::args::HASH_BLOCKS), ("ARGS_GRAIN_BLOCKS", layout::args::GRAIN_BLOCKS), ("ARGS_ONE", layout::args::ONE), ("ARGS_OLD_PAIRS", layout::args::OLD_PAIRS), ("ARGS_PAIRS", layout::args::PAIRS), ("ARGS_NEW_PAIRS", layout::args::NEW_PAIRS), ("ARGS_GRAIN_STARTS", layout::args::GRAIN_STARTS), ("ARGS_SLOTS", layout::args::SLOTS)] {
+        assert_eq!(constant(name) as u64, slot, "{name}");
+    }
+}
