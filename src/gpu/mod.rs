@@ -1,3 +1,9 @@
-//! The GPU engine: the kernels in WGSL through wgpu.
+//! The GPU engine: the step's kernels in WGSL (`shaders/`) through wgpu, f32, deterministic
+//! run to run (integer atomics only; sums in fixed trees).
 
+pub mod device;
+mod engine;
 pub mod layout;
+
+pub use device::{describe_all, open, Gpu, GpuError};
+pub use engine::{GpuEngine, GpuSetupError, INITIAL_PAIRS_PER_GRAIN, PAIR_GROWTH_THRESHOLD, STEPS_PER_SUBMIT};

@@ -30,3 +30,22 @@ pub fn engine<T: Real>(scene: &Scene) -> CpuEngine<T> {
 pub fn with_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool").install(f)
 }
+
+/// Opens the best GPU adapter. Without one, CI fails (it installs lavapipe) and a developer
+/// machine skips the test with a visible message.
+pub fn gpu() -> Option<grains::gpu::Gpu> {
+    match grains::gpu::open(None) {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var_os("CI").is_some() => panic!("CI must have a GPU adapter (lavapipe): {e}"),
+        Err(e) => {
+            eprintln!("SKIPPED (no GPU adapter): {e}");
+            None
+        }
+    }
+}
+
+/// A GPU engine for a scene, or `None` (skipped) without an adapter.
+pub fn gpu_engine(scene: &Scene) -> Option<grains::gpu::GpuEngine> {
+    let gpu = gpu()?;
+    Some(grains::gpu::GpuEngine::new(gpu, scene).unwrap_or_else(|e| panic!("{e}")))
+}

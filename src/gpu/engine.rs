@@ -1,0 +1,807 @@
+//! The GPU engine: buffers (structure of arrays, f32), one pipeline per kernel specialised to
+//! the scene's laws by override constants, and the step as a sequence of dispatches. Whether
+//! a step rebuilds the neighbour list is decided on the GPU (`decide_rebuild` writes the
+//! rebuild kernels' indirect dispatch sizes), so the host only records steps and reads a few
+//! statistics back every `stats_interval` steps.
+
+use super::device::Gpu;
+use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, STAT_ROW, WG};
+use crate::cpu::OVV_XI;
+use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
+use crate::kernels::{Access, KERNELS};
+use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+use crate::scene::{Integrator, Scene, WallShape};
+use std::collections::HashMap;
+use wgpu::util::DeviceExt;
+
+/// Pairs per grain the pair buffers start with; they grow at statistics reads when more than
+/// [`PAIR_GROWTH_THRESHOLD`] of them are in use.
+pub const INITIAL_PAIRS_PER_GRAIN: u64 = 8;
+/// Fill fraction of the pair buffers that makes them grow (to twice the pairs in use).
+pub const PAIR_GROWTH_THRESHOLD: f64 = 0.75;
+/// Steps recorded per queue submission.
+pub const STEPS_PER_SUBMIT: u64 = 16;
+
+/// Why the GPU engine refused a scene.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuSetupError {
+    /// The scene exceeds a limit of the device or of the kernels.
+    #[error("the scene needs {need} {what}, the GPU backend allows {have} on \"{adapter}\"; fix: {fix}")]
+    Limit {
+        /// Adapter.
+        adapter: String,
+        /// What.
+        what: &'static str,
+        /// Needed.
+        need: u64,
+        /// Allowed.
+        have: u64,
+        /// How to fix.
+        fix: &'static str,
+    },
+}
+
+/// Uniform slots of the step phases (kick and drift durations, spring elapsed times).
+#[derive(Clone, Copy, Debug)]
+enum Slot {
+    KickHalf,
+    DriftDt,
+    DriftXi,
+    DriftMid,
+    ForceZero,
+    ForceDt,
+    ForceXi,
+    ForceTwoXi,
+    ForceMid,
+}
+const SLOTS: usize = 9;
+
+/// How a kernel is dispatched.
+#[derive(Clone, Copy, Debug)]
+enum Size {
+    /// One invocation per grain.
+    Grains,
+    /// One workgroup.
+    One,
+    /// From an indirect-argument slot.
+    Indirect(u64),
+}
+
+/// The GPU engine (f32).
+pub struct GpuEngine {
+    gpu: Gpu,
+    n: u32,
+    params: Params,
+    integrator: Integrator,
+    dt: f64,
+    layouts: HashMap<&'static str, wgpu::BindGroupLayout>,
+    pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
+    buffers: HashMap<&'static str, wgpu::Buffer>,
+    bind_groups: HashMap<String, wgpu::BindGroup>,
+    phase_stride: u64,
+    has_walls: bool,
+    history: HistoryLayout,
+    track_orientation: bool,
+    wall_names: Vec<String>,
+    piston: Option<usize>,
+    step: u64,
+    time: f64,
+    forces_valid: bool,
+    control: Control,
+}
+
+fn groups_for(n: u64) -> (u32, u32) {
+    let g = n.div_ceil(WG as u64);
+    if g <= 65535 { (g as u32, 1) } else { (65535, g.div_ceil(65535) as u32) }
+}
+
+fn rows_for(n: u64) -> u64 {
+    let (x, y) = groups_for(n.max(1));
+    x as u64 * y as u64
+}
+
+impl GpuEngine {
+    /// Sets the engine up for a scene on an opened device and builds the first neighbour list.
+    pub fn new(gpu: Gpu, scene: &Scene) -> Result<Self, anyhow::Error> {
+        let n = scene.grains.len() as u64;
+        let adapter = gpu.info.name.clone();
+        let limit = |what, need: u64, have: u64, fix| -> Result<(), GpuSetupError> {
+            if need > have { Err(GpuSetupError::Limit { adapter: adapter.clone(), what, need, have, fix }) } else { Ok(()) }
+        };
+        let binding = gpu.limits.max_storage_buffer_binding_size as u64;
+        limit("walls", scene.walls.len() as u64, MAX_WALLS as u64, "split the container into at most 8 walls or use --backend cpu")?;
+        limit("bytes per grain array (16 per grain)", 16 * n, binding, "use fewer grains per run or a device with larger storage bindings")?;
+        let hash_size = (n.max(64)).next_power_of_two();
+        limit("scan elements (hash buckets)", hash_size, MAX_SCAN, "use fewer grains per run (the two-level scan holds 4,194,304)")?;
+        let hist_blocks = (scene.model.history_layout().tangential as u64) + (scene.model.history_layout().rolling as u64);
+        let per_pair_bytes = 16 * hist_blocks.max(1);
+        let pair_capacity = (INITIAL_PAIRS_PER_GRAIN * n).max(1024).min(binding / per_pair_bytes).min(binding / 16);
+        limit("bytes of wall history", 16 * n * scene.walls.len() as u64 * hist_blocks, binding, "use fewer walls or grains")?;
+
+        let model = &scene.model;
+        let r_max = scene.grains.radius.iter().copied().fold(0.0, f64::max);
+        let cutoff = 2.0 * r_max + scene.skin;
+        let mut params = Params {
+            n_grains: n as u32,
+            n_walls: scene.walls.len() as u32,
+            n_materials: scene.materials.len() as u32,
+            pair_capacity: pair_capacity as u32,
+            hash_size: hash_size as u32,
+            max_neighbours: scene.max_neighbours as u32,
+            piston: NONE,
+            hist_blocks: hist_blocks as u32,
+            gravity: [scene.gravity[0] as f32, scene.gravity[1] as f32, scene.gravity[2] as f32, 0.0],
+            cell: [cutoff as f32; 4],
+            skin: scene.skin as f32,
+            ..Default::default()
+        };
+        for a in 0..3 {
+            if let Some([lo, hi]) = scene.periodic[a] {
+                let dims = ((hi - lo) / cutoff).floor().max(1.0);
+                params.periodic_lo[a] = lo as f32;
+                params.periodic_len[a] = (hi - lo) as f32;
+                params.periodic_dims[a] = dims as u32;
+                params.cell[a] = ((hi - lo) / dims) as f32;
+            }
+        }
+        if let NormalLaw::Linear { k_n } = model.normal {
+            params.k_n = k_n as f32;
+        }
+        if let DampingLaw::Viscous { c_n } = model.damping {
+            params.c_n = c_n as f32;
+        }
+        let stiffness = |s: TangentialStiffness<f64>| match s {
+            TangentialStiffness::Mindlin => -1.0,
+            TangentialStiffness::RatioToNormal(r) => r as f32,
+        };
+        match model.tangential {
+            TangentialLaw::None => {}
+            TangentialLaw::Oquendo { v_slip, v_roll, stiffness: s } => {
+                params.v_slip = v_slip as f32;
+                params.v_roll = v_roll as f32;
+                params.kt_ratio = stiffness(s);
+            }
+            TangentialLaw::Mindlin { damping_ratio, stiffness: s } => {
+                params.damping_ratio = damping_ratio as f32;
+                params.kt_ratio = stiffness(s);
+            }
+        }
+        if let RollingLaw::Sds { k_r, gamma_r, mu_r } = model.rolling {
+            params.k_r = k_r as f32;
+            params.gamma_r = gamma_r as f32;
+            params.mu_r = mu_r as f32;
+        }
+
+        // Walls.
+        let mut piston = None;
+        let walls: Vec<layout::Wall> = scene
+            .walls
+            .iter()
+            .enumerate()
+            .map(|(w, wall)| {
+                let mut g = layout::Wall { material: wall.material as u32, ..Default::default() };
+                match wall.shape {
+                    WallShape::Plane { point, normal } => {
+                        g.kind = 0;
+                        g.point = [point[0] as f32, point[1] as f32, point[2] as f32, 0.0];
+                        g.normal = [normal[0] as f32, normal[1] as f32, normal[2] as f32, 0.0];
+                    }
+                    WallShape::Cylinder { center, radius } => {
+                        g.kind = 1;
+                        g.point = [center[0] as f32, center[1] as f32, 0.0, 0.0];
+                        g.normal = [0.0, 0.0, 0.0, radius as f32];
+                    }
+                    WallShape::Piston { z, pressure, mass, area } => {
+                        g.kind = 2;
+                        g.point = [0.0, 0.0, z as f32, 0.0];
+                        g.piston = [mass as f32, area as f32, pressure as f32, 0.0];
+                        piston = Some(w);
+                    }
+                }
+                g
+            })
+            .collect();
+        if let Some(p) = piston {
+            params.piston = p as u32;
+        }
+
+        let coeffs: Vec<layout::PairCoeffs> = scene
+            .materials
+            .iter()
+            .flat_map(|a| scene.materials.iter().map(move |b| (a, b)))
+            .map(|(a, b)| {
+                let c: PairCoeffs<f32> = PairCoeffs::mix(&a.constants, &b.constants);
+                layout::PairCoeffs { v_eff: c.v_eff, g_eff: c.g_eff, mu_s: c.mu_s, mu_k: c.mu_k, tan_roll: c.tan_roll, gamma_n: c.gamma_n, gamma_nt: c.gamma_nt, beta: c.beta }
+            })
+            .collect();
+
+        let g = &scene.grains;
+        let v4 = |a: [f64; 3], w: f64| [a[0] as f32, a[1] as f32, a[2] as f32, w as f32];
+        let pos: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.position[i], g.radius[i])).collect();
+        let vel: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.velocity[i], g.mass[i])).collect();
+        let omega: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.angular_velocity[i], 0.4 * g.mass[i] * g.radius[i] * g.radius[i])).collect();
+        let material: Vec<u32> = g.material.iter().map(|&m| m as u32).collect();
+        let history = model.history_layout();
+        let periodic = scene.periodic.iter().any(Option::is_some);
+
+        let device = &gpu.device;
+        let mut buffers = HashMap::new();
+        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let mut init = |name: &'static str, bytes: &[u8], extra: wgpu::BufferUsages| {
+            let b = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(name), contents: bytes, usage: storage | extra });
+            buffers.insert(name, b);
+        };
+        init("pos", bytemuck::cast_slice(&pos), wgpu::BufferUsages::empty());
+        init("vel", bytemuck::cast_slice(&vel), wgpu::BufferUsages::empty());
+        init("omega", bytemuck::cast_slice(&omega), wgpu::BufferUsages::empty());
+        init("material", bytemuck::cast_slice(&material), wgpu::BufferUsages::empty());
+        init("coeffs", bytemuck::cast_slice(&coeffs), wgpu::BufferUsages::empty());
+        let walls_bytes: Vec<layout::Wall> = if walls.is_empty() { vec![layout::Wall::default()] } else { walls };
+        init("walls", bytemuck::cast_slice(&walls_bytes), wgpu::BufferUsages::empty());
+        let control = Control { max_disp2: f32::INFINITY.to_bits(), overflow_grain: NONE, non_finite: NONE, ..Default::default() };
+        init("control", bytemuck::bytes_of(&control), wgpu::BufferUsages::empty());
+        init("args", bytemuck::cast_slice(&vec![DispatchArgs { x: 0, y: 1, z: 1 }; args::SLOTS as usize]), wgpu::BufferUsages::INDIRECT);
+        let quat: Vec<[f32; 4]> = if scene.track_orientation { vec![[1.0, 0.0, 0.0, 0.0]; g.len()] } else { vec![[0.0; 4]] };
+        init("quat", bytemuck::cast_slice(&quat), wgpu::BufferUsages::empty());
+        init("params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+
+        let phase_stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<Phase>() as u64);
+        let dt = scene.time_step.dt;
+        let xi = OVV_XI;
+        let phases: [(Slot, f64, f64); SLOTS] = [
+            (Slot::KickHalf, 0.5 * dt, 0.0),
+            (Slot::DriftDt, dt, 0.0),
+            (Slot::DriftXi, xi * dt, 0.0),
+            (Slot::DriftMid, (1.0 - 2.0 * xi) * dt, 0.0),
+            (Slot::ForceZero, 0.0, 0.0),
+            (Slot::ForceDt, 0.0, dt),
+            (Slot::ForceXi, 0.0, xi * dt),
+            (Slot::ForceTwoXi, 0.0, 2.0 * xi * dt),
+            (Slot::ForceMid, 0.0, (1.0 - 2.0 * xi) * dt),
+        ];
+        let mut phase_bytes = vec![0u8; phase_stride as usize * SLOTS];
+        for (slot, tau, elapsed) in phases {
+            let p = Phase { tau: tau as f32, elapsed: elapsed as f32, ..Default::default() };
+            let at = slot as usize * phase_stride as usize;
+            phase_bytes[at..at + std::mem::size_of::<Phase>()].copy_from_slice(bytemuck::bytes_of(&p));
+        }
+        init("phase", &phase_bytes, wgpu::BufferUsages::UNIFORM);
+
+        let mut zeroed = |name: &'static str, bytes: u64| {
+            let b = device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size: bytes.max(16), usage: storage, mapped_at_creation: false });
+            buffers.insert(name, b);
+        };
+        let v = 16 * n;
+        for name in ["force", "torque", "built_at", "wall_force", "wall_torque"] {
+            zeroed(name, v);
+        }
+        zeroed("image", if periodic { v } else { 16 });
+        zeroed("cell_of", 4 * n);
+        zeroed("cell_grains", 4 * n);
+        zeroed("cell_count", 4 * hash_size);
+        zeroed("cell_fill", 4 * hash_size);
+        zeroed("hash_sums", 4 * hash_size.div_ceil(2048));
+        zeroed("grain_sums", 4 * (n + 1).div_ceil(2048));
+        for name in ["pair_start", "old_start", "rev_start"] {
+            zeroed(name, 4 * (n + 1));
+        }
+        zeroed("rev_fill", 4 * n);
+        let wall_hist = if hist_blocks > 0 { 16 * n * scene.walls.len() as u64 * hist_blocks } else { 16 };
+        zeroed("wall_hist", wall_hist);
+        zeroed("wall_partials", rows_for(n) * MAX_WALLS as u64 * 16);
+        zeroed("wall_reaction", MAX_WALLS as u64 * 16);
+        zeroed("grain_rows", rows_for(n) * STAT_ROW as u64 * 4);
+        zeroed("stats", 2 * STAT_ROW as u64 * 4);
+
+        let mut engine = GpuEngine {
+            gpu,
+            n: n as u32,
+            params,
+            integrator: scene.integrator,
+            dt,
+            layouts: HashMap::new(),
+            pipelines: HashMap::new(),
+            buffers,
+            bind_groups: HashMap::new(),
+            phase_stride,
+            has_walls: !scene.walls.is_empty(),
+            history,
+            track_orientation: scene.track_orientation,
+            wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
+            piston,
+            step: 0,
+            time: 0.0,
+            forces_valid: false,
+            control,
+        };
+        engine.allocate_pairs(pair_capacity);
+        engine.build_pipelines(scene);
+        engine.build_bind_groups();
+        Ok(engine)
+    }
+
+    /// (Re)allocates the per-pair buffers for `capacity` pairs.
+    fn allocate_pairs(&mut self, capacity: u64) {
+        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        let blocks = self.params.hist_blocks as u64;
+        let sizes: [(&'static str, u64); 11] = [
+            ("pair_i", 4 * capacity),
+            ("pair_j", 4 * capacity),
+            ("old_j", 4 * capacity),
+            ("rev_pair", 4 * capacity),
+            ("hist", 16 * capacity * blocks),
+            ("old_hist", 16 * capacity * blocks),
+            ("out_fi", 16 * capacity),
+            ("out_fj", 16 * capacity),
+            ("out_ti", 16 * capacity),
+            ("out_tj", 16 * capacity),
+            ("pair_rows", rows_for(capacity) * STAT_ROW as u64 * 4),
+        ];
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        for (name, size) in sizes {
+            let b = self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size: size.max(16), usage: storage, mapped_at_creation: false });
+            // Growing keeps what the live pairs hold.
+            if let Some(old) = self.buffers.get(name) {
+                encoder.copy_buffer_to_buffer(old, 0, &b, 0, old.size().min(b.size()));
+            }
+            self.buffers.insert(name, b);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        self.params.pair_capacity = capacity as u32;
+        self.gpu.queue.write_buffer(&self.buffers["params"], 0, bytemuck::bytes_of(&self.params));
+    }
+
+    fn build_pipelines(&mut self, scene: &Scene) {
+        let m = &scene.model;
+        let normal = match m.normal {
+            NormalLaw::Hertz => 0.0,
+            NormalLaw::Linear { .. } => 1.0,
+        };
+        let damping = match m.damping {
+            DampingLaw::None => 0.0,
+            DampingLaw::Papers => 1.0,
+            DampingLaw::Restitution => 2.0,
+            DampingLaw::Viscous { .. } => 3.0,
+        };
+        let tangential = match m.tangential {
+            TangentialLaw::None => 0.0,
+            TangentialLaw::Oquendo { .. } => 1.0,
+            TangentialLaw::Mindlin { .. } => 2.0,
+        };
+        let rolling = if let RollingLaw::Sds { .. } = m.rolling { 1.0 } else { 0.0 };
+        let twisting = if let TwistingLaw::Oquendo = m.twisting { 1.0 } else { 0.0 };
+        let model_constants = [
+            ("NORMAL_LAW", normal),
+            ("DAMPING_LAW", damping),
+            ("TANGENTIAL_LAW", tangential),
+            ("ROLLING_LAW", rolling),
+            ("TWISTING_LAW", twisting),
+            ("HAS_TANGENTIAL_HISTORY", self.history.tangential as u8 as f64),
+            ("HAS_ROLLING_HISTORY", self.history.rolling as u8 as f64),
+        ];
+        let orientation = [("TRACK_ORIENTATION", self.track_orientation as u8 as f64)];
+        for k in KERNELS {
+            let entries: Vec<wgpu::BindGroupLayoutEntry> = k
+                .bindings
+                .iter()
+                .enumerate()
+                .map(|(i, (_, access))| wgpu::BindGroupLayoutEntry {
+                    binding: i as u32,
+                    visibility: wgpu::ShaderStages::COMPUTE,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: match access {
+                            Access::Uniform | Access::Phase => wgpu::BufferBindingType::Uniform,
+                            Access::Read => wgpu::BufferBindingType::Storage { read_only: true },
+                            Access::ReadWrite => wgpu::BufferBindingType::Storage { read_only: false },
+                        },
+                        has_dynamic_offset: *access == Access::Phase,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                })
+                .collect();
+            let device = &self.gpu.device;
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &entries });
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(k.name), bind_group_layouts: &[Some(&layout)], ..Default::default() });
+            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(k.name), source: wgpu::ShaderSource::Wgsl(k.wgsl().into()) });
+            let constants: &[(&str, f64)] = if k.includes.contains(&"model") {
+                &model_constants
+            } else if k.name == "drift" {
+                &orientation
+            } else {
+                &[]
+            };
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(k.name),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(k.name),
+                compilation_options: wgpu::PipelineCompilationOptions { constants, zero_initialize_workgroup_memory: true },
+                cache: None,
+            });
+            self.layouts.insert(k.name, layout);
+            self.pipelines.insert(k.name, pipeline);
+        }
+    }
+
+    /// Bind groups: one per kernel, and one per scanned array for the scan kernels.
+    fn build_bind_groups(&mut self) {
+        self.bind_groups.clear();
+        let scans: [(&str, &str, &str); 3] = [("cell", "cell_count", "hash_sums"), ("pairs", "pair_start", "grain_sums"), ("rev", "rev_start", "grain_sums")];
+        for k in KERNELS {
+            let instances: Vec<(String, Vec<(&str, &str)>)> = if k.name.starts_with("scan_") {
+                scans.iter().map(|(tag, data, sums)| (format!("{}:{tag}", k.name), vec![("scan_data", *data), ("block_sums", *sums)])).collect()
+            } else {
+                vec![(k.name.to_string(), vec![])]
+            };
+            for (key, aliases) in instances {
+                let entries: Vec<wgpu::BindGroupEntry> = k
+                    .bindings
+                    .iter()
+                    .enumerate()
+                    .map(|(i, (name, access))| {
+                        let buffer_name = aliases.iter().find(|(a, _)| a == name).map_or(*name, |(_, b)| *b);
+                        let buffer = self.buffers.get(buffer_name).unwrap_or_else(|| panic!("kernel {} binds {buffer_name}, which the engine lacks", k.name));
+                        let resource = if *access == Access::Phase {
+                            wgpu::BindingResource::Buffer(wgpu::BufferBinding { buffer, offset: 0, size: wgpu::BufferSize::new(std::mem::size_of::<Phase>() as u64) })
+                        } else {
+                            buffer.as_entire_binding()
+                        };
+                        wgpu::BindGroupEntry { binding: i as u32, resource }
+                    })
+                    .collect();
+                let bg = self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(&key), layout: &self.layouts[k.name], entries: &entries });
+                self.bind_groups.insert(key, bg);
+            }
+        }
+    }
+
+    fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, group: &str, size: Size, phase: Option<Slot>) {
+        pass.set_pipeline(&self.pipelines[name]);
+        let offsets: Vec<u32> = phase.map(|s| (s as u64 * self.phase_stride) as u32).into_iter().collect();
+        pass.set_bind_group(0, &self.bind_groups[group], &offsets);
+        match size {
+            Size::Grains => {
+                let (x, y) = groups_for(self.n as u64);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            Size::One => pass.dispatch_workgroups(1, 1, 1),
+            Size::Indirect(slot) => pass.dispatch_workgroups_indirect(&self.buffers["args"], slot * std::mem::size_of::<DispatchArgs>() as u64),
+        }
+    }
+
+    fn run(&self, pass: &mut wgpu::ComputePass, name: &str, size: Size, phase: Option<Slot>) {
+        self.dispatch(pass, name, name, size, phase);
+    }
+
+    fn scan(&self, pass: &mut wgpu::ComputePass, tag: &str, blocks: u64) {
+        self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{tag}"), Size::Indirect(blocks), None);
+        self.dispatch(pass, "scan_sums", &format!("scan_sums:{tag}"), Size::Indirect(args::ONE), None);
+        self.dispatch(pass, "scan_add", &format!("scan_add:{tag}"), Size::Indirect(blocks), None);
+    }
+
+    /// `decide_rebuild` and the rebuild kernels, which run with zero workgroups when the
+    /// list is still good.
+    fn encode_rebuild_if_needed(&self, pass: &mut wgpu::ComputePass) {
+        self.run(pass, "decide_rebuild", Size::One, None);
+        let keeps_history = self.params.hist_blocks > 0;
+        if keeps_history {
+            self.run(pass, "save_starts", Size::Indirect(args::GRAIN_STARTS), None);
+            self.run(pass, "save_pairs", Size::Indirect(args::OLD_PAIRS), None);
+        }
+        self.run(pass, "clear_cells", Size::Indirect(args::HASH), None);
+        self.run(pass, "hash_cells", Size::Indirect(args::GRAINS), None);
+        self.scan(pass, "cell", args::HASH_BLOCKS);
+        self.run(pass, "scatter_cells", Size::Indirect(args::GRAINS), None);
+        self.run(pass, "detect_count", Size::Indirect(args::GRAINS), None);
+        self.scan(pass, "pairs", args::GRAIN_BLOCKS);
+        self.run(pass, "pairs_ready", Size::One, None);
+        self.run(pass, "detect_fill", Size::Indirect(args::GRAINS), None);
+        if keeps_history {
+            self.run(pass, "remap_history", Size::Indirect(args::NEW_PAIRS), None);
+        }
+        self.run(pass, "reverse_count", Size::Indirect(args::NEW_PAIRS), None);
+        self.scan(pass, "rev", args::GRAIN_BLOCKS);
+        self.run(pass, "reverse_fill", Size::Indirect(args::NEW_PAIRS), None);
+        self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
+    }
+
+    /// `pair_force`, `wall_contacts` (+ `wall_reduce`), `gather`.
+    fn encode_forces(&self, pass: &mut wgpu::ComputePass, elapsed: Slot) {
+        self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(elapsed));
+        if self.has_walls {
+            self.run(pass, "wall_contacts", Size::Grains, Some(elapsed));
+            self.run(pass, "wall_reduce", Size::One, None);
+        }
+        self.run(pass, "gather", Size::Grains, None);
+    }
+
+    fn encode_step(&self, pass: &mut wgpu::ComputePass, first: bool) {
+        match self.integrator {
+            Integrator::VelocityVerlet => {
+                if first {
+                    self.encode_rebuild_if_needed(pass);
+                    self.encode_forces(pass, Slot::ForceZero);
+                }
+                self.run(pass, "kick", Size::Grains, Some(Slot::KickHalf));
+                self.run(pass, "drift", Size::Grains, Some(Slot::DriftDt));
+                self.encode_rebuild_if_needed(pass);
+                self.encode_forces(pass, Slot::ForceDt);
+                self.run(pass, "kick", Size::Grains, Some(Slot::KickHalf));
+            }
+            Integrator::OptimizedVerlet => {
+                self.run(pass, "drift", Size::Grains, Some(Slot::DriftXi));
+                self.encode_rebuild_if_needed(pass);
+                self.encode_forces(pass, if first { Slot::ForceXi } else { Slot::ForceTwoXi });
+                self.run(pass, "kick", Size::Grains, Some(Slot::KickHalf));
+                self.run(pass, "drift", Size::Grains, Some(Slot::DriftMid));
+                self.encode_rebuild_if_needed(pass);
+                self.encode_forces(pass, Slot::ForceMid);
+                self.run(pass, "kick", Size::Grains, Some(Slot::KickHalf));
+                self.run(pass, "drift", Size::Grains, Some(Slot::DriftXi));
+            }
+        }
+    }
+
+    /// Copies buffers out: `(buffer, offset, bytes)` each, returned in order.
+    fn read(&self, parts: &[(&str, u64, u64)]) -> Vec<Vec<u8>> {
+        let total: u64 = parts.iter().map(|p| p.2.next_multiple_of(4)).sum();
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: total.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        let mut at = 0;
+        for &(name, offset, bytes) in parts {
+            encoder.copy_buffer_to_buffer(&self.buffers[name], offset, &staging, at, bytes.next_multiple_of(4));
+            at += bytes.next_multiple_of(4);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping a readback buffer"));
+        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).expect("the GPU finishes");
+        let view = staging.slice(..).get_mapped_range().expect("a mapped readback buffer");
+        let mut out = Vec::new();
+        let mut at = 0usize;
+        for &(_, _, bytes) in parts {
+            out.push(view[at..at + bytes as usize].to_vec());
+            at += bytes.next_multiple_of(4) as usize;
+        }
+        out
+    }
+
+    fn read_control(&mut self) -> Control {
+        let c = self.read(&[("control", 0, std::mem::size_of::<Control>() as u64)]);
+        self.control = *bytemuck::from_bytes(&c[0]);
+        self.control
+    }
+
+    /// The adapter this engine runs on.
+    pub fn adapter(&self) -> &wgpu::AdapterInfo {
+        &self.gpu.info
+    }
+
+    /// Pairs the pair buffers hold now.
+    pub fn pair_capacity(&self) -> u32 {
+        self.params.pair_capacity
+    }
+
+    /// Checks the flags the last steps raised, and grows the pair buffers when they fill up.
+    fn check(&mut self) -> Result<(), SimError> {
+        let c = self.read_control();
+        if c.overflow_grain != NONE {
+            return Err(SimError::Capacity { step: self.step, grain: c.overflow_grain, count: c.overflow_count as usize, capacity: self.params.max_neighbours as usize });
+        }
+        if c.pair_overflow != 0 {
+            return Err(SimError::Capacity {
+                step: self.step,
+                grain: NONE,
+                count: self.params.pair_capacity as usize + 1,
+                capacity: self.params.pair_capacity as usize,
+            });
+        }
+        if c.n_pairs as f64 > PAIR_GROWTH_THRESHOLD * self.params.pair_capacity as f64 {
+            let binding = self.gpu.limits.max_storage_buffer_binding_size as u64;
+            let per_pair = 16 * (self.params.hist_blocks as u64).max(1);
+            let grown = (2 * c.n_pairs as u64).min(binding / per_pair);
+            if grown > self.params.pair_capacity as u64 {
+                self.allocate_pairs(grown);
+                self.build_bind_groups();
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads grain arrays back (vec4 per grain).
+    fn read_vec4s(&self, names: &[&str]) -> Vec<Vec<[f32; 4]>> {
+        let parts: Vec<(&str, u64, u64)> = names.iter().map(|n| (*n, 0, 16 * self.n as u64)).collect();
+        self.read(&parts).into_iter().map(|b| bytemuck::cast_slice(&b).to_vec()).collect()
+    }
+}
+
+impl Engine for GpuEngine {
+    fn backend(&self) -> &'static str {
+        "gpu"
+    }
+    fn precision(&self) -> &'static str {
+        "f32"
+    }
+    fn grain_count(&self) -> usize {
+        self.n as usize
+    }
+    fn steps(&self) -> u64 {
+        self.step
+    }
+    fn time(&self) -> f64 {
+        self.time
+    }
+
+    fn advance(&mut self, n: u64) -> Result<(), SimError> {
+        let mut done = 0;
+        while done < n {
+            let chunk = STEPS_PER_SUBMIT.min(n - done);
+            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                for s in 0..chunk {
+                    let first = self.step + s == 0;
+                    self.encode_step(&mut pass, first && !self.forces_valid);
+                }
+            }
+            self.gpu.queue.submit([encoder.finish()]);
+            self.forces_valid = true;
+            self.step += chunk;
+            self.time += chunk as f64 * self.dt;
+            done += chunk;
+        }
+        self.check()
+    }
+
+    fn stats(&mut self) -> Stats {
+        if !self.forces_valid {
+            // Statistics before the first step: build the list and evaluate forces once.
+            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                self.encode_rebuild_if_needed(&mut pass);
+                self.encode_forces(&mut pass, Slot::ForceZero);
+            }
+            self.gpu.queue.submit([encoder.finish()]);
+            if self.integrator == Integrator::VelocityVerlet {
+                self.forces_valid = true;
+            }
+        }
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.run(&mut pass, "reduce_grains", Size::Grains, None);
+            self.run(&mut pass, "reduce_pairs", Size::Indirect(args::PAIRS), None);
+            self.run(&mut pass, "reduce_final", Size::One, None);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        let n_walls = self.wall_names.len();
+        let parts = self.read(&[
+            ("control", 0, std::mem::size_of::<Control>() as u64),
+            ("stats", 0, 2 * STAT_ROW as u64 * 4),
+            ("wall_reaction", 0, MAX_WALLS as u64 * 16),
+            ("walls", 0, (n_walls.max(1) * std::mem::size_of::<layout::Wall>()) as u64),
+        ]);
+        let control: Control = *bytemuck::from_bytes(&parts[0]);
+        self.control = control;
+        let s: &[f32] = bytemuck::cast_slice(&parts[1]);
+        let reaction: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
+        let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[3]);
+        let g = |f: usize| s[f] as f64;
+        let p = |f: usize| s[STAT_ROW + f] as f64;
+        let n = self.n as f64;
+        let contacts = p(0).round() as u64;
+        let wall_contacts = g(11).round() as u64;
+        let contact_ends = 2 * contacts + wall_contacts;
+        let net = g(9);
+        let unbalanced_force = if contact_ends == 0 {
+            if net > 0.0 { f64::INFINITY } else { 0.0 }
+        } else {
+            (net / n) / ((p(3) + g(10)) / contact_ends as f64)
+        };
+        let (max_overlap, max_overlap_grain) = {
+            let (gv, gi) = (g(STAT_ROW - 2), s[STAT_ROW - 1].to_bits());
+            let (pv, pi) = (p(STAT_ROW - 2), s[2 * STAT_ROW - 1].to_bits());
+            if gv > pv || (gv == pv && gi < pi) { (gv, gi) } else { (pv, pi) }
+        };
+        let piston = self.piston.map(|w| {
+            let wall = &walls[w];
+            PistonStats {
+                z: wall.point[2] as f64,
+                velocity: wall.velocity[2] as f64,
+                target_pressure: wall.piston[2] as f64,
+                pressure: reaction[w][2] as f64 / wall.piston[1] as f64,
+            }
+        });
+        Stats {
+            step: self.step,
+            time: self.time,
+            ke_translational: g(0),
+            ke_rotational: g(1),
+            elastic_energy: p(2) + g(12),
+            gravity_energy: g(2),
+            piston_ke: self.piston.map_or(0.0, |w| 0.5 * walls[w].piston[0] as f64 * (walls[w].velocity[2] as f64).powi(2)),
+            external_work: self.piston.map_or(0.0, |w| walls[w].piston[3] as f64),
+            momentum: [g(3), g(4), g(5)],
+            angular_momentum: [g(6), g(7), g(8)],
+            contacts,
+            wall_contacts,
+            clamped: p(1).round() as u64,
+            coordination: 2.0 * contacts as f64 / n,
+            max_overlap,
+            max_overlap_grain: if max_overlap_grain == NONE { 0 } else { max_overlap_grain },
+            unbalanced_force,
+            non_finite_grain: (control.non_finite != NONE).then_some(control.non_finite),
+            rebuilds: control.rebuilds as u64,
+            walls: (0..n_walls)
+                .map(|w| WallStats {
+                    name: self.wall_names[w].clone(),
+                    force: [reaction[w][0] as f64, reaction[w][1] as f64, reaction[w][2] as f64],
+                    contacts: reaction[w][3].round() as u64,
+                })
+                .collect(),
+            piston,
+        }
+    }
+
+    fn frame(&self, contacts: bool) -> Frame {
+        let mut names = vec!["pos", "vel", "omega"];
+        if self.track_orientation {
+            names.push("quat");
+        }
+        let arrays = self.read_vec4s(&names);
+        let xyz = |v: &[f32; 4]| [v[0] as f64, v[1] as f64, v[2] as f64];
+        let contact_records = contacts.then(|| {
+            let np = self.control.n_pairs as u64;
+            let blocks = self.params.hist_blocks as u64;
+            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("hist", 0, 16 * np * blocks)]);
+            let (pi, pj): (&[u32], &[u32]) = (bytemuck::cast_slice(&parts[0]), bytemuck::cast_slice(&parts[1]));
+            let fi: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
+            let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
+            let pos = &arrays[0];
+            (0..np as usize)
+                .filter_map(|k| {
+                    let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
+                    let d = [(a[0] - b[0]) as f64, (a[1] - b[1]) as f64, (a[2] - b[2]) as f64];
+                    let mut d2 = 0.0;
+                    for (axis, x) in d.iter().enumerate() {
+                        let len = self.params.periodic_len[axis] as f64;
+                        let x = if len > 0.0 { x - len * (x / len + 0.5).floor() } else { *x };
+                        d2 += x * x;
+                    }
+                    let h = (a[3] + b[3]) as f64 - d2.sqrt();
+                    (h > 0.0).then(|| ContactRecord {
+                        i: pi[k],
+                        j: pj[k],
+                        overlap: h,
+                        normal_force: fi[k][3] as f64,
+                        force: xyz(&fi[k]),
+                        tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
+                    })
+                })
+                .collect()
+        });
+        Frame {
+            time: self.time,
+            id: (0..self.n).collect(),
+            position: arrays[0].iter().map(xyz).collect(),
+            radius: arrays[0].iter().map(|v| v[3] as f64).collect(),
+            velocity: arrays[1].iter().map(xyz).collect(),
+            angular_velocity: arrays[2].iter().map(xyz).collect(),
+            orientation: self.track_orientation.then(|| arrays[3].iter().map(|q| [q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]).collect()),
+            contacts: contact_records,
+        }
+    }
+
+    fn set_piston_pressure(&mut self, pressure: f64) {
+        if let Some(w) = self.piston {
+            let offset = (w * std::mem::size_of::<layout::Wall>() + std::mem::offset_of!(layout::Wall, piston) + 8) as u64;
+            self.gpu.queue.write_buffer(&self.buffers["walls"], offset, bytemuck::bytes_of(&(pressure as f32)));
+        }
+    }
+}
