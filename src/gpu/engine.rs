@@ -613,6 +613,24 @@ impl GpuEngine {
         Ok(())
     }
 
+    /// Rebuilds the neighbour list at the next step, whatever the displacements.
+    pub fn rebuild_next_step(&mut self) {
+        self.gpu.queue.write_buffer(&self.buffers["control"], 0, bytemuck::bytes_of(&f32::INFINITY.to_bits()));
+    }
+
+    /// The pair list (CSR: starts per grain, partners), read back.
+    pub fn pair_list(&mut self) -> (Vec<u32>, Vec<u32>) {
+        let n_pairs = self.read_control().n_pairs as u64;
+        let parts = self.read(&[("pair_start", 0, 4 * (self.n as u64 + 1)), ("pair_j", 0, 4 * n_pairs)]);
+        (bytemuck::cast_slice(&parts[0]).to_vec(), bytemuck::cast_slice(&parts[1]).to_vec())
+    }
+
+    /// Force and torque on each grain from the last force evaluation (N, N m), read back.
+    pub fn loads(&self) -> Vec<([f32; 3], [f32; 3])> {
+        let a = self.read_vec4s(&["force", "torque"]);
+        a[0].iter().zip(&a[1]).map(|(f, t)| ([f[0], f[1], f[2]], [t[0], t[1], t[2]])).collect()
+    }
+
     /// Reads grain arrays back (vec4 per grain).
     fn read_vec4s(&self, names: &[&str]) -> Vec<Vec<[f32; 4]>> {
         let parts: Vec<(&str, u64, u64)> = names.iter().map(|n| (*n, 0, 16 * self.n as u64)).collect();

@@ -1,0 +1,249 @@
+//! The GPU engine on whatever adapter there is (lavapipe in CI): kernels against their CPU
+//! twins on seeded random inputs, every shipped scene against the CPU in f32, the core physics
+//! tests again, and bitwise reproducibility run to run. Without an adapter these tests skip
+//! with a message, except under CI, where they fail.
+
+mod common;
+
+use grains::cpu::CpuEngine;
+use grains::engine::Engine;
+use grains::scene::Scene;
+
+/// GPU and CPU f32 loads: the largest difference over the mean contact force. Both compute in
+/// f32 from the same inputs; the GPU may fuse multiply-adds, so they differ by a few ulps of
+/// the largest terms.
+const F32_LOAD_TOLERANCE: f64 = 1e-4;
+/// GPU and CPU f32 positions after a few hundred steps, over the mean diameter.
+const F32_POSITION_TOLERANCE: f64 = 1e-5;
+/// Relative difference of the statistics both engines reduce (kinetic, elastic energy...).
+const F32_STATS_TOLERANCE: f64 = 1e-4;
+/// f32 momentum drift relative to the sum of |p| over a few thousand steps.
+const F32_MOMENTUM_ROUNDOFF: f64 = 1e-5;
+
+/// A dense, frictional, colliding gas with walls and orientation: every kernel has work.
+fn gas(periodic: bool) -> Scene {
+    let walls = if periodic {
+        "[periodic]\nx = [0.0, 16.0e-3]\ny = [0.0, 16.0e-3]\n[[wall]]\ntype = \"plane\"\nmaterial = \"sand\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n"
+    } else {
+        "[[wall]]\ntype = \"box\"\nmaterial = \"sand\"\nmin = [0.0, 0.0, 0.0]\nmax = [16.0e-3, 16.0e-3, 16.0e-3]\n"
+    };
+    common::parse(&format!(
+        r#"
+seed = 4
+[[material]]
+name = "sand"
+density = 2650.0
+youngs_modulus = 7.0e7
+poisson_ratio = 0.3
+mu_s = 0.5
+mu_k = 0.4
+rolling_angle = 3.0
+gamma_n = 1.0e5
+gamma_nt = 10.0
+[[generate]]
+material = "sand"
+count = 1500
+diameter = {{ min = 0.8e-3, max = 1.2e-3 }}
+region = {{ shape = "box", min = [0.0, 0.0, 0.0], max = [16.0e-3, 16.0e-3, 16.0e-3] }}
+random_speed = 0.5
+{walls}
+[model]
+damping = "papers"
+tangential = "oquendo"
+twisting = "oquendo"
+[simulation]
+track_orientation = true
+skin = 3.0e-4
+[[stage]]
+kind = "run"
+duration = 1.0e-3
+"#
+    ))
+}
+
+fn mean_contact_force(e: &mut CpuEngine<f32>) -> f64 {
+    let frame = e.frame(true);
+    let c = frame.contacts.unwrap();
+    c.iter().map(|r| r.normal_force).sum::<f64>() / c.len().max(1) as f64
+}
+
+#[test]
+fn hash_cells_and_detect_pairs_list_the_cpus_pairs() {
+    for periodic in [false, true] {
+        let scene = gas(periodic);
+        let Some(mut g) = common::gpu_engine(&scene) else { return };
+        let mut c: CpuEngine<f32> = common::engine(&scene);
+        g.stats();
+        c.stats();
+        g.advance(50).unwrap();
+        c.advance(50).unwrap();
+        let (starts, partners) = g.pair_list();
+        let list = c.pair_list();
+        println!("periodic {periodic}: {} pairs on the GPU, {} on the CPU", partners.len(), list.partner.len());
+        assert!(list.partner.len() > 1000);
+        assert_eq!(starts, list.owner_start, "pair starts per grain");
+        assert_eq!(partners, list.partner, "partners");
+    }
+}
+
+#[test]
+fn pair_force_wall_contacts_and_gather_match_the_cpu_twins() {
+    for periodic in [false, true] {
+        let scene = gas(periodic);
+        let Some(mut g) = common::gpu_engine(&scene) else { return };
+        let mut c: CpuEngine<f32> = common::engine(&scene);
+        g.advance(100).unwrap();
+        c.advance(100).unwrap();
+        let scale = mean_contact_force(&mut c);
+        let gl = g.loads();
+        let cl = c.loads();
+        let mut worst: f64 = 0.0;
+        for (a, b) in gl.iter().zip(cl) {
+            for k in 0..3 {
+                worst = worst.max((a.0[k] as f64 - b.force.f64()[k]).abs());
+            }
+        }
+        println!("periodic {periodic}: largest load difference {worst:.3e} N, mean contact force {scale:.3e} N");
+        assert!(scale > 0.0);
+        assert!(worst < F32_LOAD_TOLERANCE * scale);
+    }
+}
+
+#[test]
+fn integrate_and_the_reductions_match_the_cpu_twins() {
+    let scene = gas(false);
+    let Some(mut g) = common::gpu_engine(&scene) else { return };
+    let mut c: CpuEngine<f32> = common::engine(&scene);
+    g.advance(20).unwrap();
+    c.advance(20).unwrap();
+    let (fg, fc) = (g.frame(false), c.frame(false));
+    let d_mean = 1.0e-3;
+    let worst = fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+    let worst_q = fg.orientation.as_ref().unwrap().iter().zip(fc.orientation.as_ref().unwrap()).map(|(a, b)| (0..4).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+    println!("after 20 steps: positions differ by {:.3e} of a diameter, quaternions by {worst_q:.3e}", worst / d_mean);
+    assert!(worst / d_mean < F32_POSITION_TOLERANCE);
+    assert!(worst_q < F32_POSITION_TOLERANCE);
+    let (sg, sc) = (g.stats(), c.stats());
+    for (name, a, b) in [
+        ("kinetic", sg.kinetic_energy(), sc.kinetic_energy()),
+        ("elastic", sg.elastic_energy, sc.elastic_energy),
+        ("gravity", sg.gravity_energy, sc.gravity_energy),
+    ] {
+        println!("{name}: gpu {a:.6e} cpu {b:.6e}");
+        assert!((a - b).abs() <= F32_STATS_TOLERANCE * b.abs().max(1e-30), "{name}");
+    }
+    assert_eq!((sg.contacts, sg.wall_contacts, sg.rebuilds), (sc.contacts, sc.wall_contacts, sc.rebuilds));
+    assert_eq!(sg.max_overlap_grain, sc.max_overlap_grain);
+    for (a, b) in sg.walls.iter().zip(&sc.walls) {
+        for k in 0..3 {
+            assert!((a.force[k] - b.force[k]).abs() <= F32_LOAD_TOLERANCE * (sc.walls.iter().map(|w| w.force[2].abs()).fold(1e-9, f64::max)), "{}", a.name);
+        }
+    }
+}
+
+#[test]
+fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
+    for name in ["quickstart.toml", "two_spheres.toml", "sphere_on_plane.toml", "elastic_gas.toml", "pour.toml"] {
+        let scene = common::shipped(name);
+        let Some(mut g) = common::gpu_engine(&scene) else { return };
+        let mut c: CpuEngine<f32> = common::engine(&scene);
+        g.advance(300).unwrap();
+        c.advance(300).unwrap();
+        let (fg, fc) = (g.frame(false), c.frame(false));
+        let d_mean = 2.0 * scene.grains.radius.iter().sum::<f64>() / scene.grains.len() as f64;
+        let worst = fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+        let (sg, sc) = (g.stats(), c.stats());
+        println!("{name}: positions differ by {:.2e} of a diameter; KE gpu {:.6e} cpu {:.6e}", worst / d_mean, sg.kinetic_energy(), sc.kinetic_energy());
+        assert!(worst / d_mean < F32_POSITION_TOLERANCE, "{name}");
+        assert!((sg.kinetic_energy() - sc.kinetic_energy()).abs() <= F32_STATS_TOLERANCE * sc.kinetic_energy(), "{name}");
+    }
+}
+
+#[test]
+fn gpu_runs_are_bitwise_reproducible() {
+    let scene = gas(true);
+    let run = || -> Option<Vec<u64>> {
+        let mut g = common::gpu_engine(&scene)?;
+        g.advance(200).unwrap();
+        let f = g.frame(true);
+        let mut bits: Vec<u64> = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|v| v.map(f64::to_bits)).collect();
+        bits.extend(f.contacts.unwrap().iter().flat_map(|c| c.force.map(f64::to_bits)));
+        Some(bits)
+    };
+    let Some(a) = run() else { return };
+    let b = run().unwrap();
+    println!("{} values compared", a.len());
+    assert_eq!(a, b);
+}
+
+#[test]
+fn hertz_collision_on_the_gpu_matches_theory() {
+    const HERTZ_TOLERANCE: f64 = 0.01;
+    let mut scene = common::shipped("two_spheres.toml");
+    let t_c = 7.5939e-5; // the peers' theory value (tests/hertz_collision.rs)
+    scene.time_step.dt = t_c / 50.0;
+    let Some(mut g) = common::gpu_engine(&scene) else { return };
+    let (mut on, mut off, mut max_h) = (None, None, 0.0f64);
+    while off.is_none() && g.time() < 5e-3 {
+        g.advance(1).unwrap();
+        let s = g.stats();
+        let h = s.max_overlap * 5.0e-4;
+        if s.contacts > 0 && on.is_none() {
+            on = Some(g.time());
+        }
+        if s.contacts == 0 && on.is_some() {
+            off = Some(g.time());
+        }
+        max_h = max_h.max(h);
+    }
+    let contact = off.unwrap() - on.unwrap();
+    println!("gpu: contact {contact:.5e} s (theory {t_c:.5e}, whole steps), max overlap {max_h:.5e} m (theory 2.5803e-6)");
+    assert!((contact / t_c - 1.0).abs() < HERTZ_TOLERANCE + 1.0 / 50.0);
+    assert!((max_h / 2.5803e-6 - 1.0).abs() < HERTZ_TOLERANCE);
+}
+
+#[test]
+fn momentum_is_conserved_on_the_gpu_to_f32_round_off() {
+    let text = std::fs::read_to_string(common::scene_path("elastic_gas.toml")).unwrap().replace(
+        "[[wall]]\ntype = \"box\"\nmaterial = \"glass\"\nmin = [0.0, 0.0, 0.0]\nmax = [6.0e-3, 6.0e-3, 6.0e-3]",
+        "[periodic]\nx = [0.0, 6.0e-3]\ny = [0.0, 6.0e-3]\nz = [0.0, 6.0e-3]",
+    );
+    let text = text.replace("poisson_ratio = 0.3", "poisson_ratio = 0.3\nmu_s = 0.5\nrestitution = 0.6").replace("damping = \"none\"\ntangential = \"none\"", "damping = \"restitution\"\ntangential = \"mindlin\"");
+    let scene = common::parse(&text);
+    let Some(mut g) = common::gpu_engine(&scene) else { return };
+    let s0 = g.stats();
+    let scale: f64 = scene.grains.velocity.iter().zip(&scene.grains.mass).map(|(v, m)| m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()).sum();
+    g.advance(3000).unwrap();
+    let s1 = g.stats();
+    let dp = (0..3).map(|k| (s1.momentum[k] - s0.momentum[k]).powi(2)).sum::<f64>().sqrt();
+    println!("gpu, 3000 steps, {} rebuilds: KE {:.3e} -> {:.3e} J, |dP| / sum|p| = {:.2e}", s1.rebuilds, s0.kinetic_energy(), s1.kinetic_energy(), dp / scale);
+    assert!(s1.kinetic_energy() < s0.kinetic_energy(), "collisions must have dissipated energy");
+    assert!(dp < F32_MOMENTUM_ROUNDOFF * scale);
+}
+
+#[test]
+fn history_survives_a_rebuild_on_the_gpu() {
+    // tests/history.rs's glancing collision, with a rebuild forced mid-contact.
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/history.rs")).unwrap();
+    let scene_text = text.split("const SCENE: &str = r#\"").nth(1).unwrap().split("\"#;").next().unwrap();
+    let scene = common::parse(scene_text);
+    let run = |rebuild: bool| -> Option<(Vec<[f64; 3]>, [f64; 3], u64)> {
+        let mut g = common::gpu_engine(&scene)?;
+        g.advance(287).unwrap();
+        if rebuild {
+            g.rebuild_next_step();
+        }
+        g.advance(5).unwrap();
+        let spring = g.frame(true).contacts.unwrap()[0].tangential_spring;
+        g.advance(300).unwrap();
+        let f = g.frame(false);
+        Some((f.position.iter().chain(&f.velocity).copied().collect(), spring, g.stats().rebuilds))
+    };
+    let Some((plain, spring, r0)) = run(false) else { return };
+    let (rebuilt, spring_rebuilt, r1) = run(true).unwrap();
+    println!("spring at mid-contact {spring:?} / {spring_rebuilt:?}; rebuilds {r0} vs {r1}");
+    assert_eq!(r1, r0 + 1);
+    assert!(spring[1].abs() > 1e-8);
+    assert_eq!(spring, spring_rebuilt);
+    assert_eq!(plain, rebuilt);
+}
