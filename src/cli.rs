@@ -24,8 +24,12 @@ pub enum Precision {
 /// Which engine runs the kernels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Backend {
-    /// The CPU engine (Rust twins of the kernels, multithreaded).
+    /// The CPU engine (Rust twins of the kernels, multithreaded; f64 by default).
     Cpu,
+    /// The GPU engine (WGSL kernels through wgpu, f32); an error without an adapter.
+    Gpu,
+    /// The GPU when an adapter opens, else the CPU with a notice.
+    Auto,
 }
 
 /// Subcommands.
@@ -38,9 +42,12 @@ pub enum Command {
         /// Engine.
         #[arg(long, value_enum, default_value = "cpu")]
         backend: Backend,
-        /// Precision of the CPU engine.
-        #[arg(long, value_enum, default_value = "f64")]
-        precision: Precision,
+        /// GPU adapter whose name contains this (case-insensitive); default: the best one.
+        #[arg(long)]
+        adapter: Option<String>,
+        /// Precision: the CPU defaults to f64, the GPU computes in f32 only.
+        #[arg(long, value_enum)]
+        precision: Option<Precision>,
         /// Write summary.json, stats.csv, stages.csv and frames.mcap here.
         #[arg(long)]
         out: Option<PathBuf>,
@@ -55,5 +62,24 @@ pub enum Command {
     Check {
         /// Scene file (TOML).
         scene: PathBuf,
+    },
+    /// List the GPU adapters with their backend and limits.
+    Devices,
+    /// Run a scene on the GPU (f32) and on the CPU (f32 and f64) and report how they differ.
+    Compare {
+        /// Scene file (TOML).
+        scene: PathBuf,
+        /// Steps to run.
+        #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u64).range(1..))]
+        steps: u64,
+        /// Comparisons along the way.
+        #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..))]
+        checkpoints: u64,
+        /// GPU adapter whose name contains this.
+        #[arg(long)]
+        adapter: Option<String>,
+        /// Print one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
     },
 }

@@ -3,8 +3,9 @@
 use crate::cli::{Backend, Cli, Command, Precision};
 use anyhow::Context;
 use grains::cpu::CpuEngine;
+use grains::engine::Engine;
+use grains::gpu::GpuEngine;
 use grains::output::{RunRecorder, Summary};
-use grains::real::Real;
 use grains::scene::{self, Scene};
 use std::io::IsTerminal;
 use std::path::Path;
@@ -13,20 +14,19 @@ use std::time::Instant;
 /// Runs one command.
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Run { scene, backend, precision, out, json, threads } => {
+        Command::Run { scene, backend, adapter, precision, out, json, threads } => {
             let scene = scene::load(&scene)?;
             if !json {
                 for w in &scene.warnings {
                     eprintln!("warning: {w}");
                 }
             }
-            let Backend::Cpu = backend;
-            // The whole run happens on a worker of the pool, so that the kernels' parallel
+            // The whole run happens on a worker of the pool, so that the CPU kernels' parallel
             // loops split work among workers instead of waking them from outside every time.
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start the worker threads")?;
-            pool.install(|| match precision {
-                Precision::F32 => run::<f32>(&scene, out.as_deref(), json),
-                Precision::F64 => run::<f64>(&scene, out.as_deref(), json),
+            pool.install(|| {
+                let mut engine = engine_for(&scene, backend, adapter.as_deref(), precision, json)?;
+                run(&scene, engine.as_mut(), out.as_deref(), json)
             })
         }
         Command::Check { scene } => {
@@ -34,20 +34,79 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             print!("{}", grains::output::check_report(&scene));
             Ok(())
         }
+        Command::Devices => {
+            let list = grains::gpu::describe_all();
+            if list.is_empty() {
+                return Err(grains::gpu::GpuError::NoAdapter.into());
+            }
+            for line in list {
+                println!("{line}");
+            }
+            Ok(())
+        }
+        Command::Compare { scene, steps, checkpoints, adapter, json } => {
+            let scene = scene::load(&scene)?;
+            let gpu = grains::gpu::open(adapter.as_deref())?;
+            let name = gpu.info.name.clone();
+            let mut g = GpuEngine::new(gpu, &scene)?;
+            let mut c32 = CpuEngine::<f32>::new(&scene)?;
+            let mut c64 = CpuEngine::<f64>::new(&scene)?;
+            let report = grains::compare::compare(&scene, &name, &mut g, &mut c32, &mut c64, steps, checkpoints)?;
+            if json {
+                println!("{}", serde_json::to_string(&report)?);
+            } else {
+                print!("{}", report.human());
+            }
+            if report.passed() { Ok(()) } else { anyhow::bail!("the backends disagree beyond the named tolerances (see the table); fix: report the scene and the table as a bug") }
+        }
     }
 }
 
-fn run<T: Real>(scene: &Scene, out: Option<&Path>, json: bool) -> anyhow::Result<()> {
-    let mut engine = CpuEngine::<T>::new(scene)?;
+/// The engine `--backend` and `--precision` ask for.
+fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision: Option<Precision>, quiet: bool) -> anyhow::Result<Box<dyn Engine>> {
+    let gpu = |gpu| -> anyhow::Result<Box<dyn Engine>> { Ok(Box::new(GpuEngine::new(gpu, scene)?)) };
+    let cpu = |precision: Option<Precision>| -> anyhow::Result<Box<dyn Engine>> {
+        Ok(match precision.unwrap_or(Precision::F64) {
+            Precision::F32 => Box::new(CpuEngine::<f32>::new(scene)?),
+            Precision::F64 => Box::new(CpuEngine::<f64>::new(scene)?),
+        })
+    };
+    match backend {
+        Backend::Cpu => cpu(precision),
+        Backend::Gpu => {
+            if precision == Some(Precision::F64) {
+                anyhow::bail!("--precision f64: the GPU backend computes in f32; fix: drop --precision or use --backend cpu");
+            }
+            gpu(grains::gpu::open(adapter)?)
+        }
+        Backend::Auto => {
+            if precision == Some(Precision::F64) {
+                return cpu(precision);
+            }
+            match grains::gpu::open(adapter) {
+                Ok(g) => gpu(g),
+                Err(e) => {
+                    if !quiet {
+                        eprintln!("notice: {e}; running on the CPU");
+                    }
+                    cpu(precision)
+                }
+            }
+        }
+    }
+}
+
+fn run(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, json: bool) -> anyhow::Result<()> {
     let progress = !json && std::io::stderr().is_terminal();
     let mut rec = RunRecorder::new(out, progress)?;
     let started = Instant::now();
-    let result = grains::protocol::run(scene, &mut engine, &mut rec);
+    let result = grains::protocol::run(scene, engine, &mut rec);
     let wall_seconds = started.elapsed().as_secs_f64();
     // Whatever happened, keep what was recorded.
     rec.finish()?;
     let stages = result?;
-    let summary = Summary::new(scene, &engine, rayon::current_num_threads(), wall_seconds, stages);
+    let threads = if engine.backend() == "cpu" { rayon::current_num_threads() } else { 1 };
+    let summary = Summary::new(scene, engine, threads, wall_seconds, stages);
     if let Some(dir) = out {
         let path = dir.join("summary.json");
         std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))?;

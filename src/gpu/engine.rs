@@ -108,7 +108,7 @@ impl GpuEngine {
         let limit = |what, need: u64, have: u64, fix| -> Result<(), GpuSetupError> {
             if need > have { Err(GpuSetupError::Limit { adapter: adapter.clone(), what, need, have, fix }) } else { Ok(()) }
         };
-        let binding = gpu.limits.max_storage_buffer_binding_size as u64;
+        let binding = gpu.limits.max_storage_buffer_binding_size;
         limit("walls", scene.walls.len() as u64, MAX_WALLS as u64, "split the container into at most 8 walls or use --backend cpu")?;
         limit("bytes per grain array (16 per grain)", 16 * n, binding, "use fewer grains per run or a device with larger storage bindings")?;
         let hash_size = (n.max(64)).next_power_of_two();
@@ -543,8 +543,9 @@ impl GpuEngine {
         }
     }
 
-    /// Copies buffers out: `(buffer, offset, bytes)` each, returned in order.
-    fn read(&self, parts: &[(&str, u64, u64)]) -> Vec<Vec<u8>> {
+    /// Copies buffers out: `(buffer, offset, bytes)` each, returned in order as 4-byte words
+    /// (every type the kernels share is 4-byte aligned).
+    fn read(&self, parts: &[(&str, u64, u64)]) -> Vec<Vec<u32>> {
         let total: u64 = parts.iter().map(|p| p.2.next_multiple_of(4)).sum();
         let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -565,7 +566,7 @@ impl GpuEngine {
         let mut out = Vec::new();
         let mut at = 0usize;
         for &(_, _, bytes) in parts {
-            out.push(view[at..at + bytes as usize].to_vec());
+            out.push(bytemuck::pod_collect_to_vec(&view[at..at + bytes as usize]));
             at += bytes.next_multiple_of(4) as usize;
         }
         out
@@ -573,7 +574,7 @@ impl GpuEngine {
 
     fn read_control(&mut self) -> Control {
         let c = self.read(&[("control", 0, std::mem::size_of::<Control>() as u64)]);
-        self.control = *bytemuck::from_bytes(&c[0]);
+        self.control = *bytemuck::from_bytes(bytemuck::cast_slice(&c[0]));
         self.control
     }
 
@@ -602,7 +603,7 @@ impl GpuEngine {
             });
         }
         if c.n_pairs as f64 > PAIR_GROWTH_THRESHOLD * self.params.pair_capacity as f64 {
-            let binding = self.gpu.limits.max_storage_buffer_binding_size as u64;
+            let binding = self.gpu.limits.max_storage_buffer_binding_size;
             let per_pair = 16 * (self.params.hist_blocks as u64).max(1);
             let grown = (2 * c.n_pairs as u64).min(binding / per_pair);
             if grown > self.params.pair_capacity as u64 {
@@ -622,7 +623,7 @@ impl GpuEngine {
     pub fn pair_list(&mut self) -> (Vec<u32>, Vec<u32>) {
         let n_pairs = self.read_control().n_pairs as u64;
         let parts = self.read(&[("pair_start", 0, 4 * (self.n as u64 + 1)), ("pair_j", 0, 4 * n_pairs)]);
-        (bytemuck::cast_slice(&parts[0]).to_vec(), bytemuck::cast_slice(&parts[1]).to_vec())
+        (parts[0].clone(), parts[1].clone())
     }
 
     /// Force and torque on each grain from the last force evaluation (N, N m), read back.
@@ -705,7 +706,7 @@ impl Engine for GpuEngine {
             ("wall_reaction", 0, MAX_WALLS as u64 * 16),
             ("walls", 0, (n_walls.max(1) * std::mem::size_of::<layout::Wall>()) as u64),
         ]);
-        let control: Control = *bytemuck::from_bytes(&parts[0]);
+        let control: Control = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[0]));
         self.control = control;
         let s: &[f32] = bytemuck::cast_slice(&parts[1]);
         let reaction: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
@@ -778,7 +779,7 @@ impl Engine for GpuEngine {
             let np = self.control.n_pairs as u64;
             let blocks = self.params.hist_blocks as u64;
             let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("hist", 0, 16 * np * blocks)]);
-            let (pi, pj): (&[u32], &[u32]) = (bytemuck::cast_slice(&parts[0]), bytemuck::cast_slice(&parts[1]));
+            let (pi, pj): (&[u32], &[u32]) = (&parts[0], &parts[1]);
             let fi: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
             let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
             let pos = &arrays[0];
