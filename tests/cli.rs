@@ -167,3 +167,55 @@ fn a_missing_file_is_one_line_too() {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(err.contains("no/such/scene.toml") && err.contains("fix: "), "{err}");
 }
+
+fn grains_env(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_grains"));
+    c.args(args).env("RUST_BACKTRACE", "0").env("NODEVICE_SELECT", "1");
+    for (k, v) in env {
+        c.env(k, v);
+    }
+    c.output().expect("grains runs")
+}
+
+/// With no Vulkan driver visible (the loader pointed at no ICD), `--backend gpu` is a one-line
+/// error saying how to get one, and `--backend auto` runs on the CPU with a notice.
+#[test]
+fn without_an_adapter_gpu_is_a_clear_error_and_auto_falls_back() {
+    let scene = common::scene_path("two_spheres.toml");
+    let no_driver = [("VK_ICD_FILENAMES", "/nonexistent.json"), ("VK_DRIVER_FILES", "/nonexistent.json")];
+    let o = grains_env(&["run", scene.to_str().unwrap(), "--backend", "gpu"], &no_driver);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let last = err.trim_end().lines().last().unwrap_or("");
+    assert!(last.starts_with("error: no GPU adapter") && last.contains("mesa-vulkan-drivers") && last.contains("--backend cpu"), "{err}");
+    let o = grains_env(&["run", scene.to_str().unwrap(), "--backend", "auto", "--json"], &no_driver);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).is_empty() || !stderr(&o).contains("error:"), "{}", stderr(&o));
+    let j: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(j["backend"], "cpu");
+    let o = grains_env(&["run", scene.to_str().unwrap(), "--backend", "auto"], &no_driver);
+    assert!(stderr(&o).contains("notice: no GPU adapter") && stderr(&o).contains("running on the CPU"), "{}", stderr(&o));
+}
+
+#[test]
+fn gpu_run_and_compare_from_the_command_line() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let scene = common::shipped("two_spheres.toml");
+    let ke0: f64 = (0..2).map(|i| 0.5 * scene.grains.mass[i] * scene.grains.velocity[i][0].powi(2)).sum();
+    let j = run_json("two_spheres.toml", &["--backend", "gpu"]);
+    assert_eq!((j["backend"].as_str(), j["precision"].as_str()), (Some("gpu"), Some("f32")));
+    let ke = j["final"]["kinetic_energy"].as_f64().unwrap();
+    println!("gpu: KE after the collision / before = {:.6}", ke / ke0);
+    assert!((ke / ke0 - 1.0).abs() < ELASTIC_ENERGY_TOLERANCE);
+    let path = common::scene_path("elastic_gas.toml");
+    let o = grains_env(&["compare", path.to_str().unwrap(), "--steps", "1000", "--checkpoints", "5", "--json"], &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let c: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(c["checkpoints"].as_array().unwrap().len(), 5);
+    assert_eq!((c["short_horizon_pass"].as_bool(), c["long_horizon_pass"].as_bool()), (Some(true), Some(true)));
+    let o = grains_env(&["run", path.to_str().unwrap(), "--backend", "gpu", "--precision", "f64"], &[]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stderr(&o).contains("computes in f32"), "{}", stderr(&o));
+}
