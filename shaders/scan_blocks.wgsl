@@ -1,5 +1,6 @@
 // One workgroup turns one block of 2048 counts into exclusive prefix sums within the block and
-// writes the block's total; scan_sums and scan_add finish the scan.
+// writes the block's total. A scan runs it over the data, then once over the block totals
+// (one block of at most 2048), then scan_add adds each block's offset.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read_write> scan_data: array<u32>;
 @group(0) @binding(2) var<storage, read_write> block_sums: array<u32>;

@@ -83,7 +83,6 @@ pub const KERNELS: &[Kernel] = &[
     kernel!("clear_cells", BASE, ["params": Uniform, "cell_count": ReadWrite, "cell_fill": ReadWrite]),
     kernel!("hash_cells", GRID, ["params": Uniform, "pos": ReadWrite, "image": ReadWrite, "built_at": ReadWrite, "cell_of": ReadWrite, "cell_count": ReadWrite, "control": ReadWrite, "pair_start": ReadWrite, "rev_start": ReadWrite, "rev_fill": ReadWrite]),
     kernel!("scan_blocks", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite]),
-    kernel!("scan_sums", BASE, ["params": Uniform, "block_sums": ReadWrite]),
     kernel!("scan_add", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite]),
     kernel!("scatter_cells", BASE, ["params": Uniform, "cell_of": Read, "cell_count": Read, "cell_fill": ReadWrite, "cell_grains": ReadWrite]),
     kernel!("detect_count", DETECT, ["params": Uniform, "pos": Read, "cell_count": Read, "cell_grains": Read, "pair_start": ReadWrite, "control": ReadWrite]),

@@ -6,22 +6,9 @@ mod common;
 
 use grains::cpu::CpuEngine;
 use grains::engine::SimError;
-use grains::protocol::{self, Recorder, StageResult};
+use grains::protocol;
 
 /// Discards what a run records.
-struct Discard;
-impl Recorder for Discard {
-    fn stats(&mut self, _: &str, _: &grains::engine::Stats) -> anyhow::Result<()> {
-        Ok(())
-    }
-    fn frame(&mut self, _: &grains::engine::Frame) -> anyhow::Result<()> {
-        Ok(())
-    }
-    fn stage_end(&mut self, _: &StageResult) -> anyhow::Result<()> {
-        Ok(())
-    }
-    fn progress(&mut self, _: &str, _: u64, _: u64) {}
-}
 
 /// The elastic gas at 1.5 collision times per step (the scene check refuses this; the engine
 /// is driven directly to show what the run-time guard does): grains tunnel deep into each
@@ -33,7 +20,7 @@ fn a_run_at_a_far_too_large_step_stops_with_step_grain_and_a_smaller_dt() {
     scene.time_step.dt = dt;
     scene.stats_interval = 5;
     let mut e: CpuEngine<f64> = common::engine(&scene);
-    let err = protocol::run(&scene, &mut e, &mut Discard).expect_err("must stop");
+    let err = protocol::run(&scene, &mut e, &mut grains::output::RunRecorder::new(None, false).unwrap()).expect_err("must stop");
     let msg = err.to_string();
     println!("{msg}");
     let sim = err.downcast_ref::<SimError>().expect("a simulation error");
@@ -51,7 +38,7 @@ fn a_run_at_a_far_too_large_step_stops_with_step_grain_and_a_smaller_dt() {
 fn the_stable_step_runs_through() {
     let scene = common::shipped("elastic_gas.toml");
     let mut e: CpuEngine<f64> = common::engine(&scene);
-    let stages = protocol::run(&scene, &mut e, &mut Discard).expect("stable at the auto step");
+    let stages = protocol::run(&scene, &mut e, &mut grains::output::RunRecorder::new(None, false).unwrap()).expect("stable at the auto step");
     let s = &stages[0].stats;
     assert!(s.max_overlap < scene.max_overlap && s.non_finite_grain.is_none());
 }

@@ -7,7 +7,7 @@ mod common;
 
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
-use grains::protocol::{self, Recorder, StageResult};
+use grains::protocol;
 use grains::timestep::hertz_collision_time;
 
 /// Contact time at t_c / 50 (see tests/hertz_collision.rs).
@@ -84,19 +84,6 @@ fn a_bounce_off_the_cylinder_lasts_the_grain_wall_hertz_time() {
     assert!((ratio - 1.0).abs() < 1e-3);
 }
 
-struct Discard;
-impl Recorder for Discard {
-    fn stats(&mut self, _: &str, _: &grains::engine::Stats) -> anyhow::Result<()> {
-        Ok(())
-    }
-    fn frame(&mut self, _: &grains::engine::Frame) -> anyhow::Result<()> {
-        Ok(())
-    }
-    fn stage_end(&mut self, _: &StageResult) -> anyhow::Result<()> {
-        Ok(())
-    }
-    fn progress(&mut self, _: &str, _: u64, _: u64) {}
-}
 
 /// A piston at 200 Pa on grains in a cylinder, settled: the piston reads its target, and the
 /// floor carries the piston's load plus the grains' weight (no friction on the side wall).
@@ -141,7 +128,7 @@ unbalanced_force = 1.0e-3
     .replace("youngs_modulus = 2.0e11\npoisson_ratio = 0.3", "youngs_modulus = 2.0e11\npoisson_ratio = 0.3\ngamma_n = 3.0e6");
     let scene = common::parse(&text);
     let mut e: CpuEngine<f64> = common::engine(&scene);
-    let stages = protocol::run(&scene, &mut e, &mut Discard).unwrap();
+    let stages = protocol::run(&scene, &mut e, &mut grains::output::RunRecorder::new(None, false).unwrap()).unwrap();
     let s = &stages[0].stats;
     let piston = s.piston.as_ref().unwrap();
     let area = std::f64::consts::PI * 2.5e-3 * 2.5e-3;

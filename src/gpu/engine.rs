@@ -282,6 +282,7 @@ impl GpuEngine {
         zeroed("cell_fill", 4 * hash_size);
         zeroed("hash_sums", 4 * hash_size.div_ceil(2048));
         zeroed("grain_sums", 4 * (n + 1).div_ceil(2048));
+        zeroed("spare_sum", 4);
         for name in ["pair_start", "old_start", "rev_start"] {
             zeroed(name, 4 * (n + 1));
         }
@@ -427,7 +428,15 @@ impl GpuEngine {
     /// Bind groups: one per kernel, and one per scanned array for the scan kernels.
     fn build_bind_groups(&mut self) {
         self.bind_groups.clear();
-        let scans: [(&str, &str, &str); 3] = [("cell", "cell_count", "hash_sums"), ("pairs", "pair_start", "grain_sums"), ("rev", "rev_start", "grain_sums")];
+        // Each scanned array, and its block totals (scanned in turn as one block whose own
+        // total goes to a spare word).
+        let scans: [(&str, &str, &str); 5] = [
+            ("cell", "cell_count", "hash_sums"),
+            ("cell_sums", "hash_sums", "spare_sum"),
+            ("pairs", "pair_start", "grain_sums"),
+            ("rev", "rev_start", "grain_sums"),
+            ("grain_sums", "grain_sums", "spare_sum"),
+        ];
         for k in KERNELS {
             let instances: Vec<(String, Vec<(&str, &str)>)> = if k.name.starts_with("scan_") {
                 scans.iter().map(|(tag, data, sums)| (format!("{}:{tag}", k.name), vec![("scan_data", *data), ("block_sums", *sums)])).collect()
@@ -474,9 +483,10 @@ impl GpuEngine {
         self.dispatch(pass, name, name, size, phase);
     }
 
-    fn scan(&self, pass: &mut wgpu::ComputePass, tag: &str, blocks: u64) {
+    /// Exclusive scan of an array: blocks, the blocks' totals, then the offsets added back.
+    fn scan(&self, pass: &mut wgpu::ComputePass, tag: &str, sums_tag: &str, blocks: u64) {
         self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{tag}"), Size::Indirect(blocks), None);
-        self.dispatch(pass, "scan_sums", &format!("scan_sums:{tag}"), Size::Indirect(args::ONE), None);
+        self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{sums_tag}"), Size::Indirect(args::ONE), None);
         self.dispatch(pass, "scan_add", &format!("scan_add:{tag}"), Size::Indirect(blocks), None);
     }
 
@@ -491,17 +501,17 @@ impl GpuEngine {
         }
         self.run(pass, "clear_cells", Size::Indirect(args::HASH), None);
         self.run(pass, "hash_cells", Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "cell", args::HASH_BLOCKS);
+        self.scan(pass, "cell", "cell_sums", args::HASH_BLOCKS);
         self.run(pass, "scatter_cells", Size::Indirect(args::GRAINS), None);
         self.run(pass, "detect_count", Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "pairs", args::GRAIN_BLOCKS);
+        self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS);
         self.run(pass, "pairs_ready", Size::One, None);
         self.run(pass, "detect_fill", Size::Indirect(args::GRAINS), None);
         if keeps_history {
             self.run(pass, "remap_history", Size::Indirect(args::NEW_PAIRS), None);
         }
         self.run(pass, "reverse_count", Size::Indirect(args::NEW_PAIRS), None);
-        self.scan(pass, "rev", args::GRAIN_BLOCKS);
+        self.scan(pass, "rev", "grain_sums", args::GRAIN_BLOCKS);
         self.run(pass, "reverse_fill", Size::Indirect(args::NEW_PAIRS), None);
         self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
     }
