@@ -1,4 +1,6 @@
-//! Measures of a packing computed from a frame.
+//! Measures of a packing computed from a frame, and the fits of the experiments.
+
+pub mod fit;
 
 use crate::engine::Frame;
 use crate::scene::{cross_section, Scene, WallShape};
