@@ -65,6 +65,12 @@ pub enum Command {
     },
     /// List the GPU adapters with their backend and limits.
     Devices,
+    /// Fit a law to measured points.
+    Fit {
+        /// Which law.
+        #[command(subcommand)]
+        law: FitLaw,
+    },
     /// Run a scene on the GPU (f32) and on the CPU (f32 and f64) and report how they differ.
     Compare {
         /// Scene file (TOML).
@@ -78,6 +84,31 @@ pub enum Command {
         /// GPU adapter whose name contains this.
         #[arg(long)]
         adapter: Option<String>,
+        /// Print one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Laws `grains fit` knows.
+#[derive(Debug, Subcommand)]
+pub enum FitLaw {
+    /// Bauer's compression law e = e0 exp(-(p/h_s)^eta) by Levenberg-Marquardt.
+    Bauer {
+        /// CSV with a header (e.g. compression.csv of an oedometer run).
+        file: PathBuf,
+        /// Column of the pressure (Pa).
+        #[arg(long, default_value = "pressure_Pa")]
+        p_column: String,
+        /// Column of the void ratio.
+        #[arg(long, default_value = "void_ratio")]
+        e_column: String,
+        /// Fit the mean-stress form e = e0 exp(-(3p/h_s)^eta) (the abstract's).
+        #[arg(long)]
+        mean_stress: bool,
+        /// Hold e0 at this value instead of fitting it.
+        #[arg(long)]
+        e0: Option<f64>,
         /// Print one JSON object on stdout.
         #[arg(long)]
         json: bool,

@@ -1,6 +1,6 @@
 //! The subcommands' bodies.
 
-use crate::cli::{Backend, Cli, Command, Precision};
+use crate::cli::{Backend, Cli, Command, FitLaw, Precision};
 use anyhow::Context;
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
@@ -32,6 +32,16 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Check { scene } => {
             let scene = scene::load(&scene)?;
             print!("{}", grains::output::check_report(&scene));
+            Ok(())
+        }
+        Command::Fit { law: FitLaw::Bauer { file, p_column, e_column, mean_stress, e0, json } } => {
+            let points = read_columns(&file, &p_column, &e_column)?;
+            let fit = grains::analysis::fit::fit_bauer(&points, e0, if mean_stress { 3.0 } else { 1.0 }).with_context(|| format!("{}: cannot fit Bauer's law", file.display()))?;
+            if json {
+                println!("{}", serde_json::to_string(&fit)?);
+            } else {
+                println!("{} ({} points, rms residual {:.2e}{})", fit.line(), fit.points, fit.rms, if mean_stress { ", mean-stress form 3p/h_s" } else { "" });
+            }
             Ok(())
         }
         Command::Devices => {
@@ -110,6 +120,13 @@ fn run(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, json: bool) -
     if let Some(dir) = out {
         let path = dir.join("summary.json");
         std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))?;
+        if !summary.compression.is_empty() {
+            let path = dir.join("compression.csv");
+            std::fs::write(&path, summary.compression_csv()).with_context(|| format!("cannot write {}", path.display()))?;
+            if let Err(e) = grains::output::plot::compression(&dir.join("compression"), &scene.name, &summary.compression, summary.bauer.as_ref()) {
+                eprintln!("warning: {e:#}");
+            }
+        }
     }
     if json {
         println!("{}", serde_json::to_string(&summary)?);
@@ -117,4 +134,25 @@ fn run(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, json: bool) -
         print!("{}", summary.human());
     }
     Ok(())
+}
+
+/// Two numeric columns of a CSV file with a header, by name.
+fn read_columns(file: &Path, x: &str, y: &str) -> anyhow::Result<Vec<(f64, f64)>> {
+    let text = std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
+    let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+    let header: Vec<&str> = lines.next().with_context(|| format!("{}: empty file; fix: give a CSV with a header line", file.display()))?.split(',').map(str::trim).collect();
+    let col = |name: &str| {
+        header.iter().position(|h| *h == name).with_context(|| format!("{}: no column `{name}` (columns: {}); fix: name it with --p-column / --e-column", file.display(), header.join(", ")))
+    };
+    let (xi, yi) = (col(x)?, col(y)?);
+    lines
+        .enumerate()
+        .map(|(k, line)| {
+            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+            let get = |i: usize| -> anyhow::Result<f64> {
+                cells.get(i).and_then(|c| c.parse().ok()).with_context(|| format!("{} line {}: `{}` is not a number; fix: correct the value", file.display(), k + 2, cells.get(i).unwrap_or(&"")))
+            };
+            Ok((get(xi)?, get(yi)?))
+        })
+        .collect()
 }

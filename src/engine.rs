@@ -137,6 +137,8 @@ pub struct Frame {
     pub orientation: Option<Vec<[f64; 4]>>,
     /// Touching grain pairs with their forces, when asked for.
     pub contacts: Option<Vec<ContactRecord>>,
+    /// Grain-wall contacts with their forces, when contacts are asked for.
+    pub wall_contacts: Option<Vec<WallContactRecord>>,
 }
 
 /// One touching pair.
@@ -152,8 +154,28 @@ pub struct ContactRecord {
     pub normal_force: f64,
     /// Total force on i (N).
     pub force: [f64; 3],
+    /// Total force on j (N): `-force` except in seed 000's rolling regime.
+    pub force_j: [f64; 3],
     /// Tangential spring `xi` (m), zero when the model keeps none.
     pub tangential_spring: [f64; 3],
+}
+
+/// One grain touching one wall. Its force is evaluated from the state of the frame (springs
+/// as they stand, not advanced).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct WallContactRecord {
+    /// Permanent id of the grain.
+    pub grain: u32,
+    /// Wall index.
+    pub wall: u32,
+    /// Overlap (m).
+    pub overlap: f64,
+    /// Unit normal from the wall to the grain.
+    pub normal: [f64; 3],
+    /// Distance from the grain's centre to the contact point (m).
+    pub lever: f64,
+    /// Force on the grain (N).
+    pub force: [f64; 3],
 }
 
 /// A backend the host loop can drive.
@@ -176,4 +198,7 @@ pub trait Engine {
     fn frame(&self, contacts: bool) -> Frame;
     /// Sets the piston's target pressure (Pa); no effect without a piston.
     fn set_piston_pressure(&mut self, pressure: f64);
+    /// Moves the piston to height `z` (m) and stops it; no effect without a piston. The host
+    /// places it where it touches nothing yet, so the last forces stay valid.
+    fn place_piston(&mut self, z: f64);
 }

@@ -181,12 +181,13 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
                     rolling_regime(fr, b.m_j, b.inertia_j, g.rp_j, t, -g.n, &f_j, &t_j);
                 }
             } else {
-                var f_t = (*hist).tangential * (-k_t);
+                let damp = v_t * (eta_n * params.damping_ratio);
+                var f_t = -((*hist).tangential * k_t) - damp;
                 let limit = c.mu_s * f_n;
                 let mag = length(f_t);
                 if (mag > limit) {
                     f_t = f_t * (c.mu_k * f_n / mag);
-                    if (k_t > 0.0) { (*hist).tangential = f_t * (-1.0 / k_t); } else { (*hist).tangential = vec3<f32>(0.0); }
+                    if (k_t > 0.0) { (*hist).tangential = (f_t + damp) * (-1.0 / k_t); } else { (*hist).tangential = vec3<f32>(0.0); }
                 }
                 f_i = f_t;
                 f_j = -f_t;

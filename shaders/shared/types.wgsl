@@ -22,7 +22,7 @@ struct Params {
     v_slip: f32,          // m/s
     v_roll: f32,          // m/s
     kt_ratio: f32,        // k_t / (F_el / h); <= 0 selects Mindlin's k_t
-    damping_ratio: f32,   // eta_t / eta_n (Hertz-Mindlin)
+    damping_ratio: f32,   // eta_t / eta_n (tangential dashpot)
     k_r: f32,             // rolling stiffness (N/m)
     gamma_r: f32,         // rolling damping (N s/m)
     mu_r: f32,            // rolling friction

@@ -28,7 +28,8 @@ impl Estimate {
 /// See [`Estimate::concise`].
 pub fn concise(value: f64, error: f64) -> String {
     if !(error.is_finite() && error > 0.0) {
-        return format!("{value}");
+        // No error to go by: six significant digits.
+        return format!("{}", format!("{value:.5e}").parse::<f64>().unwrap_or(value));
     }
     let exp = error.log10().floor() as i32;
     // Two digits when the error starts with 1 (1.1, 0.14), one otherwise; an error that

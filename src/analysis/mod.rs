@@ -3,6 +3,8 @@
 pub mod fit;
 
 use crate::engine::Frame;
+use crate::periodic::Periodic;
+use crate::real::Vec3;
 use crate::scene::{cross_section, Scene, WallShape};
 
 /// Beds at least this many mean diameters tall are measured in their bulk only.
@@ -40,4 +42,72 @@ pub fn packing_fraction(scene: &Scene, frame: &Frame, piston_z: Option<f64>) -> 
         .sum();
     let height = hi.min(top) - lo.max(floor);
     (height > 0.0).then(|| solid / (area * height))
+}
+
+/// A 3x3 tensor, row-major.
+pub type Tensor = [[f64; 3]; 3];
+
+/// Volume of the grains (m^3).
+pub fn solid_volume(frame: &Frame) -> f64 {
+    frame.radius.iter().map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3)).sum()
+}
+
+/// Void ratio `e = (V_total - V_solid) / V_solid` of grains filling `total_volume` (m^3).
+pub fn void_ratio(solid_volume: f64, total_volume: f64) -> f64 {
+    (total_volume - solid_volume) / solid_volume
+}
+
+/// Volume (m^3) between the container's floor and a piston at `piston_z` (m), for a container
+/// with a cross-section (see [`cross_section`]); `None` otherwise.
+pub fn container_volume(scene: &Scene, piston_z: f64) -> Option<f64> {
+    let area = cross_section(scene.walls.iter().map(|w| &w.shape), &scene.periodic)?;
+    let floor = scene.walls.iter().find_map(|w| match w.shape {
+        WallShape::Plane { point, normal: [0.0, 0.0, 1.0] } => Some(point[2]),
+        _ => None,
+    })?;
+    Some(area * (piston_z - floor))
+}
+
+/// Per grain, the sum over its contacts of `f (x) c` (N m): `f` the force on the grain, `c`
+/// the vector from its centre to the contact point (seed 001 eq. 11 before the division by
+/// the grain's volume). Grain-grain and grain-wall contacts of the frame count; the frame
+/// must have been taken with contacts. Indexed like the frame's grains (slot = permanent id).
+pub fn contact_moments(frame: &Frame, periodic: &Periodic<f64>) -> Vec<Tensor> {
+    let mut m = vec![[[0.0; 3]; 3]; frame.radius.len()];
+    let add = |t: &mut Tensor, f: [f64; 3], c: [f64; 3]| {
+        for a in 0..3 {
+            for b in 0..3 {
+                t[a][b] += f[a] * c[b];
+            }
+        }
+    };
+    for r in frame.contacts.as_deref().unwrap_or(&[]) {
+        let (i, j) = (r.i as usize, r.j as usize);
+        let d = periodic.min_image(Vec3::of(frame.position[i]) - Vec3::of(frame.position[j]));
+        let n = d * (1.0 / d.norm());
+        let (ri, rj) = (frame.radius[i], frame.radius[j]);
+        let rp_i = ri - r.overlap * rj / (ri + rj);
+        let rp_j = rj - r.overlap * ri / (ri + rj);
+        add(&mut m[i], r.force, (n * -rp_i).f64());
+        add(&mut m[j], r.force_j, (n * rp_j).f64());
+    }
+    for w in frame.wall_contacts.as_deref().unwrap_or(&[]) {
+        let c = [-w.lever * w.normal[0], -w.lever * w.normal[1], -w.lever * w.normal[2]];
+        add(&mut m[w.grain as usize], w.force, c);
+    }
+    m
+}
+
+/// Volume-weighted mean of the particle stresses over a volume (Pa): `(1/V) sum_i sum_c f (x) c`
+/// (the particle volumes cancel). Negative in compression, as seed 001 eq. 11 defines it.
+pub fn macroscopic_stress(moments: &[Tensor], volume: f64) -> Tensor {
+    let mut s = [[0.0; 3]; 3];
+    for t in moments {
+        for a in 0..3 {
+            for b in 0..3 {
+                s[a][b] += t[a][b] / volume;
+            }
+        }
+    }
+    s
 }

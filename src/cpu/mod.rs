@@ -17,7 +17,9 @@ mod wall_contacts;
 
 pub use integrate::rotate;
 pub use pairs::PairList;
+pub use pair_force::ForceContext;
 pub use state::{Body, HistorySlots, Load, Props};
+pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::model::{normal_potential, ContactForce, ContactModel, PairCoeffs};
@@ -27,10 +29,10 @@ use crate::scene::{Integrator, Scene, WallShape};
 use crate::walls::WallGeom;
 use gather::gather;
 use grid::{hash_cells, CellGrid};
-use pair_force::{pair_force, ForceContext};
+use pair_force::pair_force;
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS};
-use wall_contacts::{wall_contacts, WallState};
+use wall_contacts::wall_contacts;
 
 /// Seed 000's optimised velocity Verlet parameter (eqs. 11-15).
 pub const OVV_XI: f64 = 0.1931833275037836;
@@ -595,11 +597,16 @@ impl<T: Real> Engine for CpuEngine<T> {
                                 overlap: h.f64(),
                                 normal_force: self.out[k].f_n.f64(),
                                 force: self.out[k].f_i.f64(),
+                                force_j: self.out[k].f_j.f64(),
                                 tangential_spring: spring.f64(),
                             }
                         })
                     })
                     .collect()
+            }),
+            wall_contacts: contacts.then(|| {
+                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic };
+                wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_hist)
             }),
         }
     }
@@ -607,6 +614,13 @@ impl<T: Real> Engine for CpuEngine<T> {
     fn set_piston_pressure(&mut self, pressure: f64) {
         if let Some(p) = &mut self.piston {
             p.pressure = T::of(pressure);
+        }
+    }
+
+    fn place_piston(&mut self, z: f64) {
+        if let Some(p) = self.piston {
+            self.walls[p.wall].geom = WallGeom::Piston { z: T::of(z) };
+            self.walls[p.wall].velocity = Vec3::ZERO;
         }
     }
 }

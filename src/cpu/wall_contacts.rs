@@ -4,6 +4,7 @@
 use super::pair_force::ForceContext;
 use super::state::{Body, Load, Props};
 use crate::model::{contact_force, Bodies, Geometry, Kinematics};
+use crate::engine::WallContactRecord;
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
 
@@ -53,4 +54,31 @@ pub fn wall_contacts<T: Real>(
         count[w] += 1;
     }
     load
+}
+
+/// Every touching grain-wall contact, with its force evaluated from the current state
+/// (springs read, not advanced: `ctx.elapsed` should be 0), grains in slot order, walls in
+/// order.
+pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[u32], walls: &[WallState<T>], ctx: &ForceContext<T>, hist: &[T]) -> Vec<WallContactRecord> {
+    let stride = ctx.slots.stride;
+    let mut out = Vec::new();
+    for (i, (b, p)) in body.iter().zip(prop).enumerate() {
+        for (w, wall) in walls.iter().enumerate() {
+            let (n, dist) = wall.geom.frame(b.pos);
+            if dist >= p.radius {
+                continue;
+            }
+            let at = (i * walls.len() + w) * stride;
+            let mut slot = hist[at..at + stride].to_vec();
+            let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
+            let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
+            let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
+            let c = &ctx.coeffs[wall.material as usize * ctx.n_materials + p.material as usize];
+            let mut h = ctx.slots.load(&slot);
+            let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
+            ctx.slots.store(&h, &mut slot);
+            out.push(WallContactRecord { grain: id[i], wall: w as u32, overlap: geo.h.f64(), normal: n.f64(), lever: geo.rp_i.f64(), force: f.f_i.f64() });
+        }
+    }
+    out
 }

@@ -84,6 +84,10 @@ pub struct GpuEngine {
     track_orientation: bool,
     wall_names: Vec<String>,
     piston: Option<usize>,
+    /// The contact model and coefficients in f32, for re-evaluating wall contacts on the host.
+    model: crate::model::ContactModel<f32>,
+    coeffs: Vec<PairCoeffs<f32>>,
+    n_materials: usize,
     step: u64,
     time: f64,
     forces_valid: bool,
@@ -156,9 +160,10 @@ impl GpuEngine {
         };
         match model.tangential {
             TangentialLaw::None => {}
-            TangentialLaw::Oquendo { v_slip, v_roll, stiffness: s } => {
+            TangentialLaw::Oquendo { v_slip, v_roll, damping_ratio, stiffness: s } => {
                 params.v_slip = v_slip as f32;
                 params.v_roll = v_roll as f32;
+                params.damping_ratio = damping_ratio as f32;
                 params.kt_ratio = stiffness(s);
             }
             TangentialLaw::Mindlin { damping_ratio, stiffness: s } => {
@@ -310,6 +315,9 @@ impl GpuEngine {
             track_orientation: scene.track_orientation,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
             piston,
+            model: scene.model.cast::<f32>(),
+            coeffs: scene.materials.iter().flat_map(|a| scene.materials.iter().map(move |b| PairCoeffs::mix(&a.constants, &b.constants))).collect(),
+            n_materials: scene.materials.len(),
             step: 0,
             time: 0.0,
             forces_valid: false,
@@ -642,6 +650,49 @@ impl GpuEngine {
         a[0].iter().zip(&a[1]).map(|(f, t)| ([f[0], f[1], f[2]], [t[0], t[1], t[2]])).collect()
     }
 
+    /// Grain-wall contacts re-evaluated on the host from the GPU's state (the CPU twin's
+    /// function in f32), given the grain arrays `[pos, vel, omega, ..]` already read.
+    fn wall_contact_records(&self, arrays: &[Vec<[f32; 4]>]) -> Vec<crate::engine::WallContactRecord> {
+        use crate::cpu::{wall_contact_records, Body, ForceContext, HistorySlots, Props, WallState};
+        use crate::real::Vec3;
+        let n_walls = self.wall_names.len();
+        let blocks = self.params.hist_blocks as usize;
+        let parts = self.read(&[
+            ("material", 0, 4 * self.n as u64),
+            ("walls", 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64),
+            ("wall_hist", 0, if blocks > 0 { 16 * (self.n as usize * n_walls * blocks) as u64 } else { 0 }),
+        ]);
+        let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[1]);
+        let gpu_hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
+        let v3 = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+        let body: Vec<Body<f32>> = (0..self.n as usize).map(|i| Body { pos: v3(arrays[0][i]), vel: v3(arrays[1][i]), omega: v3(arrays[2][i]) }).collect();
+        let prop: Vec<Props<f32>> = (0..self.n as usize).map(|i| Props { radius: arrays[0][i][3], mass: arrays[1][i][3], inertia: arrays[2][i][3], material: parts[0][i] }).collect();
+        let states: Vec<WallState<f32>> = walls
+            .iter()
+            .map(|w| WallState {
+                geom: match w.kind {
+                    0 => crate::walls::WallGeom::Plane { point: v3(w.point), normal: v3(w.normal) },
+                    1 => crate::walls::WallGeom::Cylinder { cx: w.point[0], cy: w.point[1], radius: w.normal[3] },
+                    _ => crate::walls::WallGeom::Piston { z: w.point[2] },
+                },
+                velocity: v3(w.velocity),
+                material: w.material,
+            })
+            .collect();
+        // The GPU keeps one vec4 per history block; the CPU layout packs three reals.
+        let slots = HistorySlots::new(self.history);
+        let hist: Vec<f32> = gpu_hist.iter().flat_map(|b| [b[0], b[1], b[2]]).collect();
+        let ctx = ForceContext {
+            model: &self.model,
+            coeffs: &self.coeffs,
+            n_materials: self.n_materials,
+            slots,
+            elapsed: 0.0,
+            periodic: crate::periodic::Periodic::default(),
+        };
+        wall_contact_records(&body, &prop, &(0..self.n).collect::<Vec<u32>>(), &states, &ctx, &hist)
+    }
+
     /// Reads grain arrays back (vec4 per grain).
     fn read_vec4s(&self, names: &[&str]) -> Vec<Vec<[f32; 4]>> {
         let parts: Vec<(&str, u64, u64)> = names.iter().map(|n| (*n, 0, 16 * self.n as u64)).collect();
@@ -788,10 +839,11 @@ impl Engine for GpuEngine {
         let contact_records = contacts.then(|| {
             let np = self.control.n_pairs as u64;
             let blocks = self.params.hist_blocks as u64;
-            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("hist", 0, 16 * np * blocks)]);
+            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, 16 * np), ("hist", 0, 16 * np * blocks)]);
             let (pi, pj): (&[u32], &[u32]) = (&parts[0], &parts[1]);
             let fi: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
-            let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
+            let fj: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
+            let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[4]);
             let pos = &arrays[0];
             (0..np as usize)
                 .filter_map(|k| {
@@ -810,11 +862,13 @@ impl Engine for GpuEngine {
                         overlap: h,
                         normal_force: fi[k][3] as f64,
                         force: xyz(&fi[k]),
+                        force_j: xyz(&fj[k]),
                         tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
                     })
                 })
                 .collect()
         });
+        let wall_records = (contacts && self.has_walls).then(|| self.wall_contact_records(&arrays)).or(contacts.then(Vec::new));
         Frame {
             time: self.time,
             id: (0..self.n).collect(),
@@ -824,6 +878,16 @@ impl Engine for GpuEngine {
             angular_velocity: arrays[2].iter().map(xyz).collect(),
             orientation: self.track_orientation.then(|| arrays[3].iter().map(|q| [q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]).collect()),
             contacts: contact_records,
+            wall_contacts: wall_records,
+        }
+    }
+
+    fn place_piston(&mut self, z: f64) {
+        if let Some(w) = self.piston {
+            let base = (w * std::mem::size_of::<layout::Wall>()) as u64;
+            let queue = &self.gpu.queue;
+            queue.write_buffer(&self.buffers["walls"], base + std::mem::offset_of!(layout::Wall, point) as u64 + 8, bytemuck::bytes_of(&(z as f32)));
+            queue.write_buffer(&self.buffers["walls"], base + std::mem::offset_of!(layout::Wall, velocity) as u64 + 8, bytemuck::bytes_of(&0.0f32));
         }
     }
 

@@ -76,6 +76,8 @@ pub enum TangentialLaw<T> {
         v_slip: T,
         /// Rolling threshold on the objective rolling speed (m/s).
         v_roll: T,
+        /// Static spring damping as a fraction of the normal damping coefficient.
+        damping_ratio: T,
         /// Static spring stiffness.
         stiffness: TangentialStiffness<T>,
     },
@@ -274,9 +276,9 @@ pub fn contact_force<T: Real>(
 
     match model.tangential {
         TangentialLaw::None => {}
-        TangentialLaw::Oquendo { v_slip, v_roll, stiffness } => {
+        TangentialLaw::Oquendo { v_slip, v_roll, damping_ratio, stiffness } => {
             let k_t = tangential_stiffness(&stiffness, c, geo, k_secant);
-            let t = oquendo_tangential(c, geo, kin, bodies, f_n, k_t, v_slip, v_roll, &mut hist.tangential, elapsed);
+            let t = oquendo_tangential(c, geo, kin, bodies, f_n, k_t, v_slip, v_roll, eta_n * damping_ratio, &mut hist.tangential, elapsed);
             out.f_i += t.f_i;
             out.f_j += t.f_j;
             out.t_i += t.t_i;
@@ -345,7 +347,9 @@ impl ContactModel<f64> {
             },
             tangential: match self.tangential {
                 TangentialLaw::None => TangentialLaw::None,
-                TangentialLaw::Oquendo { v_slip, v_roll, stiffness: s } => TangentialLaw::Oquendo { v_slip: u(v_slip), v_roll: u(v_roll), stiffness: stiffness(s) },
+                TangentialLaw::Oquendo { v_slip, v_roll, damping_ratio, stiffness: s } => {
+                    TangentialLaw::Oquendo { v_slip: u(v_slip), v_roll: u(v_roll), damping_ratio: u(damping_ratio), stiffness: stiffness(s) }
+                }
                 TangentialLaw::Mindlin { damping_ratio, stiffness: s } => TangentialLaw::Mindlin { damping_ratio: u(damping_ratio), stiffness: stiffness(s) },
             },
             rolling: match self.rolling {
@@ -374,7 +378,9 @@ impl ContactModel<f64> {
         };
         let tangential = match self.tangential {
             TangentialLaw::None => "none".to_string(),
-            TangentialLaw::Oquendo { v_slip, v_roll, stiffness } => format!("oquendo(v_slip={v_slip:e}, v_roll={v_roll:e}, {})", stiff(stiffness)),
+            TangentialLaw::Oquendo { v_slip, v_roll, damping_ratio, stiffness } => {
+                format!("oquendo(v_slip={v_slip:e}, v_roll={v_roll:e}, damping_ratio={damping_ratio}, {})", stiff(stiffness))
+            }
             TangentialLaw::Mindlin { damping_ratio, stiffness } => format!("mindlin(damping_ratio={damping_ratio}, {})", stiff(stiffness)),
         };
         let rolling = match self.rolling {
@@ -487,16 +493,16 @@ mod tests {
         // Sliding: v_t = 0.01 m/s along y > v_slip: F = -mu_k F_n t on i, opposite on j.
         let k = Kinematics { v_i: Vec3::new(0.0, 0.01, 0.0), ..Default::default() };
         let mut xi = Vec3::ZERO;
-        let o = oquendo_tangential(&c, &g, &k, &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, &mut xi, 1.0e-6);
+        let o = oquendo_tangential(&c, &g, &k, &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, 0.0, &mut xi, 1.0e-6);
         assert!(close(o.f_i.y, -0.4 * f_n) && o.f_j == -o.f_i);
         // Static: no relative motion, the spring gives -k_t xi.
         let mut xi = Vec3::new(0.0, 1.0e-7, 0.0);
-        let o = oquendo_tangential(&c, &g, &Kinematics::default(), &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, &mut xi, 1.0e-6);
+        let o = oquendo_tangential(&c, &g, &Kinematics::default(), &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, 0.0, &mut xi, 1.0e-6);
         assert!(close(o.f_i.y, -1.0e-4));
         // Rolling: counter-spinning grains, no slip at the contact, v_r > v_roll: eq. 8 on both.
         let k = Kinematics { w_i: Vec3::new(0.0, 0.0, 10.0), w_j: Vec3::new(0.0, 0.0, -10.0), ..Default::default() };
         let mut xi = Vec3::ZERO;
-        let o = oquendo_tangential(&c, &g, &k, &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, &mut xi, 1.0e-6);
+        let o = oquendo_tangential(&c, &g, &k, &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, 0.0, &mut xi, 1.0e-6);
         let rp = g.rp_i;
         let each = f_n * c.tan_roll / (1.0 + b.inertia_i / (b.m_i * rp * rp));
         assert!(close(o.f_i.norm(), each) && o.f_i == o.f_j, "same force on both grains");

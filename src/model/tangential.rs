@@ -42,11 +42,14 @@ pub fn contact_tangential_velocity<T: Real>(g: &Geometry<T>, k: &Kinematics<T>) 
 /// 1. sliding when `|v_t| > v_slip`: `F_t = -mu_k |F_n| t`, `t = v_t / |v_t|`;
 /// 2. rolling when `|v_r| > v_roll`, `v_r = R'_eff (w_i - w_j) x n`: eqs. 8-9 on each grain
 ///    with its own `m, I, R'` (this force does not conserve the pair's linear momentum);
-/// 3. static otherwise: spring `F_t = -k_t xi` up to `mu_s |F_n|`, slipping at `mu_k |F_n|`.
+/// 3. static otherwise: damped spring `F_t = -k_t xi - eta_t v_t` up to `mu_s |F_n|`,
+///    slipping at `mu_k |F_n|`.
 ///
 /// The spring `xi` (history) is rotated into the tangent plane and grows by `v_t elapsed` in
 /// the rolling and static regimes; a sliding contact sets it to the sliding force so that the
-/// force is continuous when the contact sticks again.
+/// force is continuous when the contact sticks again. The paper's static friction cancels the
+/// applied tangential force outright (eq. 10); the spring realises it, and its optional
+/// dashpot `eta_t` (0 by default, as in the paper) damps the spring's own oscillation.
 #[inline]
 pub fn oquendo_tangential<T: Real>(
     c: &PairCoeffs<T>,
@@ -57,6 +60,7 @@ pub fn oquendo_tangential<T: Real>(
     k_t: T,
     v_slip: T,
     v_roll: T,
+    eta_t: T,
     xi: &mut Vec3<T>,
     elapsed: T,
 ) -> TangentialOut<T> {
@@ -85,13 +89,14 @@ pub fn oquendo_tangential<T: Real>(
             if b.j_is_wall { (-f_i, Vec3::ZERO) } else { rolling_regime(fr, b.m_j, b.inertia_j, g.rp_j, t, -g.n) };
         return TangentialOut { f_i, f_j, t_i, t_j };
     }
-    let mut f_t = *xi * (-k_t);
+    let damp = v_t * eta_t;
+    let mut f_t = -(*xi * k_t) - damp;
     let limit = c.mu_s * f_n;
     let mag = f_t.norm();
     if mag > limit {
         // Slip: the force drops to the kinetic limit and the spring to match it.
         f_t = f_t * (c.mu_k * f_n / mag);
-        *xi = if k_t > T::ZERO { f_t * (-T::ONE / k_t) } else { Vec3::ZERO };
+        *xi = if k_t > T::ZERO { (f_t + damp) * (-T::ONE / k_t) } else { Vec3::ZERO };
     }
     TangentialOut {
         f_i: f_t,

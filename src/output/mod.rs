@@ -3,6 +3,7 @@
 //! on a terminal.
 
 pub mod mcap;
+pub mod plot;
 mod summary;
 
 pub use summary::{check_report, Summary, ESTIMATE_PAIRS_PER_GRAIN};

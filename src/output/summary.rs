@@ -1,9 +1,10 @@
 //! The run summary (`--json`, `summary.json`) and the `check` report.
 
+use crate::analysis::fit::{fit_bauer, BauerFit};
 use crate::analysis::packing_fraction;
 use crate::cpu::HistorySlots;
 use crate::engine::Engine;
-use crate::protocol::StageResult;
+use crate::protocol::{CompressionPoint, StageResult};
 use crate::scene::Scene;
 use serde::Serialize;
 use std::fmt::Write;
@@ -49,6 +50,12 @@ pub struct Summary {
     /// End state.
     #[serde(rename = "final")]
     pub final_state: FinalState,
+    /// Oedometer points, one per pressure step.
+    pub compression: Vec<CompressionPoint>,
+    /// Bauer's law fitted to the compression points (at least 4), if it could be.
+    pub bauer: Option<BauerFit>,
+    /// Why Bauer's law could not be fitted, when there were points to fit.
+    pub bauer_error: Option<String>,
     /// Validation warnings.
     pub warnings: Vec<String>,
 }
@@ -59,6 +66,8 @@ impl Summary {
         let last = stages.last().map(|s| &s.stats);
         let frame = engine.frame(false);
         let piston_z = last.and_then(|s| s.piston.as_ref().map(|p| p.z));
+        let compression: Vec<CompressionPoint> = stages.iter().filter_map(|s| s.compression.clone()).collect();
+        let bauer = fit_compression(&compression);
         Summary {
             scene: scene.name.clone(),
             file: scene.path.display().to_string(),
@@ -76,9 +85,24 @@ impl Summary {
                 packing_fraction: packing_fraction(scene, &frame, piston_z),
                 coordination_number: last.map_or(0.0, |s| s.coordination),
             },
+            compression: compression.clone(),
+            bauer: bauer.as_ref().ok().and_then(|b| b.clone()),
+            bauer_error: bauer.err(),
             stages,
             warnings: scene.warnings.clone(),
         }
+    }
+
+    /// The compression points as CSV (the input of `grains fit bauer`).
+    pub fn compression_csv(&self) -> String {
+        let mut s = String::from("target_pressure_Pa,pressure_Pa,piston_z_m,void_ratio,stress_zz_Pa,coordination,kinetic_energy_J,settled\n");
+        for c in &self.compression {
+            s.push_str(&format!(
+                "{:e},{:e},{:e},{},{:e},{},{:e},{}\n",
+                c.target_pressure, c.pressure, c.piston_z, c.void_ratio, c.stress_zz, c.coordination, c.kinetic_energy, c.settled
+            ));
+        }
+        s
     }
 
     /// A few lines for a person.
@@ -95,10 +119,38 @@ impl Summary {
             let _ = writeln!(s, "  stage {:<12} {:>6} {:>9} steps  t = {:.4e} s  KE/grain = {:.3e} J  unbalanced = {:.3e}  Z = {:.3}  max overlap = {:.3e}{settled}",
                 st.name, st.kind, st.steps, st.time_end, st.ke_per_grain, st.unbalanced_force, st.stats.coordination, st.stats.max_overlap);
         }
+        if !self.compression.is_empty() {
+            let _ = writeln!(s, "  oedometer: p (kPa), e, sigma_zz from particle stresses (kPa), Z");
+            for c in &self.compression {
+                let _ = writeln!(s, "    {:>9.2} {:.4} {:>9.2} {:.3}{}", c.pressure / 1e3, c.void_ratio, c.stress_zz / 1e3, c.coordination, if c.settled { "" } else { "  (not settled)" });
+            }
+        }
+        match (&self.bauer, &self.bauer_error) {
+            (Some(b), _) => {
+                let _ = writeln!(s, "  Bauer's law: {}", b.line());
+            }
+            (None, Some(e)) => {
+                let _ = writeln!(s, "  Bauer's law: not fitted: {e}");
+            }
+            _ => {}
+        }
         let pf = self.final_state.packing_fraction.map_or("n/a".to_string(), |p| format!("{p:.4}"));
         let _ = writeln!(s, "  final: KE = {:.4e} J, packing fraction = {pf}, coordination = {:.3}", self.final_state.kinetic_energy, self.final_state.coordination_number);
         s
     }
+}
+
+/// Points below which no Bauer fit is tried.
+pub const MIN_BAUER_POINTS: usize = 4;
+
+/// Bauer's law through the measured pressures and void ratios: `Ok(None)` with too few
+/// points to try.
+fn fit_compression(points: &[CompressionPoint]) -> Result<Option<BauerFit>, String> {
+    if points.len() < MIN_BAUER_POINTS {
+        return Ok(None);
+    }
+    let data: Vec<(f64, f64)> = points.iter().map(|c| (c.pressure, c.void_ratio)).collect();
+    fit_bauer(&data, None, 1.0).map(Some).map_err(|e| e.to_string())
 }
 
 /// Pairs per grain assumed by the memory estimate (a dense packing with a 10% skin).

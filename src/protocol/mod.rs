@@ -2,7 +2,9 @@
 //! `stats_interval` steps (never the particle arrays), deciding when a stage ends, and
 //! stopping a run that goes unstable.
 
+use crate::analysis::{container_volume, contact_moments, macroscopic_stress, solid_volume, void_ratio, Tensor};
 use crate::engine::{Engine, Frame, SimError, Stats};
+use crate::periodic::Periodic;
 use crate::scene::{Scene, Stage, StageKind};
 use serde::Serialize;
 
@@ -32,12 +34,37 @@ pub struct StageResult {
     pub time_end: f64,
     /// Fill/settle: whether both criteria were met before the stage's duration ran out.
     pub settled: Option<bool>,
-    /// Kinetic energy per grain at the end (J).
+    /// Translational kinetic energy per grain at the end (J), the settle criterion's measure.
     pub ke_per_grain: f64,
     /// Unbalanced-force ratio at the end (-).
     pub unbalanced_force: f64,
     /// Statistics at the end.
     pub stats: Stats,
+    /// The compression point of an oedometer step.
+    pub compression: Option<CompressionPoint>,
+}
+
+/// The state of an oedometric sample at the end of a pressure step.
+#[derive(Clone, Debug, Serialize)]
+pub struct CompressionPoint {
+    /// The piston's target pressure (Pa).
+    pub target_pressure: f64,
+    /// The pressure the grains exert on the piston (Pa).
+    pub pressure: f64,
+    /// Piston height (m).
+    pub piston_z: f64,
+    /// Void ratio of the sample between floor and piston.
+    pub void_ratio: f64,
+    /// Grain-grain contacts per grain.
+    pub coordination: f64,
+    /// Kinetic energy (J).
+    pub kinetic_energy: f64,
+    /// Volume-weighted particle stress over the sample, compression positive (Pa).
+    pub stress: Tensor,
+    /// Its vertical component (Pa), to compare with the pressure.
+    pub stress_zz: f64,
+    /// Whether the step met its settle criteria.
+    pub settled: bool,
 }
 
 /// Receives what the host loop produces as it goes.
@@ -75,6 +102,11 @@ fn run_stage(
     if let Some(p) = stage.piston_pressure {
         engine.set_piston_pressure(p);
     }
+    if stage.lower_piston {
+        let f = engine.frame(false);
+        let top = (0..f.radius.len()).map(|i| f.position[i][2] + f.radius[i]).fold(f64::NEG_INFINITY, f64::max);
+        engine.place_piston(top);
+    }
     let dt = scene.time_step.dt;
     let total = (stage.duration / dt).round().max(1.0) as u64;
     let k = scene.stats_interval;
@@ -96,7 +128,13 @@ fn run_stage(
             rec.frame(&engine.frame(scene.output.contact_forces))?;
             *t += scene.output.frame_interval;
         }
-        if settles && stats.kinetic_energy() / n < stage.ke_per_grain && stats.unbalanced_force < stage.unbalanced_force {
+        let pressure_reached = match (stage.piston_pressure, &stats.piston) {
+            (Some(target), Some(p)) if target > 0.0 => ((p.pressure - target) / target).abs() < stage.pressure_tolerance,
+            _ => true,
+        };
+        // Translational energy: a rattler spinning in its cage (nothing to brake it on a
+        // frictionless wall) says nothing about whether the packing stands.
+        if settles && stats.ke_translational / n < stage.ke_per_grain && stats.unbalanced_force < stage.unbalanced_force && pressure_reached {
             settled = true;
             break;
         }
@@ -104,6 +142,7 @@ fn run_stage(
     if next_frame.is_none() {
         rec.frame(&engine.frame(scene.output.contact_forces))?;
     }
+    let compression = if stage.records_compression { Some(compression_point(scene, engine, &stats, settled)) } else { None };
     let result = StageResult {
         name: stage.name.clone(),
         kind: match stage.kind {
@@ -115,12 +154,38 @@ fn run_stage(
         time_start: time0,
         time_end: engine.time(),
         settled: settles.then_some(settled),
-        ke_per_grain: stats.kinetic_energy() / n,
+        ke_per_grain: stats.ke_translational / n,
         unbalanced_force: stats.unbalanced_force,
         stats,
+        compression,
     };
     rec.stage_end(&result)?;
     Ok(result)
+}
+
+/// Measures the sample at the end of a pressure step.
+fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, settled: bool) -> CompressionPoint {
+    let piston = stats.piston.clone().unwrap_or_default();
+    let frame = engine.frame(true);
+    let volume = container_volume(scene, piston.z).unwrap_or(f64::NAN);
+    let moments = contact_moments(&frame, &Periodic::of(&scene.periodic));
+    let mut stress = macroscopic_stress(&moments, volume);
+    for row in &mut stress {
+        for x in row.iter_mut() {
+            *x = -*x;
+        }
+    }
+    CompressionPoint {
+        target_pressure: piston.target_pressure,
+        pressure: piston.pressure,
+        piston_z: piston.z,
+        void_ratio: void_ratio(solid_volume(&frame), volume),
+        coordination: stats.coordination,
+        kinetic_energy: stats.kinetic_energy(),
+        stress_zz: stress[2][2],
+        stress,
+        settled,
+    }
 }
 
 /// The stability checks made at every statistics read.

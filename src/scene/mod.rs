@@ -152,6 +152,13 @@ pub struct Stage {
     pub unbalanced_force: f64,
     /// Piston target pressure during the stage (Pa), if it changes.
     pub piston_pressure: Option<f64>,
+    /// Settling also needs the piston's measured pressure within this fraction of its
+    /// target (stages with a piston pressure).
+    pub pressure_tolerance: f64,
+    /// Move the piston down onto the sample (just above the highest grain) at the start.
+    pub lower_piston: bool,
+    /// Record a compression point (pressure, void ratio, macroscopic stress) at the end.
+    pub records_compression: bool,
 }
 
 /// What `--out` records.
@@ -212,6 +219,10 @@ pub const DEFAULT_V_THRESHOLD: f64 = 1e-4;
 pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
 /// Default settle criterion on the unbalanced-force ratio.
 pub const DEFAULT_UNBALANCED_FORCE: f64 = 0.01;
+/// Default tolerance on the piston's pressure at the end of a pressure stage.
+pub const DEFAULT_PRESSURE_TOLERANCE: f64 = 0.01;
+/// Default pressure multiplier between oedometer steps (seed 000: doubled).
+pub const DEFAULT_OEDOMETER_FACTOR: f64 = 2.0;
 /// Default settle speed, as a fraction of `sqrt(|g| d_mean)`.
 pub const DEFAULT_SETTLE_SPEED_FRACTION: f64 = 1e-2;
 
@@ -342,6 +353,17 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         output,
         warnings,
     })
+}
+
+/// `10kPa`, `1.28MPa`: a pressure for stage names.
+pub fn pressure_label(p: f64) -> String {
+    if p >= 1e6 {
+        format!("{}MPa", (p / 1e6 * 1000.0).round() / 1000.0)
+    } else if p >= 1e3 {
+        format!("{}kPa", (p / 1e3 * 1000.0).round() / 1000.0)
+    } else {
+        format!("{}Pa", (p * 1000.0).round() / 1000.0)
+    }
 }
 
 /// Mass (kg) of a sphere of radius `r` (m) and density `rho` (kg/m^3).
@@ -660,14 +682,12 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
             }
             TangentialLaw::None
         }
-        "oquendo" => {
-            unused("tangential_damping_ratio", m.tangential_damping_ratio.is_some(), "tangential = \"oquendo\"")?;
-            TangentialLaw::Oquendo {
-                v_slip: positive(c, "model.v_slip", m.v_slip.unwrap_or(DEFAULT_V_THRESHOLD), "give a small speed in m/s, e.g. 1e-4")?,
-                v_roll: positive(c, "model.v_roll", m.v_roll.unwrap_or(DEFAULT_V_THRESHOLD), "give a small speed in m/s, e.g. 1e-4")?,
-                stiffness: stiffness(m.kt_ratio)?,
-            }
-        }
+        "oquendo" => TangentialLaw::Oquendo {
+            v_slip: positive(c, "model.v_slip", m.v_slip.unwrap_or(DEFAULT_V_THRESHOLD), "give a small speed in m/s, e.g. 1e-4")?,
+            v_roll: positive(c, "model.v_roll", m.v_roll.unwrap_or(DEFAULT_V_THRESHOLD), "give a small speed in m/s, e.g. 1e-4")?,
+            damping_ratio: non_negative(c, "model.tangential_damping_ratio", m.tangential_damping_ratio.unwrap_or(0.0), "give a fraction such as 0.9")?,
+            stiffness: stiffness(m.kt_ratio)?,
+        },
         "mindlin" => {
             unused("v_slip", m.v_slip.is_some(), "tangential = \"mindlin\"")?;
             unused("v_roll", m.v_roll.is_some(), "tangential = \"mindlin\"")?;
@@ -746,20 +766,28 @@ fn validate_stages(c: &Complainer, specs: &[StageSpec], grains: &Grains, gravity
     let mut out = Vec::new();
     for (i, s) in specs.iter().enumerate() {
         let key = |k: &str| format!("stage[{i}].{k}");
+        let oedometer = s.kind == "oedometer";
         let kind = match s.kind.as_str() {
             "fill" => StageKind::Fill,
-            "settle" => StageKind::Settle,
+            "settle" | "oedometer" => StageKind::Settle,
             "run" => StageKind::Run,
-            other => return Err(c.invalid(key("kind"), format!("\"{other}\""), "unknown stage kind", "use \"fill\", \"settle\" or \"run\"")),
+            other => return Err(c.invalid(key("kind"), format!("\"{other}\""), "unknown stage kind", "use \"fill\", \"settle\", \"run\" or \"oedometer\"")),
         };
         let duration = positive(c, &key("duration"), s.duration, "give the (longest) stage time in seconds")?;
         if kind == StageKind::Fill && g == 0.0 {
             return Err(c.invalid(key("kind"), "\"fill\"", "deposition needs gravity", "set simulation.gravity or use kind = \"settle\""));
         }
         if kind == StageKind::Run {
-            for (k, set) in [("ke_per_grain", s.ke_per_grain.is_some()), ("unbalanced_force", s.unbalanced_force.is_some())] {
+            for (k, set) in [("ke_per_grain", s.ke_per_grain.is_some()), ("unbalanced_force", s.unbalanced_force.is_some()), ("pressure_tolerance", s.pressure_tolerance.is_some())] {
                 if set {
                     return Err(c.invalid(key(k), "(set)", "is a settle criterion; a \"run\" stage ends after its duration", format!("remove `{k}` or use kind = \"settle\"")));
+                }
+            }
+        }
+        if !oedometer {
+            for (k, set) in [("p0", s.p0.is_some()), ("p_max", s.p_max.is_some()), ("factor", s.factor.is_some())] {
+                if set {
+                    return Err(c.invalid(key(k), "(set)", "belongs to kind = \"oedometer\"", format!("remove `{k}` or use kind = \"oedometer\"")));
                 }
             }
         }
@@ -776,15 +804,54 @@ fn validate_stages(c: &Complainer, specs: &[StageSpec], grains: &Grains, gravity
             Some(v) => positive(c, &key("unbalanced_force"), v, "give a ratio such as 0.01")?,
             None => DEFAULT_UNBALANCED_FORCE,
         };
-        let piston_pressure = match s.piston_pressure {
-            Some(_) if !has_piston => {
-                return Err(c.invalid(key("piston_pressure"), "(set)", "the scene has no piston", "add a [[wall]] with type = \"piston\" or remove the key"));
-            }
-            Some(p) => Some(non_negative(c, &key("piston_pressure"), p, "give the pressure in Pa")?),
-            None => None,
+        let pressure_tolerance = positive(c, &key("pressure_tolerance"), s.pressure_tolerance.unwrap_or(DEFAULT_PRESSURE_TOLERANCE), "give a fraction such as 0.01")?;
+        if (s.piston_pressure.is_some() || oedometer) && !has_piston {
+            let k = if oedometer { "kind" } else { "piston_pressure" };
+            return Err(c.invalid(key(k), "(set)", "the scene has no piston", "add a [[wall]] with type = \"piston\""));
+        }
+        let base = Stage {
+            name: s.name.clone().unwrap_or_else(|| format!("{}{}", s.kind, i)),
+            kind,
+            duration,
+            ke_per_grain,
+            unbalanced_force,
+            piston_pressure: s.piston_pressure.map(|p| non_negative(c, &key("piston_pressure"), p, "give the pressure in Pa")).transpose()?,
+            pressure_tolerance,
+            lower_piston: false,
+            records_compression: false,
         };
-        let name = s.name.clone().unwrap_or_else(|| format!("{}{}", s.kind, i));
-        out.push(Stage { name, kind, duration, ke_per_grain, unbalanced_force, piston_pressure });
+        if !oedometer {
+            out.push(base);
+            continue;
+        }
+        if s.piston_pressure.is_some() {
+            return Err(c.invalid(key("piston_pressure"), "(set)", "an oedometer sets the pressure itself from p0 to p_max", "remove `piston_pressure`"));
+        }
+        let need = |k: &str, v: Option<f64>| match v {
+            Some(x) => positive(c, &key(k), x, "give a pressure in Pa"),
+            None => Err(c.invalid(key(k), "(missing)", "is required by kind = \"oedometer\"", "give a pressure in Pa, e.g. p0 = 1e4 and p_max = 1.28e6")),
+        };
+        let (p0, p_max) = (need("p0", s.p0)?, need("p_max", s.p_max)?);
+        if p_max < p0 {
+            return Err(c.invalid(key("p_max"), p_max, format!("is below p0 = {p0}"), "give p_max >= p0"));
+        }
+        let factor = s.factor.unwrap_or(DEFAULT_OEDOMETER_FACTOR);
+        if !(factor > 1.0 && factor.is_finite()) {
+            return Err(c.invalid(key("factor"), factor, "must exceed 1", "give a multiplier such as 2"));
+        }
+        let mut p = p0;
+        let mut first = true;
+        while p <= p_max * (1.0 + 1e-12) {
+            out.push(Stage {
+                name: format!("{}@{}", base.name, pressure_label(p)),
+                piston_pressure: Some(p),
+                lower_piston: first,
+                records_compression: true,
+                ..base.clone()
+            });
+            first = false;
+            p *= factor;
+        }
     }
     if out.is_empty() {
         return Err(c.invalid("stage", "[]", "the scene has no [[stage]]", "add e.g. [[stage]] kind = \"run\" duration = 1e-3"));

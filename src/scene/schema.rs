@@ -238,8 +238,8 @@ pub struct ModelSpec {
     /// Tangential spring as a ratio of the normal secant stiffness (-). Default: Mindlin
     /// `8 G_eff sqrt(R_eff h)` for Hertz, 2/7 for linear.
     pub kt_ratio: Option<f64>,
-    /// Tangential damping as a fraction of the normal damping coefficient (-),
-    /// `tangential = "mindlin"`. Default 0.
+    /// Tangential damping as a fraction of the normal damping coefficient (-): the dashpot of
+    /// the Hertz-Mindlin spring, or of seed 000's static-regime spring. Default 0.
     pub tangential_damping_ratio: Option<f64>,
     /// Rolling stiffness k_r (N/m), `rolling = "sds"`.
     pub rolling_k: Option<f64>,
@@ -336,12 +336,15 @@ impl Default for SimulationSpec {
 pub struct StageSpec {
     /// Name used in reports. Default: the kind and its position.
     pub name: Option<String>,
-    /// "fill" (deposition under gravity until settled), "settle" (until settled) or "run"
-    /// (for a duration).
+    /// "fill" (deposition under gravity until settled), "settle" (until settled), "run"
+    /// (for a duration) or "oedometer" (the piston lowered onto the sample at p0, then the
+    /// pressure multiplied by `factor` at each step up to p_max, each step settling).
     pub kind: String,
-    /// "run": simulated time (s). "fill"/"settle": the most time to wait (s).
+    /// "run": simulated time (s). "fill"/"settle": the most time to wait (s). "oedometer": the
+    /// most time to wait at each pressure (s).
     pub duration: f64,
-    /// "fill"/"settle": kinetic energy per grain (J) below which the sample counts as settled.
+    /// "fill"/"settle": translational kinetic energy per grain (J) below which the sample
+    /// counts as settled (rattlers spinning in their cages do not count).
     /// Default: that of a grain of mean mass moving at 1e-2 sqrt(|g| d_mean) (1 mm/s for 1 mm grains).
     pub ke_per_grain: Option<f64>,
     /// "fill"/"settle": unbalanced-force ratio (mean net force on a grain over mean contact
@@ -349,6 +352,15 @@ pub struct StageSpec {
     pub unbalanced_force: Option<f64>,
     /// Target pressure (Pa) of the scene's piston during this stage. Default: unchanged.
     pub piston_pressure: Option<f64>,
+    /// "oedometer": first pressure (Pa).
+    pub p0: Option<f64>,
+    /// "oedometer": last pressure (Pa), reached or not exceeded.
+    pub p_max: Option<f64>,
+    /// "oedometer": pressure multiplier between steps. Default 2 (seed 000).
+    pub factor: Option<f64>,
+    /// Settle stages with a piston pressure, and oedometer steps: the piston's measured
+    /// pressure must also be within this fraction of its target. Default 0.01.
+    pub pressure_tolerance: Option<f64>,
 }
 
 /// `[output]`.

@@ -1,0 +1,157 @@
+//! Plots a person would rather look at than read, as PNG and SVG (plotters): the oedometer's
+//! e(p) with the fitted Bauer curve, and a sweep's h_s against eta with the power law and the
+//! paper's experimental Guamo point.
+//!
+//! Laying text out needs a TrueType font: the first of [`FONT_CANDIDATES`] found is used
+//! (Debian/Ubuntu: `apt install fonts-dejavu-core`). Without one no plot is drawn, and the
+//! error names the fix; the run's data files are unaffected.
+
+use crate::analysis::fit::{BauerFit, Estimate, PowerLaw};
+use crate::protocol::CompressionPoint;
+use anyhow::Context;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+use std::sync::OnceLock;
+
+/// Fonts tried, in order.
+pub const FONT_CANDIDATES: &[&str] = &[
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf",
+    "/usr/share/fonts/liberation-sans/LiberationSans-Regular.ttf",
+    "/Library/Fonts/Arial.ttf",
+    "/System/Library/Fonts/Supplemental/Arial.ttf",
+    "C:\\Windows\\Fonts\\arial.ttf",
+];
+
+/// The paper's experimental Guamo sand: h_s = 19.1(1.1) MPa, eta = 0.57(1).
+pub const GUAMO: (Estimate, Estimate) = (Estimate { value: 0.57, error: 0.01 }, Estimate { value: 19.1, error: 1.1 });
+
+/// Registers a font for bitmap text once; `false` when none is found.
+fn font_ready() -> bool {
+    static READY: OnceLock<bool> = OnceLock::new();
+    *READY.get_or_init(|| {
+        FONT_CANDIDATES.iter().any(|path| match std::fs::read(path) {
+            Ok(bytes) => plotters::style::register_font("sans-serif", FontStyle::Normal, Box::leak(bytes.into_boxed_slice())).is_ok(),
+            Err(_) => false,
+        })
+    })
+}
+
+/// Draws `draw` into `<stem>.svg` and `<stem>.png`.
+fn both(stem: &Path, size: (u32, u32), draw: impl Fn(&DrawingArea<SVGBackend, Shift>) -> anyhow::Result<()> + Copy, draw_png: impl Fn(&DrawingArea<BitMapBackend, Shift>) -> anyhow::Result<()>) -> anyhow::Result<()> {
+    if !font_ready() {
+        anyhow::bail!("{} not drawn: no TrueType font found (tried {}); fix: install one, e.g. `apt install fonts-dejavu-core`", stem.display(), FONT_CANDIDATES[0]);
+    }
+    let svg = stem.with_extension("svg");
+    {
+        let root = SVGBackend::new(&svg, size).into_drawing_area();
+        draw(&root)?;
+        root.present().with_context(|| format!("cannot write {}", svg.display()))?;
+    }
+    let png = stem.with_extension("png");
+    let root = BitMapBackend::new(&png, size).into_drawing_area();
+    draw_png(&root)?;
+    root.present().with_context(|| format!("cannot write {}", png.display()))?;
+    Ok(())
+}
+
+/// e against p, linear and logarithmic in p, with the Bauer curve: `<stem>.png`, `<stem>.svg`.
+pub fn compression(stem: &Path, title: &str, points: &[CompressionPoint], fit: Option<&BauerFit>) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, points: &[CompressionPoint], fit: Option<&BauerFit>) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        let (left, right) = root.split_horizontally(root.dim_in_pixel().0 / 2);
+        let p_kpa: Vec<f64> = points.iter().map(|c| c.pressure / 1e3).collect();
+        let e: Vec<f64> = points.iter().map(|c| c.void_ratio).collect();
+        let (p_min, p_max) = (p_kpa.iter().copied().fold(f64::INFINITY, f64::min), p_kpa.iter().copied().fold(0.0, f64::max));
+        let (e_min, e_max) = (e.iter().copied().fold(f64::INFINITY, f64::min), e.iter().copied().fold(0.0, f64::max));
+        let pad = 0.1 * (e_max - e_min).max(1e-3);
+        let e_range = (e_min - pad)..(e_max + pad);
+        let curve = |p_lo: f64, p_hi: f64, log: bool| -> Vec<(f64, f64)> {
+            let Some(f) = fit else { return Vec::new() };
+            (0..=200)
+                .map(|k| {
+                    let t = k as f64 / 200.0;
+                    let p = if log { p_lo * (p_hi / p_lo).powf(t) } else { p_lo + (p_hi - p_lo) * t };
+                    (p, f.void_ratio(p * 1e3))
+                })
+                .collect()
+        };
+        let label = fit.map(|f| format!("Bauer: {}", f.line())).unwrap_or_else(|| "no fit".into());
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
+        {
+            let mut chart = ChartBuilder::on(&left)
+                .caption(format!("{title}: e(p)"), ("sans-serif", 18))
+                .margin(12)
+                .x_label_area_size(40)
+                .y_label_area_size(56)
+                .build_cartesian_2d(0.0..p_max * 1.05, e_range.clone())
+                .map_err(err)?;
+            chart.configure_mesh().x_desc("p (kPa)").y_desc("void ratio e").draw().map_err(err)?;
+            chart.draw_series(LineSeries::new(curve(0.0, p_max * 1.05, false), &BLUE)).map_err(err)?.label(label.clone()).legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE));
+            chart.draw_series(p_kpa.iter().zip(&e).map(|(&x, &y)| Circle::new((x, y), 4, BLACK.filled()))).map_err(err)?;
+            chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
+        }
+        let mut chart = ChartBuilder::on(&right)
+            .caption(format!("{title}: e(log p)"), ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(56)
+            .build_cartesian_2d((p_min * 0.8..p_max * 1.25).log_scale(), e_range)
+            .map_err(err)?;
+        chart.configure_mesh().x_desc("p (kPa)").y_desc("void ratio e").draw().map_err(err)?;
+        chart.draw_series(LineSeries::new(curve(p_min * 0.8, p_max * 1.25, true), &BLUE)).map_err(err)?;
+        chart.draw_series(p_kpa.iter().zip(&e).map(|(&x, &y)| Circle::new((x, y), 4, BLACK.filled()))).map_err(err)?;
+        Ok(())
+    }
+    both(stem, (1200, 520), |r| draw(r, title, points, fit), |r| draw(r, title, points, fit))
+}
+
+/// h_s against eta (log-log) across a sweep, with the power law and the Guamo point.
+pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: Option<&PowerLaw>) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, points: &[(Estimate, Estimate)], law: Option<&PowerLaw>) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
+        root.fill(&WHITE).map_err(err)?;
+        let all: Vec<&(Estimate, Estimate)> = points.iter().chain(std::iter::once(&GUAMO)).collect();
+        let x_lo = all.iter().map(|p| (p.0.value - p.0.error).max(p.0.value * 0.5)).fold(f64::INFINITY, f64::min) * 0.8;
+        let x_hi = all.iter().map(|p| p.0.value + p.0.error).fold(0.0, f64::max) * 1.25;
+        let y_lo = all.iter().map(|p| (p.1.value - p.1.error).max(p.1.value * 0.2)).fold(f64::INFINITY, f64::min) * 0.5;
+        let y_hi = all.iter().map(|p| p.1.value + p.1.error).fold(0.0, f64::max) * 2.0;
+        let mut chart = ChartBuilder::on(root)
+            .caption(format!("{title}: h_s against eta"), ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(64)
+            .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
+            .map_err(err)?;
+        chart.configure_mesh().x_desc("eta").y_desc("h_s (MPa)").draw().map_err(err)?;
+        if let Some(l) = law {
+            let line: Vec<(f64, f64)> = (0..=100).map(|k| x_lo * (x_hi / x_lo).powf(k as f64 / 100.0)).map(|x| (x, l.a.value * x.powf(l.b.value))).collect();
+            chart
+                .draw_series(LineSeries::new(line, &BLUE))
+                .map_err(err)?
+                .label(format!("h_s = {} eta^{} MPa", l.a.concise(), l.b.concise()))
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE));
+        }
+        chart
+            .draw_series(points.iter().map(|(eta, h)| ErrorBar::new_vertical(eta.value, (h.value - h.error).max(y_lo), h.value, h.value + h.error, BLACK.filled(), 6)))
+            .map_err(err)?;
+        chart.draw_series(points.iter().map(|(eta, h)| Circle::new((eta.value, h.value), 4, BLACK.filled()))).map_err(err)?.label("simulations").legend(|(x, y)| Circle::new((x + 8, y), 4, BLACK.filled()));
+        chart
+            .draw_series(std::iter::once(TriangleMarker::new((GUAMO.0.value, GUAMO.1.value), 7, RED.filled())))
+            .map_err(err)?
+            .label("Guamo sand (experiment): h_s = 19.1(1.1) MPa, eta = 0.57(1)")
+            .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, RED.filled()));
+        chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
+        Ok(())
+    }
+    both(stem, (900, 640), |r| draw(r, title, points, law), |r| draw(r, title, points, law))
+}
