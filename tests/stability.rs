@@ -8,8 +8,6 @@ use grains::cpu::CpuEngine;
 use grains::engine::SimError;
 use grains::protocol;
 
-/// Discards what a run records.
-
 /// The elastic gas at 1.5 collision times per step (the scene check refuses this; the engine
 /// is driven directly to show what the run-time guard does): grains tunnel deep into each
 /// other and the energy explodes.

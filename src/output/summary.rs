@@ -86,7 +86,7 @@ impl Summary {
                 coordination_number: last.map_or(0.0, |s| s.coordination),
             },
             compression: compression.clone(),
-            bauer: bauer.as_ref().ok().and_then(|b| b.clone()),
+            bauer: bauer.as_ref().ok().and_then(|b| *b),
             bauer_error: bauer.err(),
             stages,
             warnings: scene.warnings.clone(),
