@@ -37,8 +37,13 @@ pub enum Backend {
 pub enum Command {
     /// Run a scene's stages and report.
     Run {
-        /// Scene file (TOML).
-        scene: PathBuf,
+        /// Scene file (TOML); with --resume, the checkpoint's own scene by default.
+        #[arg(required_unless_present = "resume")]
+        scene: Option<PathBuf>,
+        /// Continue the run whose --out directory this is, from its last checkpoint (written
+        /// at every stage end by the CPU backend).
+        #[arg(long, value_name = "DIR", conflicts_with = "out")]
+        resume: Option<PathBuf>,
         /// Engine.
         #[arg(long, value_enum, default_value = "cpu")]
         backend: Backend,

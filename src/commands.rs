@@ -2,10 +2,12 @@
 
 use crate::cli::{Backend, Cli, Command, FitLaw, Precision};
 use anyhow::Context;
+use grains::checkpoint::{CheckpointHeader, EngineState, RunIdentity};
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
 use grains::gpu::GpuEngine;
 use grains::output::{RunRecorder, Summary};
+use grains::protocol::Progress;
 use grains::scene::{self, Scene};
 use std::io::IsTerminal;
 use std::path::Path;
@@ -14,20 +16,28 @@ use std::time::Instant;
 /// Runs one command.
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Run { scene, backend, adapter, precision, out, json, threads } => {
-            let scene = scene::load(&scene)?;
-            if !json {
-                for w in &scene.warnings {
-                    eprintln!("warning: {w}");
-                }
-            }
+        Command::Run { scene, resume, backend, adapter, precision, out, json, threads } => {
             // The whole run happens on a worker of the pool, so that the CPU kernels' parallel
             // loops split work among workers instead of waking them from outside every time.
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start the worker threads")?;
-            pool.install(|| {
-                let mut engine = engine_for(&scene, backend, adapter.as_deref(), precision, json)?;
-                run(&scene, engine.as_mut(), out.as_deref(), json)
-            })
+            match resume {
+                Some(dir) => pool.install(|| resume_run(&dir, scene.as_deref(), precision, json)),
+                None => {
+                    let path = scene.expect("clap requires a scene without --resume");
+                    let scene = scene::load(&path)?;
+                    if !json {
+                        for w in &scene.warnings {
+                            eprintln!("warning: {w}");
+                        }
+                    }
+                    pool.install(|| {
+                        let mut engine = engine_for(&scene, backend, adapter.as_deref(), precision, json)?;
+                        let progress = grains::protocol::Progress::start(&scene, engine.as_mut());
+                        let identity = identity(&path, engine.as_ref())?;
+                        run(&scene, engine.as_mut(), out.as_deref(), json, progress, identity, false)
+                    })
+                }
+            }
         }
         Command::Check { scene } => {
             let scene = scene::load(&scene)?;
@@ -106,11 +116,52 @@ fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision:
     }
 }
 
-fn run(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, json: bool) -> anyhow::Result<()> {
+/// What a checkpoint of this run belongs to.
+fn identity(scene_file: &Path, engine: &dyn Engine) -> anyhow::Result<RunIdentity> {
+    let text = std::fs::read(scene_file).with_context(|| format!("cannot read {}", scene_file.display()))?;
+    Ok(RunIdentity {
+        scene_file: scene_file.display().to_string(),
+        scene_hash: grains::checkpoint::fnv1a(&text),
+        backend: engine.backend().to_string(),
+        precision: engine.precision().to_string(),
+    })
+}
+
+/// `grains run --resume DIR`: the run of DIR's checkpoint, continued into DIR.
+fn resume_run(dir: &Path, scene_file: Option<&Path>, precision: Option<Precision>, json: bool) -> anyhow::Result<()> {
+    let (header, state): (CheckpointHeader, EngineState) = grains::checkpoint::read(&dir.join(grains::checkpoint::FILE))?;
+    let id = &header.identity;
+    let path = scene_file.map(Path::to_path_buf).unwrap_or_else(|| id.scene_file.clone().into());
+    let scene = scene::load(&path)?;
+    let text = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    if grains::checkpoint::fnv1a(&text) != id.scene_hash {
+        anyhow::bail!("{}: the scene differs from the one the checkpoint in {} was written for; fix: restore the scene or start the run afresh", path.display(), dir.display());
+    }
+    let wanted = match id.precision.as_str() {
+        "f32" => Precision::F32,
+        _ => Precision::F64,
+    };
+    if precision.is_some_and(|p| p != wanted) {
+        anyhow::bail!("the checkpoint was written in {}; fix: drop --precision or give --precision {}", id.precision, id.precision);
+    }
+    let mut engine = engine_for(&scene, Backend::Cpu, None, Some(wanted), json)?;
+    engine.restore(&state).with_context(|| format!("cannot resume from {}", dir.display()))?;
+    let identity = identity(&path, engine.as_ref())?;
+    run(&scene, engine.as_mut(), Some(dir), json, header.progress, identity, true)
+}
+
+fn run(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, json: bool, start: Progress, identity: RunIdentity, resumed: bool) -> anyhow::Result<()> {
     let progress = !json && std::io::stderr().is_terminal();
-    let mut rec = RunRecorder::new(out, progress)?;
+    let rec = match (out, resumed) {
+        (Some(dir), true) => RunRecorder::resume(dir, start.next_stage, progress)?,
+        _ => RunRecorder::new(out, progress)?,
+    };
+    let mut rec = match out {
+        Some(dir) => rec.with_checkpoints(dir, identity),
+        None => rec,
+    };
     let started = Instant::now();
-    let result = grains::protocol::run(scene, engine, &mut rec);
+    let result = grains::protocol::run_from(scene, engine, &mut rec, start);
     let wall_seconds = started.elapsed().as_secs_f64();
     // Whatever happened, keep what was recorded.
     rec.finish()?;

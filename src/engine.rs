@@ -1,6 +1,6 @@
 //! What the host loop needs from a backend: advance, read a few statistics, take a frame.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Why a run stopped early.
 #[derive(Debug, thiserror::Error)]
@@ -36,7 +36,7 @@ pub enum SimError {
 }
 
 /// Force on one wall and, for the piston, its state.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct WallStats {
     /// Wall name.
     pub name: String,
@@ -47,7 +47,7 @@ pub struct WallStats {
 }
 
 /// The piston's state.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PistonStats {
     /// Height (m).
     pub z: f64,
@@ -60,7 +60,7 @@ pub struct PistonStats {
 }
 
 /// Statistics read back every `stats_interval` steps.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Stats {
     /// Steps taken since the start.
     pub step: u64,
@@ -198,6 +198,10 @@ pub trait Engine {
     fn frame(&self, contacts: bool) -> Frame;
     /// Sets the piston's target pressure (Pa); no effect without a piston.
     fn set_piston_pressure(&mut self, pressure: f64);
+    /// The engine's whole state for a checkpoint; `None` where the backend cannot save it.
+    fn save(&self) -> Option<crate::checkpoint::EngineState>;
+    /// Restores a state `save` returned, for the same scene, backend and precision.
+    fn restore(&mut self, state: &crate::checkpoint::EngineState) -> anyhow::Result<()>;
     /// Moves the piston to height `z` (m) and stops it; no effect without a piston. The host
     /// places it where it touches nothing yet, so the last forces stay valid.
     fn place_piston(&mut self, z: f64);

@@ -5,6 +5,7 @@
 //! statistics and frames ([`output`]).
 
 pub mod analysis;
+pub mod checkpoint;
 pub mod compare;
 pub mod cpu;
 pub mod engine;

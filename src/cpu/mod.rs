@@ -21,6 +21,7 @@ pub use pair_force::ForceContext;
 pub use state::{Body, HistorySlots, Load, Props};
 pub use wall_contacts::{wall_contact_records, WallState};
 
+use crate::checkpoint::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::model::{normal_potential, ContactForce, ContactModel, PairCoeffs};
 use crate::periodic::Periodic;
@@ -615,6 +616,95 @@ impl<T: Real> Engine for CpuEngine<T> {
         if let Some(p) = &mut self.piston {
             p.pressure = T::of(pressure);
         }
+    }
+
+    fn save(&self) -> Option<EngineState> {
+        let mut s = EngineState::default();
+        let v3 = |v: &Vec3<T>| [v.x.f64(), v.y.f64(), v.z.f64()];
+        s.put_reals("body", self.body.iter().flat_map(|b| [v3(&b.pos), v3(&b.vel), v3(&b.omega)].concat()));
+        s.put_reals("load", self.load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
+        s.put_reals("wall_load", self.wall_load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
+        s.put_reals("built_at", self.built_at.iter().flat_map(v3));
+        s.put_ints("image", self.image.iter().flat_map(|i| i.map(|x| x as i64 as u64)));
+        if let Some(q) = &self.orientation {
+            s.put_reals("orientation", q.iter().flat_map(|q| q.map(T::f64)));
+        }
+        s.put_reals("wall_hist", self.wall_hist.iter().map(|x| x.f64()));
+        s.put_reals("wall_reaction", self.wall_reaction.iter().flat_map(v3));
+        s.put_ints("wall_count", self.wall_count.iter().copied());
+        let piston = self.piston.map_or(Vec::new(), |p| {
+            let z = match self.walls[p.wall].geom {
+                WallGeom::Piston { z } => z.f64(),
+                _ => unreachable!("the piston's wall is a piston"),
+            };
+            vec![z, self.walls[p.wall].velocity.z.f64(), p.pressure.f64()]
+        });
+        s.put_reals("piston", piston);
+        let l = &self.pairs;
+        for (name, v) in [("owner_start", &l.owner_start), ("owner", &l.owner), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
+            s.put_ints(name, v.iter().map(|&x| x as u64));
+        }
+        s.put_reals("hist", self.hist.iter().map(|x| x.f64()));
+        s.put_reals("out", self.out.iter().flat_map(|o| [v3(&o.f_i), v3(&o.f_j), v3(&o.t_i), v3(&o.t_j), [o.f_n.f64(), if o.clamped { 1.0 } else { 0.0 }, 0.0]].concat()));
+        s.put_reals("clock", [self.since_eval.f64(), self.time, self.external_work]);
+        s.put_ints("counters", [self.step, self.rebuilds, self.forces_valid as u64]);
+        Some(s)
+    }
+
+    fn restore(&mut self, s: &EngineState) -> anyhow::Result<()> {
+        let n = self.body.len();
+        let v3 = |a: &[f64]| Vec3::new(T::of(a[0]), T::of(a[1]), T::of(a[2]));
+        for (b, c) in self.body.iter_mut().zip(s.reals("body", 9 * n)?.chunks_exact(9)) {
+            *b = Body { pos: v3(&c[0..3]), vel: v3(&c[3..6]), omega: v3(&c[6..9]) };
+        }
+        for (l, c) in self.load.iter_mut().zip(s.reals("load", 6 * n)?.chunks_exact(6)) {
+            *l = Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) };
+        }
+        for (l, c) in self.wall_load.iter_mut().zip(s.reals("wall_load", 6 * n)?.chunks_exact(6)) {
+            *l = Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) };
+        }
+        for (b, c) in self.built_at.iter_mut().zip(s.reals("built_at", 3 * n)?.chunks_exact(3)) {
+            *b = v3(c);
+        }
+        let images = s.ints("image", Some(3 * self.image.len()))?;
+        for (i, c) in self.image.iter_mut().zip(images.chunks_exact(3)) {
+            *i = [c[0] as i64 as i32, c[1] as i64 as i32, c[2] as i64 as i32];
+        }
+        if let Some(q) = &mut self.orientation {
+            for (q, c) in q.iter_mut().zip(s.reals("orientation", 4 * n)?.chunks_exact(4)) {
+                *q = [T::of(c[0]), T::of(c[1]), T::of(c[2]), T::of(c[3])];
+            }
+        }
+        self.wall_hist = s.reals("wall_hist", self.wall_hist.len())?.iter().map(|&x| T::of(x)).collect();
+        self.wall_reaction = s.reals("wall_reaction", 3 * self.walls.len())?.chunks_exact(3).map(v3).collect();
+        self.wall_count = s.ints("wall_count", Some(self.walls.len()))?.to_vec();
+        if let Some(p) = &mut self.piston {
+            let v = s.reals("piston", 3)?;
+            self.walls[p.wall].geom = WallGeom::Piston { z: T::of(v[0]) };
+            self.walls[p.wall].velocity.z = T::of(v[1]);
+            p.pressure = T::of(v[2]);
+        }
+        let u32s = |name: &str, len: Option<usize>| -> anyhow::Result<Vec<u32>> { Ok(s.ints(name, len)?.iter().map(|&x| x as u32).collect()) };
+        let owner = u32s("owner", None)?;
+        let n_pairs = owner.len();
+        self.pairs = PairList {
+            owner_start: u32s("owner_start", Some(n + 1))?,
+            owner,
+            partner: u32s("partner", Some(n_pairs))?,
+            rev_start: u32s("rev_start", Some(n + 1))?,
+            rev_pair: u32s("rev_pair", Some(n_pairs))?,
+        };
+        self.hist = s.reals("hist", n_pairs * self.slots.stride)?.iter().map(|&x| T::of(x)).collect();
+        self.out = s
+            .reals("out", 15 * n_pairs)?
+            .chunks_exact(15)
+            .map(|c| ContactForce { f_i: v3(&c[0..3]), f_j: v3(&c[3..6]), t_i: v3(&c[6..9]), t_j: v3(&c[9..12]), f_n: T::of(c[12]), clamped: c[13] != 0.0 })
+            .collect();
+        let clock = s.reals("clock", 3)?;
+        (self.since_eval, self.time, self.external_work) = (T::of(clock[0]), clock[1], clock[2]);
+        let counters = s.ints("counters", Some(3))?;
+        (self.step, self.rebuilds, self.forces_valid) = (counters[0], counters[1], counters[2] != 0);
+        Ok(())
     }
 
     fn place_piston(&mut self, z: f64) {

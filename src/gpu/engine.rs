@@ -882,6 +882,14 @@ impl Engine for GpuEngine {
         }
     }
 
+    fn save(&self) -> Option<crate::checkpoint::EngineState> {
+        None
+    }
+
+    fn restore(&mut self, _: &crate::checkpoint::EngineState) -> anyhow::Result<()> {
+        anyhow::bail!("the GPU backend does not resume from checkpoints yet; fix: resume with --backend cpu")
+    }
+
     fn place_piston(&mut self, z: f64) {
         if let Some(w) = self.piston {
             let base = (w * std::mem::size_of::<layout::Wall>()) as u64;

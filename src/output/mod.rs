@@ -8,8 +8,9 @@ mod summary;
 
 pub use summary::{check_report, Summary, ESTIMATE_PAIRS_PER_GRAIN};
 
-use crate::engine::{Frame, Stats};
-use crate::protocol::{Recorder, StageResult};
+use crate::checkpoint::{CheckpointHeader, RunIdentity};
+use crate::engine::{Engine, Frame, Stats};
+use crate::protocol::{Progress, Recorder, StageResult};
 use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::fs::File;
@@ -66,6 +67,12 @@ impl Csv {
         let out = BufWriter::new(File::create(&path).with_context(|| format!("cannot create {}", path.display()))?);
         Ok(Csv { path, out, header_written: false })
     }
+    /// Opens an existing CSV to add rows after a resume.
+    fn append(path: PathBuf) -> anyhow::Result<Self> {
+        let header_written = path.exists();
+        let file = std::fs::OpenOptions::new().create(true).append(true).open(&path).with_context(|| format!("cannot open {}", path.display()))?;
+        Ok(Csv { path, out: BufWriter::new(file), header_written })
+    }
     fn row(&mut self, stage: &str, s: &Stats) -> anyhow::Result<()> {
         if !self.header_written {
             writeln!(self.out, "{}", stats_header(s))?;
@@ -85,6 +92,8 @@ pub struct RunRecorder {
     frames: Option<mcap::McapRecorder>,
     bar: ProgressBar,
     bar_stage: String,
+    /// Where checkpoints go and what they belong to.
+    checkpoint: Option<(PathBuf, RunIdentity)>,
 }
 
 impl RunRecorder {
@@ -104,7 +113,24 @@ impl RunRecorder {
             }
             None => (None, None, None),
         };
-        Ok(RunRecorder { stats, stages, frames, bar, bar_stage: String::new() })
+        Ok(RunRecorder { stats, stages, frames, bar, bar_stage: String::new(), checkpoint: None })
+    }
+
+    /// Continues the files of a run resumed at stage `next_stage`: rows are appended to the
+    /// CSV files, frames go to `frames-from-stage<next_stage>.mcap` (the earlier recording is
+    /// complete and kept).
+    pub fn resume(dir: &Path, next_stage: usize, progress: bool) -> anyhow::Result<Self> {
+        let mut r = RunRecorder::new(None, progress)?;
+        r.stats = Some(Csv::append(dir.join("stats.csv"))?);
+        r.stages = Some(Csv::append(dir.join("stages.csv"))?);
+        r.frames = Some(mcap::McapRecorder::create(&dir.join(format!("frames-from-stage{next_stage}.mcap")))?);
+        Ok(r)
+    }
+
+    /// Writes a checkpoint into `dir` at every stage boundary (CPU engines).
+    pub fn with_checkpoints(mut self, dir: &Path, identity: RunIdentity) -> Self {
+        self.checkpoint = Some((dir.join(crate::checkpoint::FILE), identity));
+        self
     }
 
     /// Flushes the CSV files and closes the MCAP recording (also what a failed run keeps).
@@ -143,6 +169,12 @@ impl Recorder for RunRecorder {
         }
         Ok(())
     }
+    fn checkpoint(&mut self, progress: &Progress, engine: &dyn Engine) -> anyhow::Result<()> {
+        let (Some((path, identity)), Some(state)) = (&self.checkpoint, engine.save()) else { return Ok(()) };
+        let header = CheckpointHeader { identity: identity.clone(), progress: progress.clone() };
+        crate::checkpoint::write(path, &header, &state)
+    }
+
     fn progress(&mut self, stage: &str, done: u64, total: u64) {
         if self.bar_stage != stage {
             self.bar_stage = stage.to_string();

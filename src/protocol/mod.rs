@@ -6,7 +6,7 @@ use crate::analysis::{container_volume, contact_moments, macroscopic_stress, sol
 use crate::engine::{Engine, Frame, SimError, Stats};
 use crate::periodic::Periodic;
 use crate::scene::{Scene, Stage, StageKind};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A run whose mechanical energy (kinetic + elastic + gravitational - external work) grows
 /// above its start by more than this fraction of the energy in play is unstable: with
@@ -20,12 +20,12 @@ pub fn suggested_dt(scene: &Scene) -> f64 {
 }
 
 /// What a stage did.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StageResult {
     /// Stage name.
     pub name: String,
     /// "fill", "settle" or "run".
-    pub kind: &'static str,
+    pub kind: String,
     /// Steps taken in the stage.
     pub steps: u64,
     /// Simulated time at the start and the end (s).
@@ -45,7 +45,7 @@ pub struct StageResult {
 }
 
 /// The state of an oedometric sample at the end of a pressure step.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CompressionPoint {
     /// The piston's target pressure (Pa).
     pub target_pressure: f64,
@@ -77,18 +77,52 @@ pub trait Recorder {
     fn stage_end(&mut self, r: &StageResult) -> anyhow::Result<()>;
     /// Progress within a stage: steps done out of at most `total`.
     fn progress(&mut self, stage: &str, done: u64, total: u64);
+    /// A stage boundary: the moment to write a checkpoint of `engine` and `progress`.
+    fn checkpoint(&mut self, progress: &Progress, engine: &dyn Engine) -> anyhow::Result<()>;
+}
+
+/// Where a run stands between stages: what a checkpoint stores besides the engine.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Progress {
+    /// Index of the next stage to run.
+    pub next_stage: usize,
+    /// Results of the stages run so far.
+    pub results: Vec<StageResult>,
+    /// The stability guard's references.
+    guard: Guard,
+    /// Simulated time of the next frame, when frames are taken at an interval.
+    next_frame: Option<f64>,
+}
+
+impl Progress {
+    /// The start of a run on a freshly set-up engine.
+    pub fn start(scene: &Scene, engine: &mut dyn Engine) -> Self {
+        let stats = engine.stats();
+        Progress {
+            next_stage: 0,
+            results: Vec::new(),
+            guard: Guard::new(scene, &stats),
+            next_frame: (scene.output.frame_interval > 0.0).then(|| engine.time()),
+        }
+    }
 }
 
 /// Runs every stage of `scene` on `engine`.
 pub fn run(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn Recorder) -> anyhow::Result<Vec<StageResult>> {
-    let start = engine.stats();
-    let guard = Guard::new(scene, &start);
-    let mut next_frame = if scene.output.frame_interval > 0.0 { Some(engine.time()) } else { None };
-    let mut results = Vec::with_capacity(scene.stages.len());
-    for stage in &scene.stages {
-        results.push(run_stage(scene, stage, engine, rec, &guard, &mut next_frame)?);
+    let progress = Progress::start(scene, engine);
+    run_from(scene, engine, rec, progress)
+}
+
+/// Runs the stages from `progress` on (a fresh start, or a resumed checkpoint), offering a
+/// checkpoint to the recorder after each.
+pub fn run_from(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn Recorder, mut progress: Progress) -> anyhow::Result<Vec<StageResult>> {
+    while let Some(stage) = scene.stages.get(progress.next_stage) {
+        let result = run_stage(scene, stage, engine, rec, &progress.guard, &mut progress.next_frame)?;
+        progress.results.push(result);
+        progress.next_stage += 1;
+        rec.checkpoint(&progress, engine)?;
     }
-    Ok(results)
+    Ok(progress.results)
 }
 
 fn run_stage(
@@ -149,7 +183,8 @@ fn run_stage(
             StageKind::Fill => "fill",
             StageKind::Settle => "settle",
             StageKind::Run => "run",
-        },
+        }
+        .to_string(),
         steps: engine.steps() - step0,
         time_start: time0,
         time_end: engine.time(),
@@ -189,6 +224,7 @@ fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, sett
 }
 
 /// The stability checks made at every statistics read.
+#[derive(Clone, Debug, Serialize, Deserialize)]
 struct Guard {
     max_overlap: f64,
     suggested_dt: f64,
