@@ -58,6 +58,8 @@ pub fn concise(value: f64, error: f64) -> String {
 pub struct BauerFit {
     /// Void ratio at zero pressure (fitted, or given).
     pub e0: Estimate,
+    /// True when e0 was fitted, false when it was given (measured).
+    pub e0_fitted: bool,
     /// Granular hardness h_s (Pa).
     pub h_s: Estimate,
     /// Exponent eta.
@@ -76,10 +78,12 @@ impl BauerFit {
         bauer(self.e0.value, self.h_s.value, self.eta.value, self.stress_factor * p)
     }
 
-    /// The paper's line: `h_s = 19.1(1.1) MPa, eta = 0.57(1), e0 = 0.712(3)`.
+    /// The paper's line: `h_s = 19.1(1.1) MPa, eta = 0.57(1), e0 = 0.712(3)` (e0 without an
+    /// error when it was measured, not fitted).
     pub fn line(&self) -> String {
         let mpa = Estimate { value: self.h_s.value / 1e6, error: self.h_s.error / 1e6 };
-        format!("h_s = {} MPa, eta = {}, e0 = {}", mpa.concise(), self.eta.concise(), self.e0.concise())
+        let e0 = if self.e0_fitted { self.e0.concise() } else { format!("{:.4} (measured)", self.e0.value) };
+        format!("h_s = {} MPa, eta = {}, e0 = {e0}", mpa.concise(), self.eta.concise())
     }
 }
 
@@ -230,6 +234,7 @@ pub fn fit_bauer(points: &[(f64, f64)], e0: Option<f64>, stress_factor: f64) -> 
     let h_s = theta[0].exp();
     Ok(BauerFit {
         e0: if theta.len() == 3 { Estimate { value: theta[2], error: err(2) } } else { Estimate { value: e0.unwrap_or(1.0), error: 0.0 } },
+        e0_fitted: theta.len() == 3,
         h_s: Estimate { value: h_s, error: h_s * err(0) },
         eta: Estimate { value: theta[1], error: err(1) },
         stress_factor,

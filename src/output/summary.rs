@@ -67,7 +67,8 @@ impl Summary {
         let frame = engine.frame(false);
         let piston_z = last.and_then(|s| s.piston.as_ref().map(|p| p.z));
         let compression: Vec<CompressionPoint> = stages.iter().filter_map(|s| s.compression.clone()).collect();
-        let bauer = fit_compression(&compression);
+        let e0 = stages.iter().find_map(|s| s.initial_void_ratio);
+        let bauer = fit_compression(&compression, e0);
         Summary {
             scene: scene.name.clone(),
             file: scene.path.display().to_string(),
@@ -143,14 +144,15 @@ impl Summary {
 /// Points below which no Bauer fit is tried.
 pub const MIN_BAUER_POINTS: usize = 4;
 
-/// Bauer's law through the measured pressures and void ratios: `Ok(None)` with too few
-/// points to try.
-fn fit_compression(points: &[CompressionPoint]) -> Result<Option<BauerFit>, String> {
+/// Bauer's law through the measured pressures and void ratios, with e0 the void ratio
+/// measured before loading (as the experiment measures it) when known, else fitted:
+/// `Ok(None)` with too few points to try.
+fn fit_compression(points: &[CompressionPoint], e0: Option<f64>) -> Result<Option<BauerFit>, String> {
     if points.len() < MIN_BAUER_POINTS {
         return Ok(None);
     }
     let data: Vec<(f64, f64)> = points.iter().map(|c| (c.pressure, c.void_ratio)).collect();
-    fit_bauer(&data, None, 1.0).map(Some).map_err(|e| e.to_string())
+    fit_bauer(&data, e0, 1.0).map(Some).map_err(|e| e.to_string())
 }
 
 /// Pairs per grain assumed by the memory estimate (a dense packing with a 10% skin).

@@ -42,6 +42,9 @@ pub struct StageResult {
     pub stats: Stats,
     /// The compression point of an oedometer step.
     pub compression: Option<CompressionPoint>,
+    /// The void ratio of the sample when the piston was lowered onto it (Bauer's e0,
+    /// measured before any pressure acts), for the stage that lowered it.
+    pub initial_void_ratio: Option<f64>,
 }
 
 /// The state of an oedometric sample at the end of a pressure step.
@@ -136,10 +139,12 @@ fn run_stage(
     if let Some(p) = stage.piston_pressure {
         engine.set_piston_pressure(p);
     }
+    let mut initial_void_ratio = None;
     if stage.lower_piston {
         let f = engine.frame(false);
         let top = (0..f.radius.len()).map(|i| f.position[i][2] + f.radius[i]).fold(f64::NEG_INFINITY, f64::max);
         engine.place_piston(top);
+        initial_void_ratio = container_volume(scene, top).map(|v| void_ratio(solid_volume(&f), v));
     }
     let dt = scene.time_step.dt;
     let total = (stage.duration / dt).round().max(1.0) as u64;
@@ -193,6 +198,7 @@ fn run_stage(
         unbalanced_force: stats.unbalanced_force,
         stats,
         compression,
+        initial_void_ratio,
     };
     rec.stage_end(&result)?;
     Ok(result)
