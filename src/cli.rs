@@ -70,6 +70,33 @@ pub enum Command {
     },
     /// List the GPU adapters with their backend and limits.
     Devices,
+    /// Run a scene over a grid of parameter values (resumable) and gather the table, the
+    /// power law h_s = a eta^b and its plot.
+    Sweep {
+        /// Sweep file (TOML).
+        sweep: PathBuf,
+        /// Directory of the points (default: next to the sweep file, `<name>-runs`).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Run point K alone (0-based) and stop; a plain `grains sweep` gathers afterwards.
+        #[arg(long, value_name = "K")]
+        only: Option<usize>,
+        /// Write an sbatch job-array script (one task per point) into the out directory.
+        #[arg(long)]
+        emit_slurm: bool,
+        /// Points run at once (default: all cores, one thread each).
+        #[arg(long)]
+        jobs: Option<usize>,
+        /// Worker threads per point.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// CPU precision of the points.
+        #[arg(long, value_enum, default_value = "f64")]
+        precision: Precision,
+        /// Print the gathered table as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
     /// Fit a law to measured points.
     Fit {
         /// Which law.

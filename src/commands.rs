@@ -2,16 +2,14 @@
 
 use crate::cli::{Backend, Cli, Command, FitLaw, Precision};
 use anyhow::Context;
-use grains::checkpoint::{CheckpointHeader, EngineState, RunIdentity};
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
 use grains::gpu::GpuEngine;
-use grains::output::{RunRecorder, Summary};
+use grains::output::Summary;
 use grains::protocol::Progress;
 use grains::scene::{self, Scene};
 use std::io::IsTerminal;
 use std::path::Path;
-use std::time::Instant;
 
 /// Runs one command.
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
@@ -21,7 +19,10 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             // loops split work among workers instead of waking them from outside every time.
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start the worker threads")?;
             match resume {
-                Some(dir) => pool.install(|| resume_run(&dir, scene.as_deref(), precision, json)),
+                Some(dir) => {
+                    let precision = precision.map(|p| if p == Precision::F32 { "f32" } else { "f64" });
+                    report(&pool.install(|| grains::runner::resume(&dir, scene.as_deref(), precision, progress_bar(json)))?, json)
+                }
                 None => {
                     let path = scene.expect("clap requires a scene without --resume");
                     let scene = scene::load(&path)?;
@@ -30,12 +31,13 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                             eprintln!("warning: {w}");
                         }
                     }
-                    pool.install(|| {
+                    let summary = pool.install(|| {
                         let mut engine = engine_for(&scene, backend, adapter.as_deref(), precision, json)?;
-                        let progress = grains::protocol::Progress::start(&scene, engine.as_mut());
-                        let identity = identity(&path, engine.as_ref())?;
-                        run(&scene, engine.as_mut(), out.as_deref(), json, progress, identity, false)
-                    })
+                        let start = Progress::start(&scene, engine.as_mut());
+                        let identity = grains::runner::identity(&path, engine.as_ref())?;
+                        grains::runner::execute(&scene, engine.as_mut(), out.as_deref(), start, identity, false, progress_bar(json))
+                    })?;
+                    report(&summary, json)
                 }
             }
         }
@@ -51,6 +53,53 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 println!("{}", serde_json::to_string(&fit)?);
             } else {
                 println!("{} ({} points, rms residual {:.2e}{})", fit.line(), fit.points, fit.rms, if mean_stress { ", mean-stress form 3p/h_s" } else { "" });
+            }
+            Ok(())
+        }
+        Command::Sweep { sweep, out, only, emit_slurm, jobs, threads, precision, json } => {
+            let sw = grains::sweep::load(&sweep)?;
+            let out = out.unwrap_or_else(|| {
+                let stem = sweep.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "sweep".into());
+                sweep.parent().unwrap_or(Path::new(".")).join(format!("{stem}-runs"))
+            });
+            std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+            if emit_slurm {
+                let exe = std::env::current_exe().context("cannot find the grains executable")?;
+                let path = out.join("sweep.sbatch");
+                std::fs::write(&path, sw.slurm_script(&out, &exe)).with_context(|| format!("cannot write {}", path.display()))?;
+                println!("{} ({} tasks); submit with `sbatch {}`, then gather with `grains sweep {} --out {}`", path.display(), sw.points.len(), path.display(), sweep.display(), out.display());
+                return Ok(());
+            }
+            let precision = if precision == Precision::F32 { "f32" } else { "f64" };
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let points: Vec<usize> = match only {
+                Some(k) if k >= sw.points.len() => anyhow::bail!("--only {k}: the sweep has points 0 to {}; fix: give one of those", sw.points.len() - 1),
+                Some(k) => vec![k],
+                None => sw.points.iter().filter(|p| !grains::sweep::done(&out, p)).map(|p| p.index).collect(),
+            };
+            let threads = threads.unwrap_or(if only.is_some() { cores } else { 1 });
+            let jobs = jobs.unwrap_or((cores / threads).max(1)).min(points.len().max(1));
+            let failures = grains::sweep::run_points(&sw, &out, &points, precision, jobs, threads);
+            if only.is_none() {
+                let table = grains::sweep::gather(&sw, &out)?;
+                std::fs::write(out.join("sweep.csv"), table.csv())?;
+                std::fs::write(out.join("sweep.json"), serde_json::to_string_pretty(&table)?)?;
+                let fitted: Vec<_> = table.rows.iter().filter_map(|r| Some((r.eta?, r.h_s?))).collect();
+                if !fitted.is_empty() {
+                    let title = sweep.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+                    if let Err(e) = grains::output::plot::hardness(&out.join("hardness"), &title, &fitted, table.power_law.as_ref()) {
+                        eprintln!("warning: {e:#}");
+                    }
+                }
+                if json {
+                    println!("{}", serde_json::to_string(&table)?);
+                } else {
+                    print!("{}", table.human());
+                }
+            }
+            if !failures.is_empty() {
+                let list: Vec<String> = failures.iter().map(|(k, e)| format!("point {k}: {e}")).collect();
+                anyhow::bail!("{} of {} points failed ({}); fix: see each point's error, then run the sweep again to retry them", failures.len(), points.len(), list.join("; "));
             }
             Ok(())
         }
@@ -82,15 +131,15 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     }
 }
 
+/// A progress bar on a terminal, not with --json.
+fn progress_bar(json: bool) -> bool {
+    !json && std::io::stderr().is_terminal()
+}
+
 /// The engine `--backend` and `--precision` ask for.
 fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision: Option<Precision>, quiet: bool) -> anyhow::Result<Box<dyn Engine>> {
     let gpu = |gpu| -> anyhow::Result<Box<dyn Engine>> { Ok(Box::new(GpuEngine::new(gpu, scene)?)) };
-    let cpu = |precision: Option<Precision>| -> anyhow::Result<Box<dyn Engine>> {
-        Ok(match precision.unwrap_or(Precision::F64) {
-            Precision::F32 => Box::new(CpuEngine::<f32>::new(scene)?),
-            Precision::F64 => Box::new(CpuEngine::<f64>::new(scene)?),
-        })
-    };
+    let cpu = |precision: Option<Precision>| grains::runner::cpu_engine(scene, if precision == Some(Precision::F32) { "f32" } else { "f64" });
     match backend {
         Backend::Cpu => cpu(precision),
         Backend::Gpu => {
@@ -116,71 +165,10 @@ fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision:
     }
 }
 
-/// What a checkpoint of this run belongs to.
-fn identity(scene_file: &Path, engine: &dyn Engine) -> anyhow::Result<RunIdentity> {
-    let text = std::fs::read(scene_file).with_context(|| format!("cannot read {}", scene_file.display()))?;
-    Ok(RunIdentity {
-        scene_file: scene_file.display().to_string(),
-        scene_hash: grains::checkpoint::fnv1a(&text),
-        backend: engine.backend().to_string(),
-        precision: engine.precision().to_string(),
-    })
-}
-
-/// `grains run --resume DIR`: the run of DIR's checkpoint, continued into DIR.
-fn resume_run(dir: &Path, scene_file: Option<&Path>, precision: Option<Precision>, json: bool) -> anyhow::Result<()> {
-    let (header, state): (CheckpointHeader, EngineState) = grains::checkpoint::read(&dir.join(grains::checkpoint::FILE))?;
-    let id = &header.identity;
-    let path = scene_file.map(Path::to_path_buf).unwrap_or_else(|| id.scene_file.clone().into());
-    let scene = scene::load(&path)?;
-    let text = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
-    if grains::checkpoint::fnv1a(&text) != id.scene_hash {
-        anyhow::bail!("{}: the scene differs from the one the checkpoint in {} was written for; fix: restore the scene or start the run afresh", path.display(), dir.display());
-    }
-    let wanted = match id.precision.as_str() {
-        "f32" => Precision::F32,
-        _ => Precision::F64,
-    };
-    if precision.is_some_and(|p| p != wanted) {
-        anyhow::bail!("the checkpoint was written in {}; fix: drop --precision or give --precision {}", id.precision, id.precision);
-    }
-    let mut engine = engine_for(&scene, Backend::Cpu, None, Some(wanted), json)?;
-    engine.restore(&state).with_context(|| format!("cannot resume from {}", dir.display()))?;
-    let identity = identity(&path, engine.as_ref())?;
-    run(&scene, engine.as_mut(), Some(dir), json, header.progress, identity, true)
-}
-
-fn run(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, json: bool, start: Progress, identity: RunIdentity, resumed: bool) -> anyhow::Result<()> {
-    let progress = !json && std::io::stderr().is_terminal();
-    let rec = match (out, resumed) {
-        (Some(dir), true) => RunRecorder::resume(dir, start.next_stage, progress)?,
-        _ => RunRecorder::new(out, progress)?,
-    };
-    let mut rec = match out {
-        Some(dir) => rec.with_checkpoints(dir, identity),
-        None => rec,
-    };
-    let started = Instant::now();
-    let result = grains::protocol::run_from(scene, engine, &mut rec, start);
-    let wall_seconds = started.elapsed().as_secs_f64();
-    // Whatever happened, keep what was recorded.
-    rec.finish()?;
-    let stages = result?;
-    let threads = if engine.backend() == "cpu" { rayon::current_num_threads() } else { 1 };
-    let summary = Summary::new(scene, engine, threads, wall_seconds, stages);
-    if let Some(dir) = out {
-        let path = dir.join("summary.json");
-        std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))?;
-        if !summary.compression.is_empty() {
-            let path = dir.join("compression.csv");
-            std::fs::write(&path, summary.compression_csv()).with_context(|| format!("cannot write {}", path.display()))?;
-            if let Err(e) = grains::output::plot::compression(&dir.join("compression"), &scene.name, &summary.compression, summary.bauer.as_ref()) {
-                eprintln!("warning: {e:#}");
-            }
-        }
-    }
+/// Prints a finished run's summary.
+fn report(summary: &Summary, json: bool) -> anyhow::Result<()> {
     if json {
-        println!("{}", serde_json::to_string(&summary)?);
+        println!("{}", serde_json::to_string(summary)?);
     } else {
         print!("{}", summary.human());
     }

@@ -16,6 +16,8 @@ pub mod output;
 pub mod periodic;
 pub mod protocol;
 pub mod real;
+pub mod runner;
 pub mod scene;
+pub mod sweep;
 pub mod timestep;
 pub mod walls;

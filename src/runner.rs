@@ -1,0 +1,92 @@
+//! Running a scene end to end with its outputs: what `grains run` and every sweep point do.
+
+use crate::checkpoint::{CheckpointHeader, EngineState, RunIdentity};
+use crate::cpu::CpuEngine;
+use crate::engine::Engine;
+use crate::output::{RunRecorder, Summary};
+use crate::protocol::Progress;
+use crate::scene::{self, Scene};
+use anyhow::Context;
+use std::path::Path;
+use std::time::Instant;
+
+/// What a checkpoint of this run belongs to.
+pub fn identity(scene_file: &Path, engine: &dyn Engine) -> anyhow::Result<RunIdentity> {
+    let text = std::fs::read(scene_file).with_context(|| format!("cannot read {}", scene_file.display()))?;
+    Ok(RunIdentity {
+        scene_file: scene_file.display().to_string(),
+        scene_hash: crate::checkpoint::fnv1a(&text),
+        backend: engine.backend().to_string(),
+        precision: engine.precision().to_string(),
+    })
+}
+
+/// A CPU engine of precision "f32" or "f64".
+pub fn cpu_engine(scene: &Scene, precision: &str) -> anyhow::Result<Box<dyn Engine>> {
+    Ok(match precision {
+        "f32" => Box::new(CpuEngine::<f32>::new(scene)?),
+        _ => Box::new(CpuEngine::<f64>::new(scene)?),
+    })
+}
+
+/// Runs the stages from `start` on, recording into `out` (with checkpoints at every stage
+/// end), and writes `summary.json` last: a directory with a summary holds a finished run.
+pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start: Progress, identity: RunIdentity, resumed: bool, progress_bar: bool) -> anyhow::Result<Summary> {
+    let rec = match (out, resumed) {
+        (Some(dir), true) => RunRecorder::resume(dir, start.next_stage, progress_bar)?,
+        _ => RunRecorder::new(out, progress_bar)?,
+    };
+    let mut rec = match out {
+        Some(dir) => rec.with_checkpoints(dir, identity),
+        None => rec,
+    };
+    let started = Instant::now();
+    let result = crate::protocol::run_from(scene, engine, &mut rec, start);
+    let wall_seconds = started.elapsed().as_secs_f64();
+    // Whatever happened, keep what was recorded.
+    rec.finish()?;
+    let stages = result?;
+    let threads = if engine.backend() == "cpu" { rayon::current_num_threads() } else { 1 };
+    let summary = Summary::new(scene, engine, threads, wall_seconds, stages);
+    if let Some(dir) = out {
+        if !summary.compression.is_empty() {
+            let path = dir.join("compression.csv");
+            std::fs::write(&path, summary.compression_csv()).with_context(|| format!("cannot write {}", path.display()))?;
+            if let Err(e) = crate::output::plot::compression(&dir.join("compression"), &scene.name, &summary.compression, summary.bauer.as_ref()) {
+                eprintln!("warning: {e:#}");
+            }
+        }
+        let path = dir.join("summary.json");
+        std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(summary)
+}
+
+/// A fresh run of the scene file on a CPU engine, into `out`.
+pub fn run_cpu(scene_file: &Path, precision: &str, out: Option<&Path>, progress_bar: bool) -> anyhow::Result<Summary> {
+    let scene = scene::load(scene_file)?;
+    let mut engine = cpu_engine(&scene, precision)?;
+    let start = Progress::start(&scene, engine.as_mut());
+    let id = identity(scene_file, engine.as_ref())?;
+    execute(&scene, engine.as_mut(), out, start, id, false, progress_bar)
+}
+
+/// Continues the run of `dir` from its checkpoint (CPU), into `dir`. The scene is the one the
+/// checkpoint names unless `scene_file` is given; it must be unchanged.
+pub fn resume(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, progress_bar: bool) -> anyhow::Result<Summary> {
+    let (header, state): (CheckpointHeader, EngineState) = crate::checkpoint::read(&dir.join(crate::checkpoint::FILE))?;
+    let id = &header.identity;
+    let path = scene_file.map(Path::to_path_buf).unwrap_or_else(|| id.scene_file.clone().into());
+    let scene = scene::load(&path)?;
+    let text = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    if crate::checkpoint::fnv1a(&text) != id.scene_hash {
+        anyhow::bail!("{}: the scene differs from the one the checkpoint in {} was written for; fix: restore the scene or start the run afresh", path.display(), dir.display());
+    }
+    if precision.is_some_and(|p| p != id.precision) {
+        anyhow::bail!("the checkpoint was written in {}; fix: drop --precision or give --precision {}", id.precision, id.precision);
+    }
+    let mut engine = cpu_engine(&scene, &id.precision)?;
+    engine.restore(&state).with_context(|| format!("cannot resume from {}", dir.display()))?;
+    let identity = identity(&path, engine.as_ref())?;
+    execute(&scene, engine.as_mut(), Some(dir), header.progress, identity, true, progress_bar)
+}

@@ -1,0 +1,82 @@
+//! Sweeps: points run separately (`--only K`, as a cluster's job array would) are gathered by
+//! a plain `grains sweep`, which runs only what is missing; the table holds each point's
+//! parameters and fit; the Slurm script names one task per point.
+
+mod common;
+
+use std::process::Command;
+
+/// A tiny oedometer (50 grains, Hertz-Mindlin so that each step settles, four steps).
+fn tiny_oedometer() -> String {
+    std::fs::read_to_string(common::scene_path("oedometer.toml"))
+        .unwrap()
+        .replace("count = 1200", "count = 50")
+        .replace("radius = 6.0e-3, z_min = 0.0, z_max = 20.0e-3", "radius = 2.5e-3, z_min = 0.0, z_max = 9.0e-3")
+        .replace("radius = 6.0e-3\n", "radius = 2.5e-3\n")
+        .replace("z = 21.0e-3", "z = 10.0e-3")
+        .replace("mu_k = 0.3\n", "")
+        .replace("rolling_angle = 2.0\n", "")
+        .replace("tangential = \"oquendo\"", "tangential = \"mindlin\"\ntangential_damping_ratio = 0.9\n#")
+        .replace("v_slip = 1.0e-3", "#")
+        .replace("v_roll = 1.0e-3", "#")
+        .replace("p_max = 1.6e6", "p_max = 100.0e3")
+        .replace("duration = 0.04 ", "duration = 0.02 ")
+}
+
+fn grains(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_grains")).args(args).env("RUST_BACKTRACE", "0").output().unwrap()
+}
+
+#[test]
+fn points_run_apart_are_gathered_and_only_the_missing_one_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), tiny_oedometer()).unwrap();
+    let sweep = dir.path().join("mu.toml");
+    std::fs::write(&sweep, "scene = \"tiny.toml\"\n[parameters]\n\"material.sand.mu_s\" = [0.2, 0.4, 0.6]\n").unwrap();
+    let out = dir.path().join("runs");
+    let (s, o) = (sweep.to_str().unwrap(), out.to_str().unwrap());
+
+    let slurm = grains(&["sweep", s, "--out", o, "--emit-slurm"]);
+    assert!(slurm.status.success(), "{}", String::from_utf8_lossy(&slurm.stderr));
+    let script = std::fs::read_to_string(out.join("sweep.sbatch")).unwrap();
+    assert!(script.contains("#SBATCH --array=0-2") && script.contains("--only \"$SLURM_ARRAY_TASK_ID\""), "{script}");
+
+    for k in ["0", "2"] {
+        let r = grains(&["sweep", s, "--out", o, "--only", k]);
+        assert!(r.status.success(), "point {k}: {}", String::from_utf8_lossy(&r.stderr));
+    }
+    assert!(!out.join("sweep.csv").exists(), "--only runs one point and gathers nothing");
+    let stamp = |k: usize| std::fs::metadata(out.join(format!("point-{k:03}/summary.json"))).unwrap().modified().unwrap();
+    let (t0, t2) = (stamp(0), stamp(2));
+
+    let g = grains(&["sweep", s, "--out", o, "--json"]);
+    assert!(g.status.success(), "{}", String::from_utf8_lossy(&g.stderr));
+    let err = String::from_utf8_lossy(&g.stderr);
+    assert!(err.contains("point 1: done") && !err.contains("point 0: done") && !err.contains("point 2: done"), "only point 1 runs: {err}");
+    assert_eq!((stamp(0), stamp(2)), (t0, t2), "finished points are left alone");
+    let table: serde_json::Value = serde_json::from_slice(&g.stdout).unwrap();
+    let rows = table["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 3);
+    for (k, mu) in [0.2, 0.4, 0.6].iter().enumerate() {
+        assert_eq!(rows[k]["point"]["values"]["material.sand.mu_s"].as_f64(), Some(*mu));
+        println!("mu_s = {mu}: e0 = {}, h_s = {} MPa, eta = {}", rows[k]["e0"], rows[k]["h_s"], rows[k]["eta"]);
+        assert!(rows[k]["eta"]["value"].as_f64().is_some(), "point {k} has a Bauer fit: {}", rows[k]);
+    }
+    let csv = std::fs::read_to_string(out.join("sweep.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+    println!("power law: {}", table["power_law"]);
+    assert!(table["power_law"]["b"]["value"].as_f64().is_some());
+}
+
+#[test]
+fn a_bad_parameter_path_is_refused_before_anything_runs() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("tiny.toml"), tiny_oedometer()).unwrap();
+    let sweep = dir.path().join("bad.toml");
+    std::fs::write(&sweep, "scene = \"tiny.toml\"\n[parameters]\n\"material.clay.mu_s\" = [0.2]\n").unwrap();
+    let r = grains(&["sweep", sweep.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert_eq!(r.status.code(), Some(1));
+    assert!(err.contains("material.clay.mu_s") && err.contains("fix:"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+}
