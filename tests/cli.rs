@@ -28,6 +28,8 @@ fn shipped_scenes() -> Vec<std::path::PathBuf> {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        // Sweep files name a scene; they are not scenes themselves.
+        .filter(|p| !p.to_string_lossy().ends_with("_sweep.toml"))
         .collect();
     v.sort();
     v
