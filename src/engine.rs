@@ -100,6 +100,12 @@ pub struct Stats {
     pub non_finite_grain: Option<u32>,
     /// Neighbour-list rebuilds since the start.
     pub rebuilds: u64,
+    /// Liquid bridges (capillary scenes).
+    pub bridges: u64,
+    /// Liquid held in bridges (m^3).
+    pub liquid_in_bridges: f64,
+    /// Liquid held on grains, waiting for their next bridges (m^3).
+    pub liquid_on_grains: f64,
     /// Per-wall forces.
     pub walls: Vec<WallStats>,
     /// The piston, if any.
@@ -150,7 +156,8 @@ pub struct ContactRecord {
     pub j: u32,
     /// Overlap (m).
     pub overlap: f64,
-    /// Normal force magnitude (N, compressive positive).
+    /// Total normal force (N, compressive positive, tensile negative): elastic + damping +
+    /// capillary.
     pub normal_force: f64,
     /// Total force on i (N).
     pub force: [f64; 3],
@@ -202,6 +209,9 @@ pub trait Engine {
     fn save(&self) -> Option<crate::checkpoint::EngineState>;
     /// Restores a state `save` returned, for the same scene, backend and precision.
     fn restore(&mut self, state: &crate::checkpoint::EngineState) -> anyhow::Result<()>;
+    /// Wets the sample with `volume` (m^3) of liquid: shared among the pairs closer than their
+    /// rupture distance in proportion to their reduced diameter (seed 001, PHYSICS.md).
+    fn wet(&mut self, volume: f64) -> anyhow::Result<()>;
     /// Moves the piston to height `z` (m) and stops it; no effect without a piston. The host
     /// places it where it touches nothing yet, so the last forces stay valid.
     fn place_piston(&mut self, z: f64);

@@ -43,6 +43,8 @@ pub trait Real:
     fn abs(self) -> Self;
     /// `self^e`.
     fn powf(self, e: Self) -> Self;
+    /// `e^self`.
+    fn exp(self) -> Self;
     /// The larger of two values.
     fn max(self, o: Self) -> Self;
     /// The smaller of two values.
@@ -78,6 +80,10 @@ macro_rules! impl_real {
             #[inline(always)]
             fn powf(self, e: Self) -> Self {
                 <$t>::powf(self, e)
+            }
+            #[inline(always)]
+            fn exp(self) -> Self {
+                <$t>::exp(self)
             }
             #[inline(always)]
             fn max(self, o: Self) -> Self {

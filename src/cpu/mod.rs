@@ -23,7 +23,7 @@ pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::checkpoint::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
-use crate::model::{normal_potential, ContactForce, ContactModel, PairCoeffs};
+use crate::model::{normal_potential, rupture_distance, CohesionLaw, ContactForce, ContactModel, PairCoeffs};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 use crate::scene::{Integrator, Scene, WallShape};
@@ -61,8 +61,15 @@ pub struct CpuEngine<T: Real> {
     suggested_dt: f64,
     integrator: Integrator,
     skin: T,
+    /// Distance beyond contact that pair detection reaches: the skin plus, for capillary
+    /// scenes, the rupture distance of the largest bridge (m).
+    detect_reach: T,
     cutoff: T,
     capacity: usize,
+    /// Largest bridge volume (m^3).
+    bridge_cap: T,
+    /// Liquid on each grain waiting for its next bridge (m^3); empty without cohesion.
+    liquid: Vec<T>,
     periodic: Periodic<T>,
     // Grains, indexed by slot; `id` is the permanent id (equal to the slot: grains are not
     // reordered yet, so history lookups by slot stay valid across rebuilds).
@@ -144,8 +151,11 @@ impl<T: Real> CpuEngine<T> {
             suggested_dt: crate::protocol::suggested_dt(scene),
             integrator: scene.integrator,
             skin: T::of(scene.skin),
-            cutoff: T::of(2.0 * r_max + scene.skin),
+            detect_reach: T::of(scene.skin + scene.bridges.reach),
+            cutoff: T::of(2.0 * r_max + scene.skin + scene.bridges.reach),
             capacity: scene.max_neighbours,
+            bridge_cap: T::of(scene.bridges.volume_cap),
+            liquid: if slots.layout.bridge { vec![T::ZERO; n] } else { Vec::new() },
             periodic: Periodic::of(&scene.periodic),
             id: (0..n as u32).collect(),
             built_at: body.iter().map(|b| b.pos).collect(),
@@ -192,7 +202,7 @@ impl<T: Real> CpuEngine<T> {
         if !hash_cells(&self.body, self.cutoff, &self.periodic, &mut self.grid) {
             return Err(self.non_finite_error());
         }
-        let pairs = PairList::detect(&self.body, &self.prop, &self.id, &self.grid, &self.periodic, self.skin, self.capacity)
+        let pairs = PairList::detect(&self.body, &self.prop, &self.id, &self.grid, &self.periodic, self.detect_reach, self.capacity)
             .map_err(|(i, count)| SimError::Capacity { step: self.step, grain: self.id[i], count, capacity: self.capacity })?;
         self.hist = pairs::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
         self.pairs = pairs;
@@ -242,8 +252,51 @@ impl<T: Real> CpuEngine<T> {
         &self.pairs
     }
 
-    /// Runs the force passes: `pair_force`, `wall_contacts`, `gather`.
+    /// Gap (m) between the surfaces of pair `k`'s grains (negative when they overlap).
+    fn gap(&self, k: usize) -> T {
+        let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+        self.periodic.min_image(self.body[i].pos - self.body[j].pos).norm() - self.prop[i].radius - self.prop[j].radius
+    }
+
+    /// `update_bridges`: ruptures bridges stretched past their rupture distance, returning
+    /// their liquid to the two grains in equal halves, and forms bridges at new contacts from
+    /// half of each grain's liquid (capped at the largest bridge volume). Serial, in pair
+    /// order, so that a grain forming several bridges in one step gives its liquid out in a
+    /// fixed order; liquid is conserved to round-off.
+    fn update_bridges(&mut self) {
+        let CohesionLaw::Capillary { theta, .. } = self.model.cohesion else { return };
+        let (stride, b) = (self.slots.stride, self.slots.bridge);
+        let half = T::of(0.5);
+        for k in 0..self.pairs.len() {
+            let gap = self.gap(k);
+            let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+            let v = self.hist[k * stride + b];
+            if v > T::ZERO {
+                if gap > rupture_distance(theta, v) {
+                    self.liquid[i] += v * half;
+                    self.liquid[j] += v * half;
+                    self.hist[k * stride + b] = T::ZERO;
+                }
+            } else if gap < T::ZERO && (self.liquid[i] > T::ZERO || self.liquid[j] > T::ZERO) {
+                let (mut a, mut c) = (self.liquid[i] * half, self.liquid[j] * half);
+                if a + c > self.bridge_cap {
+                    let s = self.bridge_cap / (a + c);
+                    a *= s;
+                    c *= s;
+                }
+                self.liquid[i] -= a;
+                self.liquid[j] -= c;
+                self.hist[k * stride + b] = a + c;
+            }
+        }
+    }
+
+    /// Runs the force passes: `update_bridges` (capillary scenes), `pair_force`,
+    /// `wall_contacts`, `gather`.
     fn evaluate_forces(&mut self) {
+        if self.slots.layout.bridge {
+            self.update_bridges();
+        }
         let ctx = ForceContext {
             model: &self.model,
             coeffs: &self.coeffs,
@@ -552,6 +605,15 @@ impl<T: Real> Engine for CpuEngine<T> {
             }
         });
         let piston_ke = self.piston.map_or(0.0, |p| 0.5 * p.mass.f64() * self.walls[p.wall].velocity.z.f64().powi(2));
+        let (bridges, liquid_in_bridges) = if self.slots.layout.bridge {
+            let (stride, b) = (self.slots.stride, self.slots.bridge);
+            chunked(self.pairs.len(), |r| r.map(|k| self.hist[k * stride + b].f64()).filter(|v| *v > 0.0).fold((0u64, 0.0), |(n, s), v| (n + 1, s + v)))
+                .into_iter()
+                .fold((0, 0.0), |(n, s), (m, t)| (n + m, s + t))
+        } else {
+            (0, 0.0)
+        };
+        let liquid_on_grains: f64 = chunked(self.liquid.len(), |r| self.liquid[r].iter().map(|x| x.f64()).sum::<f64>()).into_iter().sum();
         Stats {
             step: self.step,
             time: self.time,
@@ -572,6 +634,9 @@ impl<T: Real> Engine for CpuEngine<T> {
             unbalanced_force,
             non_finite_grain: self.body.iter().position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|i| self.id[i]),
             rebuilds: self.rebuilds,
+            bridges,
+            liquid_in_bridges,
+            liquid_on_grains,
             walls,
             piston,
         }
@@ -590,13 +655,13 @@ impl<T: Real> Engine for CpuEngine<T> {
                 (0..self.pairs.len())
                     .filter_map(|k| {
                         let (h, _) = self.pair_overlap(k);
-                        (h > T::ZERO).then(|| {
+                        (h > T::ZERO || self.out[k].f_c != T::ZERO).then(|| {
                             let spring = if self.slots.layout.tangential { self.slots.load(&self.hist[k * self.slots.stride..]).tangential } else { Vec3::ZERO };
                             ContactRecord {
                                 i: self.id[self.pairs.owner[k] as usize],
                                 j: self.id[self.pairs.partner[k] as usize],
                                 overlap: h.f64(),
-                                normal_force: self.out[k].f_n.f64(),
+                                normal_force: (self.out[k].f_n + self.out[k].f_c).f64(),
                                 force: self.out[k].f_i.f64(),
                                 force_j: self.out[k].f_j.f64(),
                                 tangential_spring: spring.f64(),
@@ -616,6 +681,49 @@ impl<T: Real> Engine for CpuEngine<T> {
         if let Some(p) = &mut self.piston {
             p.pressure = T::of(pressure);
         }
+    }
+
+    fn wet(&mut self, volume: f64) -> anyhow::Result<()> {
+        let CohesionLaw::Capillary { theta, .. } = self.model.cohesion else {
+            anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
+        };
+        // Pairs within their rupture distance share the liquid in proportion to 2 R_eff;
+        // dropping the pairs beyond the rupture distance of their share raises the others'
+        // shares, so repeat until no pair drops.
+        let d: Vec<f64> = (0..self.pairs.len())
+            .map(|k| {
+                let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+                let (ri, rj) = (self.prop[i].radius.f64(), self.prop[j].radius.f64());
+                2.0 * ri * rj / (ri + rj)
+            })
+            .collect();
+        let gaps: Vec<f64> = (0..self.pairs.len()).map(|k| self.gap(k).f64()).collect();
+        let cap = self.bridge_cap.f64();
+        let mut eligible: Vec<usize> = (0..self.pairs.len()).collect();
+        loop {
+            let total: f64 = eligible.iter().map(|&k| d[k]).sum();
+            let share = |k: usize| (volume * d[k] / total).min(cap);
+            let before = eligible.len();
+            eligible.retain(|&k| gaps[k] <= rupture_distance(theta.f64(), share(k)));
+            if eligible.len() == before || eligible.is_empty() {
+                break;
+            }
+        }
+        let total: f64 = eligible.iter().map(|&k| d[k]).sum();
+        let (stride, b) = (self.slots.stride, self.slots.bridge);
+        let mut placed = 0.0;
+        for &k in &eligible {
+            let v = (volume * d[k] / total).min(cap);
+            self.hist[k * stride + b] += T::of(v);
+            placed += v;
+        }
+        // What the bridges could not hold waits on the grains.
+        let rest = T::of((volume - placed) / self.liquid.len() as f64);
+        for l in &mut self.liquid {
+            *l += rest;
+        }
+        self.forces_valid = false;
+        Ok(())
     }
 
     fn save(&self) -> Option<EngineState> {
@@ -645,7 +753,8 @@ impl<T: Real> Engine for CpuEngine<T> {
             s.put_ints(name, v.iter().map(|&x| x as u64));
         }
         s.put_reals("hist", self.hist.iter().map(|x| x.f64()));
-        s.put_reals("out", self.out.iter().flat_map(|o| [v3(&o.f_i), v3(&o.f_j), v3(&o.t_i), v3(&o.t_j), [o.f_n.f64(), if o.clamped { 1.0 } else { 0.0 }, 0.0]].concat()));
+        s.put_reals("liquid", self.liquid.iter().map(|x| x.f64()));
+        s.put_reals("out", self.out.iter().flat_map(|o| [v3(&o.f_i), v3(&o.f_j), v3(&o.t_i), v3(&o.t_j), [o.f_n.f64(), if o.clamped { 1.0 } else { 0.0 }, o.f_c.f64()]].concat()));
         s.put_reals("clock", [self.since_eval.f64(), self.time, self.external_work]);
         s.put_ints("counters", [self.step, self.rebuilds, self.forces_valid as u64]);
         Some(s)
@@ -695,10 +804,11 @@ impl<T: Real> Engine for CpuEngine<T> {
             rev_pair: u32s("rev_pair", Some(n_pairs))?,
         };
         self.hist = s.reals("hist", n_pairs * self.slots.stride)?.iter().map(|&x| T::of(x)).collect();
+        self.liquid = s.reals("liquid", self.liquid.len())?.iter().map(|&x| T::of(x)).collect();
         self.out = s
             .reals("out", 15 * n_pairs)?
             .chunks_exact(15)
-            .map(|c| ContactForce { f_i: v3(&c[0..3]), f_j: v3(&c[3..6]), t_i: v3(&c[6..9]), t_j: v3(&c[9..12]), f_n: T::of(c[12]), clamped: c[13] != 0.0 })
+            .map(|c| ContactForce { f_i: v3(&c[0..3]), f_j: v3(&c[3..6]), t_i: v3(&c[6..9]), t_j: v3(&c[9..12]), f_n: T::of(c[12]), clamped: c[13] != 0.0, f_c: T::of(c[14]) })
             .collect();
         let clock = s.reals("clock", 3)?;
         (self.since_eval, self.time, self.external_work) = (T::of(clock[0]), clock[1], clock[2]);

@@ -3,7 +3,7 @@
 
 use super::pairs::PairList;
 use super::state::{Body, HistorySlots, Props};
-use crate::model::{contact_force, Bodies, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs};
+use crate::model::{capillary_force, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs};
 use crate::periodic::Periodic;
 use crate::real::Real;
 
@@ -24,8 +24,8 @@ pub struct ForceContext<'a, T> {
     pub periodic: Periodic<T>,
 }
 
-/// `pair_force` for pair `k`. A listed pair that does not touch exerts nothing and has its
-/// history zeroed (a contact that separates forgets its springs).
+/// `pair_force` for pair `k`. A listed pair that does not touch forgets its springs and
+/// exerts only the capillary force of its liquid bridge, if it has one within reach.
 #[inline]
 pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, hist: &mut [T]) -> ContactForce<T> {
     let i = pairs.owner[k] as usize;
@@ -35,8 +35,16 @@ pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &
     let dist2 = d.norm2();
     let reach = pi.radius + pj.radius;
     if dist2 >= reach * reach {
-        hist.fill(T::ZERO);
-        return ContactForce::default();
+        ctx.slots.clear_springs(hist);
+        return match ctx.model.cohesion {
+            CohesionLaw::Capillary { kappa, theta, c } if ctx.slots.layout.bridge => {
+                let dist = dist2.sqrt();
+                let f_c = capillary_force(kappa, theta, c, pi.radius, pj.radius, hist[ctx.slots.bridge], dist - reach);
+                let n = d * (T::ONE / dist);
+                ContactForce { f_i: n * f_c, f_j: n * (-f_c), f_c, ..Default::default() }
+            }
+            _ => ContactForce::default(),
+        };
     }
     let geo = Geometry::grain_grain(d, dist2.sqrt(), pi.radius, pj.radius, pi.mass, pj.mass);
     let kin = Kinematics { v_i: bi.vel, v_j: bj.vel, w_i: bi.omega, w_j: bj.omega };

@@ -47,17 +47,27 @@ pub struct HistorySlots {
     pub tangential: usize,
     /// Offset of the rolling spring.
     pub rolling: usize,
+    /// Offset of the bridge volume.
+    pub bridge: usize,
     /// Reals per contact.
     pub stride: usize,
 }
 
 impl HistorySlots {
-    /// Packs the blocks a layout uses, in slot order (tangential, rolling).
+    /// Packs the blocks a layout uses, in slot order (tangential, rolling, bridge).
     pub fn new(layout: HistoryLayout) -> Self {
         let tangential = 0;
         let rolling = if layout.tangential { 3 } else { 0 };
-        let stride = rolling + if layout.rolling { 3 } else { 0 };
-        HistorySlots { layout, tangential, rolling, stride }
+        let bridge = rolling + if layout.rolling { 3 } else { 0 };
+        let stride = bridge + if layout.bridge { 1 } else { 0 };
+        HistorySlots { layout, tangential, rolling, bridge, stride }
+    }
+
+    /// Forgets the springs of a contact that has opened, keeping its liquid bridge.
+    #[inline(always)]
+    pub fn clear_springs<T: Real>(&self, s: &mut [T]) {
+        let end = if self.layout.bridge { self.bridge } else { self.stride };
+        s[..end].fill(T::ZERO);
     }
 
     /// Reads one contact's history (absent blocks read as zero).
@@ -67,6 +77,7 @@ impl HistorySlots {
         History {
             tangential: if self.layout.tangential { v(self.tangential) } else { Vec3::ZERO },
             rolling: if self.layout.rolling { v(self.rolling) } else { Vec3::ZERO },
+            bridge: if self.layout.bridge { s[self.bridge] } else { T::ZERO },
         }
     }
 
@@ -83,6 +94,9 @@ impl HistorySlots {
         }
         if self.layout.rolling {
             put(self.rolling, h.rolling);
+        }
+        if self.layout.bridge {
+            s[self.bridge] = h.bridge;
         }
     }
 }

@@ -38,7 +38,7 @@ pub fn wall_contacts<T: Real>(
         let h_slot = &mut hist[w * stride..(w + 1) * stride];
         let (n, dist) = wall.geom.frame(b.pos);
         if dist >= p.radius {
-            h_slot.fill(T::ZERO);
+            ctx.slots.clear_springs(h_slot);
             continue;
         }
         let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);

@@ -113,6 +113,9 @@ impl GpuEngine {
             if need > have { Err(GpuSetupError::Limit { adapter: adapter.clone(), what, need, have, fix }) } else { Ok(()) }
         };
         let binding = gpu.limits.max_storage_buffer_binding_size;
+        if !matches!(scene.model.cohesion, crate::model::CohesionLaw::None) {
+            anyhow::bail!("{}: model.cohesion: the GPU backend has no capillary cohesion yet; fix: run with --backend cpu", scene.path.display());
+        }
         limit("walls", scene.walls.len() as u64, MAX_WALLS as u64, "split the container into at most 8 walls or use --backend cpu")?;
         limit("bytes per grain array (16 per grain)", 16 * n, binding, "use fewer grains per run or a device with larger storage bindings")?;
         let hash_size = (n.max(64)).next_power_of_two();
@@ -818,6 +821,9 @@ impl Engine for GpuEngine {
             unbalanced_force,
             non_finite_grain: (control.non_finite != NONE).then_some(control.non_finite),
             rebuilds: control.rebuilds as u64,
+            bridges: 0,
+            liquid_in_bridges: 0.0,
+            liquid_on_grains: 0.0,
             walls: (0..n_walls)
                 .map(|w| WallStats {
                     name: self.wall_names[w].clone(),
@@ -880,6 +886,10 @@ impl Engine for GpuEngine {
             contacts: contact_records,
             wall_contacts: wall_records,
         }
+    }
+
+    fn wet(&mut self, _: f64) -> anyhow::Result<()> {
+        anyhow::bail!("the GPU backend has no capillary cohesion yet; fix: run with --backend cpu")
     }
 
     fn save(&self) -> Option<crate::checkpoint::EngineState> {

@@ -20,6 +20,10 @@ pub struct Geometry<T> {
     pub rp_j: T,
     /// `R'_eff = R'_i R'_j / (R'_i + R'_j)` (m); `R'_i` for a wall.
     pub rp_eff: T,
+    /// Radius of i (m).
+    pub r_i: T,
+    /// Radius of j (m); infinite for a wall.
+    pub r_j: T,
 }
 
 /// Velocities of the two partners (world frame).
@@ -68,7 +72,21 @@ impl<T: Real> Geometry<T> {
             rp_i,
             rp_j,
             rp_eff: rp_i * rp_j / (rp_i + rp_j),
+            r_i,
+            r_j,
         }
+    }
+
+    /// Radius of i (m).
+    #[inline(always)]
+    pub fn r_i(&self) -> T {
+        self.r_i
+    }
+
+    /// Radius of j (m).
+    #[inline(always)]
+    pub fn r_j(&self) -> T {
+        self.r_j
     }
 
     /// Geometry of grain i against a wall whose surface is at signed distance `dist` from the
@@ -77,6 +95,6 @@ impl<T: Real> Geometry<T> {
     pub fn grain_wall(n: Vec3<T>, dist: T, r_i: T, m_i: T) -> Self {
         let h = r_i - dist;
         let rp_i = r_i - h;
-        Geometry { n, h, r_eff: r_i, m_eff: m_i, rp_i, rp_j: T::ZERO, rp_eff: rp_i }
+        Geometry { n, h, r_eff: r_i, m_eff: m_i, rp_i, rp_j: T::ZERO, rp_eff: rp_i, r_i, r_j: T::of(f64::INFINITY) }
     }
 }

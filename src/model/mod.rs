@@ -9,12 +9,14 @@
 //! A scene picks one law per slot ([`ContactModel`]); a slot set to `None` is skipped before
 //! any arithmetic, and its history is not allocated (see [`HistoryLayout`]).
 
+mod capillary;
 mod geometry;
 mod normal;
 mod rolling;
 mod tangential;
 mod twisting;
 
+pub use capillary::{capillary_force, decay_length, rupture_distance};
 pub use geometry::{Bodies, Geometry, Kinematics};
 pub use normal::{normal_damping, normal_elastic, normal_force, restitution_beta};
 pub use rolling::rolling_sds;
@@ -118,6 +120,22 @@ pub enum TwistingLaw {
     Oquendo,
 }
 
+/// Cohesion law.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CohesionLaw<T> {
+    /// No cohesion.
+    None,
+    /// Capillary bridges (seed 001 eqs. 1-8), per-pair liquid volume as history.
+    Capillary {
+        /// `kappa = 2 pi gamma_s cos(theta)` (N/m).
+        kappa: T,
+        /// Contact angle (rad).
+        theta: T,
+        /// The decay-length constant `c` (0.9 in seed 001).
+        c: T,
+    },
+}
+
 /// The law chosen for each slot of a scene's contacts.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactModel<T> {
@@ -131,6 +149,8 @@ pub struct ContactModel<T> {
     pub rolling: RollingLaw<T>,
     /// Twisting torque.
     pub twisting: TwistingLaw,
+    /// Cohesion.
+    pub cohesion: CohesionLaw<T>,
 }
 
 impl<T: Real> ContactModel<T> {
@@ -139,6 +159,7 @@ impl<T: Real> ContactModel<T> {
         HistoryLayout {
             tangential: !matches!(self.tangential, TangentialLaw::None),
             rolling: !matches!(self.rolling, RollingLaw::None),
+            bridge: !matches!(self.cohesion, CohesionLaw::None),
         }
     }
 }
@@ -151,6 +172,8 @@ pub struct HistoryLayout {
     pub tangential: bool,
     /// Accumulated rolling displacement `psi` (m).
     pub rolling: bool,
+    /// Liquid bridge volume `V_b` (m^3), one real.
+    pub bridge: bool,
 }
 
 /// Per-contact history, world frame, zero when a contact forms.
@@ -160,6 +183,8 @@ pub struct History<T> {
     pub tangential: Vec3<T>,
     /// Rolling spring displacement `psi` (m).
     pub rolling: Vec3<T>,
+    /// Liquid bridge volume (m^3); 0 without a bridge.
+    pub bridge: T,
 }
 
 /// Coefficients of one pair of materials (see [`PairCoeffs::mix`]).
@@ -247,8 +272,10 @@ pub struct ContactForce<T> {
     pub t_i: Vec3<T>,
     /// Torque on j (N m).
     pub t_j: Vec3<T>,
-    /// Normal force magnitude after the clamp (N, compressive positive).
+    /// Elastic + damping normal force after the no-pull clamp (N, compressive positive).
     pub f_n: T,
+    /// Capillary normal force (N, tensile negative; 0 without a bridge).
+    pub f_c: T,
     /// True when the no-pull clamp removed an attractive damping force.
     pub clamped: bool,
 }
@@ -304,6 +331,12 @@ pub fn contact_force<T: Real>(
         out.t_i += tau;
         out.t_j -= tau;
     }
+    if let CohesionLaw::Capillary { kappa, theta, c } = model.cohesion {
+        let f_c = capillary_force(kappa, theta, c, geo.r_i(), geo.r_j(), hist.bridge, -geo.h);
+        out.f_c = f_c;
+        out.f_i += geo.n * f_c;
+        out.f_j -= geo.n * f_c;
+    }
     out
 }
 
@@ -357,6 +390,10 @@ impl ContactModel<f64> {
                 RollingLaw::Sds { k_r, gamma_r, mu_r } => RollingLaw::Sds { k_r: u(k_r), gamma_r: u(gamma_r), mu_r: u(mu_r) },
             },
             twisting: self.twisting,
+            cohesion: match self.cohesion {
+                CohesionLaw::None => CohesionLaw::None,
+                CohesionLaw::Capillary { kappa, theta, c } => CohesionLaw::Capillary { kappa: u(kappa), theta: u(theta), c: u(c) },
+            },
         }
     }
 
@@ -391,7 +428,11 @@ impl ContactModel<f64> {
             TwistingLaw::None => "none",
             TwistingLaw::Oquendo => "oquendo(gamma_nt)",
         };
-        format!("normal={normal} damping={damping} tangential={tangential} rolling={rolling} twisting={twisting}")
+        let cohesion = match self.cohesion {
+            CohesionLaw::None => "none".to_string(),
+            CohesionLaw::Capillary { kappa, theta, c } => format!("capillary(kappa={kappa:e} N/m, theta={:.1} deg, c={c})", theta.to_degrees()),
+        };
+        format!("normal={normal} damping={damping} tangential={tangential} rolling={rolling} twisting={twisting} cohesion={cohesion}")
     }
 }
 

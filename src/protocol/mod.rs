@@ -139,6 +139,9 @@ fn run_stage(
     if let Some(p) = stage.piston_pressure {
         engine.set_piston_pressure(p);
     }
+    if let Some(v) = stage.wet_volume {
+        engine.wet(v)?;
+    }
     let mut initial_void_ratio = None;
     if stage.lower_piston {
         let f = engine.frame(false);

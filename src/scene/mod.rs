@@ -7,8 +7,8 @@ pub mod schema;
 pub use error::SceneError;
 
 use crate::model::{
-    ContactModel, DampingLaw, MaterialConstants, NormalLaw, RollingLaw, TangentialLaw, TangentialStiffness,
-    TwistingLaw,
+    CohesionLaw, ContactModel, DampingLaw, MaterialConstants, NormalLaw, RollingLaw, TangentialLaw,
+    TangentialStiffness, TwistingLaw,
 };
 use crate::timestep::{self, TimeStep};
 use error::Complainer;
@@ -159,6 +159,8 @@ pub struct Stage {
     pub lower_piston: bool,
     /// Record a compression point (pressure, void ratio, macroscopic stress) at the end.
     pub records_compression: bool,
+    /// Wet the sample at the start with this liquid volume (m^3).
+    pub wet_volume: Option<f64>,
 }
 
 /// What `--out` records.
@@ -211,6 +213,18 @@ pub struct Scene {
     pub output: Output,
     /// Warnings found while validating (e.g. a time step above the recommended fraction).
     pub warnings: Vec<String>,
+    /// Capillary scenes: the largest bridge volume (m^3) and the rupture distance it reaches
+    /// (m), which the neighbour search adds to the skin; zero without cohesion.
+    pub bridges: BridgeLimits,
+}
+
+/// Bounds on liquid bridges.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BridgeLimits {
+    /// Largest bridge volume (m^3).
+    pub volume_cap: f64,
+    /// Rupture distance of the largest bridge (m).
+    pub reach: f64,
 }
 
 /// Default sliding and rolling thresholds of seed 000's tangential regimes (m/s).
@@ -219,6 +233,19 @@ pub const DEFAULT_V_THRESHOLD: f64 = 1e-4;
 pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
 /// Default settle criterion on the unbalanced-force ratio.
 pub const DEFAULT_UNBALANCED_FORCE: f64 = 0.01;
+/// Water's surface tension (N/m), the default of `model.surface_tension`.
+pub const DEFAULT_SURFACE_TENSION: f64 = 0.0728;
+/// Seed 001's decay-length constant `c` (its eq. 6).
+pub const CAPILLARY_C: f64 = 0.9;
+/// Default liquid density (kg/m^3).
+pub const DEFAULT_LIQUID_DENSITY: f64 = 1000.0;
+/// Bridges per grain assumed when sizing the largest bridge: the mean bridge holds the
+/// liquid over `BRIDGES_PER_GRAIN / 2` pairs per grain...
+pub const BRIDGES_PER_GRAIN: f64 = 6.0;
+/// ... and no bridge holds more than this many mean bridges (the excess stays on the grains),
+/// which bounds the rupture distance the neighbour search must reach.
+pub const BRIDGE_CAP_IN_MEANS: f64 = 8.0;
+
 /// Default tolerance on the piston's pressure at the end of a pressure stage.
 pub const DEFAULT_PRESSURE_TOLERANCE: f64 = 0.01;
 /// Default pressure multiplier between oedometer steps (seed 000: doubled).
@@ -326,7 +353,12 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         Some(v) => positive(&c, "simulation.max_overlap", v, "give a fraction of the radius, e.g. 0.2")?,
         None => 0.2,
     };
-    let stages = validate_stages(&c, &f.stages, &grains, gravity, d_mean, &walls)?;
+    let liquid_density = match f.model.liquid_density {
+        Some(v) => positive(&c, "model.liquid_density", v, "give the liquid's density in kg/m^3, e.g. 1000")?,
+        None => DEFAULT_LIQUID_DENSITY,
+    };
+    let stages = validate_stages(&c, &f.stages, &grains, gravity, d_mean, &walls, liquid_density)?;
+    let bridges = bridge_limits(&c, &model, &stages, &grains)?;
     let output = Output {
         frame_interval: non_negative(&c, "output.frame_interval", f.output.frame_interval, "give seconds, or 0 for a frame per stage")?,
         contact_forces: f.output.contact_forces,
@@ -352,7 +384,31 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         stages,
         output,
         warnings,
+        bridges,
     })
+}
+
+/// Sizes the largest bridge from the most liquid a stage adds: the mean bridge holds the
+/// liquid over `BRIDGES_PER_GRAIN / 2` pairs per grain, and no bridge more than
+/// `BRIDGE_CAP_IN_MEANS` of them.
+fn bridge_limits(c: &Complainer, model: &ContactModel<f64>, stages: &[Stage], grains: &Grains) -> Result<BridgeLimits, SceneError> {
+    let wettest = stages.iter().filter_map(|s| s.wet_volume).fold(0.0, f64::max);
+    match model.cohesion {
+        CohesionLaw::None => {
+            if wettest > 0.0 {
+                return Err(c.invalid("stage.water_content", "(set)", "wets the sample, but the model has no cohesion", "set model.cohesion = \"capillary\" or remove water_content"));
+            }
+            Ok(BridgeLimits::default())
+        }
+        CohesionLaw::Capillary { theta, .. } => {
+            if wettest == 0.0 {
+                return Err(c.invalid("model.cohesion", "\"capillary\"", "no stage wets the sample", "give a stage `water_content`, e.g. 0.007"));
+            }
+            let mean = wettest / (0.5 * BRIDGES_PER_GRAIN * grains.len() as f64);
+            let volume_cap = BRIDGE_CAP_IN_MEANS * mean;
+            Ok(BridgeLimits { volume_cap, reach: crate::model::rupture_distance(theta, volume_cap) })
+        }
+    }
 }
 
 /// `10kPa`, `1.28MPa`: a pressure for stage names.
@@ -724,7 +780,26 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
         "oquendo" => TwistingLaw::Oquendo,
         other => return Err(c.invalid("model.twisting", format!("\"{other}\""), "unknown twisting law", "use \"none\" or \"oquendo\"")),
     };
-    Ok(ContactModel { normal, damping, tangential, rolling, twisting })
+    let cohesion_name = law(&m.cohesion, "none");
+    let cohesion = match cohesion_name.as_str() {
+        "none" => {
+            for (k, set) in [("surface_tension", m.surface_tension.is_some()), ("contact_angle", m.contact_angle.is_some()), ("liquid_density", m.liquid_density.is_some())] {
+                unused(k, set, "cohesion = \"none\"")?;
+            }
+            CohesionLaw::None
+        }
+        "capillary" => {
+            let gamma_s = positive(c, "model.surface_tension", m.surface_tension.unwrap_or(DEFAULT_SURFACE_TENSION), "give the surface tension in N/m, e.g. 0.0728 for water")?;
+            let theta = m.contact_angle.unwrap_or(0.0);
+            if !(0.0..90.0).contains(&theta) {
+                return Err(c.invalid("model.contact_angle", theta, "must lie in [0, 90) degrees for an attractive bridge", "give the contact angle in degrees, e.g. 0"));
+            }
+            let theta = theta.to_radians();
+            CohesionLaw::Capillary { kappa: 2.0 * std::f64::consts::PI * gamma_s * theta.cos(), theta, c: CAPILLARY_C }
+        }
+        other => return Err(c.invalid("model.cohesion", format!("\"{other}\""), "unknown cohesion law", "use \"none\" or \"capillary\"")),
+    };
+    Ok(ContactModel { normal, damping, tangential, rolling, twisting, cohesion })
 }
 
 #[allow(clippy::too_many_arguments, reason = "validation needs the whole scene")]
@@ -759,7 +834,15 @@ fn choose_time_step(
     }
 }
 
-fn validate_stages(c: &Complainer, specs: &[StageSpec], grains: &Grains, gravity: [f64; 3], d_mean: f64, walls: &[Wall]) -> Result<Vec<Stage>, SceneError> {
+fn validate_stages(
+    c: &Complainer,
+    specs: &[StageSpec],
+    grains: &Grains,
+    gravity: [f64; 3],
+    d_mean: f64,
+    walls: &[Wall],
+    liquid_density: f64,
+) -> Result<Vec<Stage>, SceneError> {
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let m_mean = grains.mass.iter().sum::<f64>() / grains.len() as f64;
     let has_piston = walls.iter().any(|w| matches!(w.shape, WallShape::Piston { .. }));
@@ -819,6 +902,10 @@ fn validate_stages(c: &Complainer, specs: &[StageSpec], grains: &Grains, gravity
             pressure_tolerance,
             lower_piston: false,
             records_compression: false,
+            wet_volume: match s.water_content {
+                Some(w) => Some(positive(c, &key("water_content"), w, "give the gravimetric water content, e.g. 0.007")? * grains.mass.iter().sum::<f64>() / liquid_density),
+                None => None,
+            },
         };
         if !oedometer {
             out.push(base);
@@ -847,6 +934,7 @@ fn validate_stages(c: &Complainer, specs: &[StageSpec], grains: &Grains, gravity
                 piston_pressure: Some(p),
                 lower_piston: first,
                 records_compression: true,
+                wet_volume: if first { base.wet_volume } else { None },
                 ..base.clone()
             });
             first = false;

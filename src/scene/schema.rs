@@ -227,6 +227,15 @@ pub struct ModelSpec {
     pub rolling: Option<String>,
     /// "none" (default) or "oquendo".
     pub twisting: Option<String>,
+    /// "none" (default) or "capillary" (seed 001's liquid bridges; a stage must wet the
+    /// sample with `water_content`).
+    pub cohesion: Option<String>,
+    /// Liquid surface tension gamma_s (N/m), `cohesion = "capillary"`. Default 0.0728 (water).
+    pub surface_tension: Option<f64>,
+    /// Contact angle theta (degrees), `cohesion = "capillary"`. Default 0 (perfectly wetting).
+    pub contact_angle: Option<f64>,
+    /// Liquid density (kg/m^3) turning a gravimetric water content into a volume. Default 1000.
+    pub liquid_density: Option<f64>,
     /// Linear normal stiffness k_n (N/m), `normal = "linear"`.
     pub k_n: Option<f64>,
     /// Viscous coefficient c_n (N s/m), `damping = "viscous"`.
@@ -358,6 +367,10 @@ pub struct StageSpec {
     pub p_max: Option<f64>,
     /// "oedometer": pressure multiplier between steps. Default 2 (seed 000).
     pub factor: Option<f64>,
+    /// Wet the sample at the start of the stage: gravimetric water content w (liquid mass over
+    /// solid mass), shared among pairs closer than their rupture distance in proportion to
+    /// their reduced diameter. Needs `model.cohesion = "capillary"`.
+    pub water_content: Option<f64>,
     /// Settle stages with a piston pressure, and oedometer steps: the piston's measured
     /// pressure must also be within this fraction of its target. Default 0.01.
     pub pressure_tolerance: Option<f64>,

@@ -1,0 +1,39 @@
+//! Capillary cohesion of a liquid bridge (seed 001 eqs. 1-8, PHYSICS.md), derived from the
+//! paper: the force is `f0 = -kappa R` while the grains touch, decays as `f0 exp(-delta/lambda)`
+//! across the gap `delta`, and vanishes beyond the rupture distance `delta_max`.
+
+use crate::real::Real;
+
+/// `delta_max = (1 + theta/2) V_b^(1/3)` (m), `theta` the contact angle (rad), `V_b` the
+/// bridge volume (m^3) (seed 001 eq. 5).
+#[inline(always)]
+pub fn rupture_distance<T: Real>(theta: T, v_b: T) -> T {
+    (T::ONE + theta * T::of(0.5)) * v_b.powf(T::of(1.0 / 3.0))
+}
+
+/// `lambda = c / sqrt(2) sqrt((1/R_i + 1/R_j) / max(R_i/R_j, R_j/R_i) V_b)` (m), the decay
+/// length of the force across the gap (seed 001 eq. 8).
+#[inline(always)]
+pub fn decay_length<T: Real>(c: T, r_i: T, r_j: T, v_b: T) -> T {
+    let ratio = (r_i / r_j).max(r_j / r_i);
+    c * T::of(std::f64::consts::FRAC_1_SQRT_2) * ((T::ONE / r_i + T::ONE / r_j) / ratio * v_b).sqrt()
+}
+
+/// The capillary normal force (N, tensile negative) of a bridge of volume `v_b` between grains
+/// of radii `r_i`, `r_j` at gap `delta = -h` (m), with `kappa = 2 pi gamma_s cos(theta)` (N/m):
+/// `f0 = -kappa sqrt(R_i R_j)` in contact (`delta < 0`), `f0 exp(-delta/lambda)` up to
+/// `delta_max`, 0 beyond or without liquid.
+#[inline(always)]
+pub fn capillary_force<T: Real>(kappa: T, theta: T, c: T, r_i: T, r_j: T, v_b: T, delta: T) -> T {
+    if v_b <= T::ZERO {
+        return T::ZERO;
+    }
+    let f0 = -kappa * (r_i * r_j).sqrt();
+    if delta < T::ZERO {
+        f0
+    } else if delta <= rupture_distance(theta, v_b) {
+        f0 * (-(delta / decay_length(c, r_i, r_j, v_b))).exp()
+    } else {
+        T::ZERO
+    }
+}

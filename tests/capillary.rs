@@ -1,0 +1,150 @@
+//! Capillary cohesion (seed 001 eqs. 1-8): the law against the formula worked by hand, a wet
+//! pair that a bridge holds together or lets go at its rupture distance as energy says it
+//! should, and liquid conserved while bridges break and form.
+
+mod common;
+
+use grains::cpu::CpuEngine;
+use grains::engine::Engine;
+use grains::model::{capillary_force, decay_length, rupture_distance};
+
+/// The law against its formula: round-off.
+const FORMULA: f64 = 1e-12;
+/// Liquid conserved over a run: round-off of some thousand additions.
+const LIQUID_ROUNDOFF: f64 = 1e-12;
+
+#[test]
+fn the_capillary_law_matches_the_formula_at_gaps_size_ratios_and_volumes() {
+    let kappa = 2.0 * std::f64::consts::PI * 0.0728; // water, theta = 0
+    for (ri, rj) in [(5e-4, 5e-4), (5e-4, 2.5e-4), (3e-4, 6e-4)] {
+        for v in [1e-12, 1e-11, 5e-11] {
+            // By hand: R = sqrt(ri rj), f0 = -kappa R, delta_max = V^(1/3),
+            // lambda = 0.9 / sqrt(2) * sqrt((1/ri + 1/rj) / max(ri/rj, rj/ri) * V).
+            let f0 = -kappa * (ri * rj as f64).sqrt();
+            let dmax = (v as f64).cbrt();
+            let ratio = if ri > rj { ri / rj } else { rj / ri };
+            let lambda = 0.9 / 2f64.sqrt() * ((1.0 / ri + 1.0 / rj) / ratio * v).sqrt();
+            assert!((rupture_distance(0.0, v) / dmax - 1.0).abs() < FORMULA);
+            assert!((decay_length(0.9, ri, rj, v) / lambda - 1.0).abs() < FORMULA);
+            for (delta, expect) in [(-1e-6, f0), (0.0, f0), (0.3 * dmax, f0 * (-0.3 * dmax / lambda).exp()), (dmax, f0 * (-dmax / lambda).exp()), (1.01 * dmax, 0.0)] {
+                let got = capillary_force(kappa, 0.0, 0.9, ri, rj, v, delta);
+                assert!((got - expect).abs() <= FORMULA * expect.abs(), "R = ({ri}, {rj}), V = {v}, delta = {delta}: {got} vs {expect}");
+            }
+        }
+    }
+    // A contact angle shortens kappa by cos(theta) and lengthens the rupture distance by
+    // (1 + theta/2); no liquid, no force.
+    let theta = 20f64.to_radians();
+    assert!((rupture_distance(theta, 1e-11) / ((1.0 + theta / 2.0) * 1e-11f64.cbrt()) - 1.0).abs() < FORMULA);
+    assert_eq!(capillary_force(kappa, 0.0, 0.9, 5e-4, 5e-4, 0.0, 0.0), 0.0);
+}
+
+/// Two grains 10 um apart moving away from each other at `speed` each, wetted at the start
+/// with `w` (all of it goes into their one bridge).
+fn wet_pair(speed: f64, w: f64) -> grains::scene::Scene {
+    common::parse(&format!(
+        r#"
+[[material]]
+name = "glass"
+density = 2500.0
+youngs_modulus = 1.0e8
+poisson_ratio = 0.3
+restitution = 0.5
+[[grain]]
+material = "glass"
+radius = 5.0e-4
+position = [-5.05e-4, 0.0, 0.0]
+velocity = [-{speed}, 0.0, 0.0]
+[[grain]]
+material = "glass"
+radius = 5.0e-4
+position = [5.05e-4, 0.0, 0.0]
+velocity = [{speed}, 0.0, 0.0]
+[model]
+damping = "restitution"
+cohesion = "capillary"
+[simulation]
+gravity = [0.0, 0.0, 0.0]
+dt = 2.0e-7
+stats_interval = 50
+[[stage]]
+kind = "run"
+duration = 0.02
+water_content = {w}
+"#
+    ))
+}
+
+#[test]
+fn a_bridge_holds_a_slow_pair_and_breaks_at_its_rupture_distance_for_a_fast_one() {
+    let w = 1e-3;
+    let scene = wet_pair(0.0, w);
+    let m = scene.grains.mass[0];
+    let v_b = w * 2.0 * m / 1000.0;
+    let kappa = 2.0 * std::f64::consts::PI * 0.0728;
+    let (r, gap0) = (5.0e-4, 1.0e-5);
+    let lambda = decay_length(0.9, r, r, v_b);
+    let dmax = rupture_distance(0.0, v_b);
+    // Work to pull the pair from gap0 to the rupture distance: kappa R lambda (e^-gap0/l - e^-dmax/l).
+    let work = kappa * r * lambda * ((-gap0 / lambda).exp() - (-dmax / lambda).exp());
+    let escape = (2.0 * work / (m / 2.0)).sqrt() / 2.0; // speed of each grain
+    println!("V_b = {v_b:.3e} m^3, rupture distance {dmax:.3e} m, lambda {lambda:.3e} m, escape speed {escape:.4e} m/s per grain");
+    for (factor, breaks) in [(0.7, false), (1.3, true)] {
+        let scene = wet_pair(factor * escape, w);
+        let mut e: CpuEngine<f64> = common::engine(&scene);
+        e.wet(scene.stages[0].wet_volume.unwrap()).unwrap();
+        let s0 = e.stats();
+        assert_eq!(s0.bridges, 1, "the one pair is wetted");
+        assert!((s0.liquid_in_bridges / v_b - 1.0).abs() < 1e-12);
+        let (mut max_gap, mut gap_at_break) = (0.0f64, None);
+        let mut last_gap = gap0;
+        for _ in 0..100_000 {
+            e.step().unwrap();
+            let b = e.bodies();
+            let gap = (b[1].pos.x - b[0].pos.x) - 2.0 * r;
+            max_gap = max_gap.max(gap);
+            let s = e.stats();
+            if s.bridges == 0 && gap_at_break.is_none() {
+                gap_at_break = Some((last_gap, gap));
+                assert!((s.liquid_on_grains / v_b - 1.0).abs() < 1e-12, "the liquid goes back to the grains");
+                break;
+            }
+            last_gap = gap;
+        }
+        println!("{factor} x escape: largest gap {max_gap:.4e} m, broke between gaps {gap_at_break:?}");
+        match (breaks, gap_at_break) {
+            (false, None) => assert!(max_gap < dmax, "held below the rupture distance"),
+            (true, Some((before, after))) => assert!(before <= dmax && after > dmax, "breaks on crossing the rupture distance"),
+            other => panic!("expected breaks = {breaks}, got {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn liquid_is_conserved_while_bridges_break_and_form() {
+    let text = std::fs::read_to_string(common::scene_path("elastic_gas.toml")).unwrap();
+    let text = text
+        .replace("count = 50", "count = 120")
+        .replace("max = [6.0e-3, 6.0e-3, 6.0e-3] }\nrandom_speed = 0.5", "max = [8.0e-3, 8.0e-3, 8.0e-3] }\nrandom_speed = 0.3")
+        .replace("max = [6.0e-3, 6.0e-3, 6.0e-3]\n", "max = [8.0e-3, 8.0e-3, 8.0e-3]\n")
+        .replace("poisson_ratio = 0.3", "poisson_ratio = 0.3\nmu_s = 0.4\nrestitution = 0.8")
+        .replace("damping = \"none\"\ntangential = \"none\"", "damping = \"restitution\"\ntangential = \"mindlin\"\ncohesion = \"capillary\"")
+        .replace("duration = 0.05", "duration = 0.05\nwater_content = 0.01");
+    let scene = common::parse(&text);
+    let mut e: CpuEngine<f64> = common::engine(&scene);
+    let total = scene.stages[0].wet_volume.unwrap();
+    e.wet(total).unwrap();
+    let s0 = e.stats();
+    let (mut formed_or_broken, mut last) = (0u64, s0.bridges);
+    let mut worst: f64 = 0.0;
+    for _ in 0..200 {
+        e.advance(100).unwrap();
+        let s = e.stats();
+        formed_or_broken += s.bridges.abs_diff(last);
+        last = s.bridges;
+        worst = worst.max(((s.liquid_in_bridges + s.liquid_on_grains) / total - 1.0).abs());
+    }
+    println!("{} bridges at the start, {} now, {formed_or_broken} net changes seen; liquid {total:.4e} m^3 conserved to {worst:.2e}", s0.bridges, last);
+    assert!(s0.bridges > 0 && formed_or_broken > 10, "bridges must break and form");
+    assert!(worst < LIQUID_ROUNDOFF);
+}
