@@ -16,12 +16,12 @@ const LIQUID_ROUNDOFF: f64 = 1e-12;
 #[test]
 fn the_capillary_law_matches_the_formula_at_gaps_size_ratios_and_volumes() {
     let kappa = 2.0 * std::f64::consts::PI * 0.0728; // water, theta = 0
-    for (ri, rj) in [(5e-4, 5e-4), (5e-4, 2.5e-4), (3e-4, 6e-4)] {
-        for v in [1e-12, 1e-11, 5e-11] {
+    for (ri, rj) in [(5e-4f64, 5e-4f64), (5e-4, 2.5e-4), (3e-4, 6e-4)] {
+        for v in [1e-12f64, 1e-11, 5e-11] {
             // By hand: R = sqrt(ri rj), f0 = -kappa R, delta_max = V^(1/3),
             // lambda = 0.9 / sqrt(2) * sqrt((1/ri + 1/rj) / max(ri/rj, rj/ri) * V).
-            let f0 = -kappa * (ri * rj as f64).sqrt();
-            let dmax = (v as f64).cbrt();
+            let f0 = -kappa * (ri * rj).sqrt();
+            let dmax = v.cbrt();
             let ratio = if ri > rj { ri / rj } else { rj / ri };
             let lambda = 0.9 / 2f64.sqrt() * ((1.0 / ri + 1.0 / rj) / ratio * v).sqrt();
             assert!((rupture_distance(0.0, v) / dmax - 1.0).abs() < FORMULA);
