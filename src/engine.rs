@@ -44,6 +44,10 @@ pub struct WallStats {
     pub force: [f64; 3],
     /// Grains touching it.
     pub contacts: u64,
+    /// Servo walls: the plane's coordinate along its axis (m).
+    pub position: Option<f64>,
+    /// Servo walls: the pressure the grains exert on it (Pa).
+    pub pressure: Option<f64>,
 }
 
 /// The piston's state.
@@ -209,6 +213,9 @@ pub trait Engine {
     fn save(&self) -> Option<crate::checkpoint::EngineState>;
     /// Restores a state `save` returned, for the same scene, backend and precision.
     fn restore(&mut self, state: &crate::checkpoint::EngineState) -> anyhow::Result<()>;
+    /// Sets the servo walls' target pressure (Pa, when given) and switches the z walls to a
+    /// fixed strain rate (1/s, positive closing) or back to pressure control (`None`).
+    fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>);
     /// Wets the sample with `volume` (m^3) of liquid: shared among the pairs closer than their
     /// rupture distance in proportion to their reduced diameter (seed 001, PHYSICS.md).
     fn wet(&mut self, volume: f64) -> anyhow::Result<()>;

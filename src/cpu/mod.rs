@@ -35,6 +35,9 @@ use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS};
 use wall_contacts::wall_contacts;
 
+/// Fraction of the largest stable servo gain used where a wall's contacts are stiff.
+pub const SERVO_RELAXATION: f64 = 0.5;
+
 /// Seed 000's optimised velocity Verlet parameter (eqs. 11-15).
 pub const OVV_XI: f64 = 0.1931833275037836;
 
@@ -47,6 +50,21 @@ struct Piston<T> {
     area: T,
     /// Target pressure (Pa).
     pressure: T,
+}
+
+/// The servo box's control state.
+#[derive(Clone, Copy, Debug)]
+struct Servo<T> {
+    /// Wall indices: x_min, x_max, y_min, y_max, z_min, z_max.
+    walls: [usize; 6],
+    /// Target pressure (Pa).
+    pressure: T,
+    /// Wall speed per pressure error (m/(s Pa)).
+    gain: T,
+    /// Largest wall speed (m/s).
+    max_speed: T,
+    /// Strain rate of the z walls (1/s), when they are strain-controlled.
+    strain_rate: Option<T>,
 }
 
 /// The CPU engine in precision `T`.
@@ -85,10 +103,14 @@ pub struct CpuEngine<T: Real> {
     walls: Vec<WallState<T>>,
     wall_names: Vec<String>,
     piston: Option<Piston<T>>,
+    servo: Option<Servo<T>>,
     wall_hist: Vec<T>,
     wall_load: Vec<Load<T>>,
     wall_reaction: Vec<Vec3<T>>,
     wall_count: Vec<u64>,
+    /// Sum over each wall's contacts of the normal tangent stiffness (N/m) and damping
+    /// coefficient (N s/m).
+    wall_response: Vec<(T, T)>,
     // Pairs.
     grid: CellGrid<T>,
     pairs: PairList,
@@ -167,10 +189,12 @@ impl<T: Real> CpuEngine<T> {
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
             walls,
             piston,
+            servo: scene.servo.map(|s| Servo { walls: s.walls, pressure: T::of(s.pressure), gain: T::of(s.gain), max_speed: T::of(s.max_speed), strain_rate: None }),
             wall_hist: vec![T::ZERO; n * n_walls * slots.stride],
             wall_load: vec![Load::default(); n],
             wall_reaction: vec![Vec3::ZERO; n_walls],
             wall_count: vec![0; n_walls],
+            wall_response: vec![(T::ZERO, T::ZERO); n_walls],
             grid: CellGrid::default(),
             pairs: PairList::default(),
             hist: Vec::new(),
@@ -319,9 +343,10 @@ impl<T: Real> CpuEngine<T> {
                 .for_each(|(k, (o, h))| *o = pair_force(k, pairs, body, prop, &ctx, h));
         }
         if !self.walls.is_empty() {
-            let (reaction, count) = wall_pass(&ctx, body, prop, &self.walls, &mut self.wall_load, &mut self.wall_hist);
-            self.wall_reaction = reaction;
-            self.wall_count = count;
+            let sums = wall_pass(&ctx, body, prop, &self.walls, &mut self.wall_load, &mut self.wall_hist);
+            self.wall_reaction = sums.reaction;
+            self.wall_count = sums.count;
+            self.wall_response = sums.response;
         }
         let (out, wall_load, gravity) = (&self.out, &self.wall_load, self.gravity);
         self.load.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, l)| *l = gather(i, pairs, out, &wall_load[i], &prop[i], gravity));
@@ -360,6 +385,7 @@ impl<T: Real> CpuEngine<T> {
             }
             self.external_work -= (p.pressure * p.area * dz).f64();
         }
+        self.servo_drift(tau);
         self.since_eval += tau;
         let max_moved = moved.into_iter().fold(T::ZERO, T::max);
         let half = self.skin * T::of(0.5);
@@ -367,6 +393,63 @@ impl<T: Real> CpuEngine<T> {
             self.rebuild()?;
         }
         Ok(())
+    }
+
+    /// Plane point and unit normal of wall `w` (a plane).
+    fn plane(&self, w: usize) -> (Vec3<T>, Vec3<T>) {
+        match self.walls[w].geom {
+            WallGeom::Plane { point, normal } => (point, normal),
+            _ => unreachable!("servo walls are planes"),
+        }
+    }
+
+    /// Extent of the servo box along each axis (m).
+    fn servo_extents(&self, s: &Servo<T>) -> [T; 3] {
+        let coord = |k: usize, a: usize| {
+            let p = self.plane(s.walls[k]).0;
+            [p.x, p.y, p.z][a]
+        };
+        [0, 1, 2].map(|a| coord(2 * a + 1, a) - coord(2 * a, a))
+    }
+
+    /// The pressure (Pa) the grains exert on servo wall `k` (0..6) of the box.
+    fn servo_pressure(&self, s: &Servo<T>, k: usize) -> T {
+        let e = self.servo_extents(s);
+        let a = k / 2;
+        let area = e[(a + 1) % 3] * e[(a + 2) % 3];
+        let (_, normal) = self.plane(s.walls[k]);
+        -self.wall_reaction[s.walls[k]].dot(normal) / area
+    }
+
+    /// Moves the servo walls by `tau` (s): each plane along its normal at
+    /// `gain x (target - measured pressure)`, capped at the largest speed; in triaxial mode the
+    /// z planes close at the strain rate instead. Books their work on the grains.
+    ///
+    /// The gain is lowered where the wall's contacts respond strongly: a wall moving at `v` for
+    /// `tau` changes the pressure it reads by `(k tau + c) v / A` (`k` the summed contact
+    /// stiffness, `c` the summed damping coefficients: a moving wall feels its own dashpots),
+    /// so a gain above `A / (k tau + c)` overshoots every step and the wall rattles; the servo
+    /// keeps to [`SERVO_RELAXATION`] of that, as YADE's and Thornton's servos do for stiffness.
+    fn servo_drift(&mut self, tau: T) {
+        let Some(s) = self.servo else { return };
+        let extents = self.servo_extents(&s);
+        for k in 0..6 {
+            let w = s.walls[k];
+            let (point, normal) = self.plane(w);
+            let a = k / 2;
+            let area = extents[(a + 1) % 3] * extents[(a + 2) % 3];
+            let (k_wall, c_wall) = self.wall_response[w];
+            let response = k_wall * tau + c_wall;
+            let gain = if response > T::ZERO { s.gain.min(T::of(SERVO_RELAXATION) * area / response) } else { s.gain };
+            let speed = match s.strain_rate {
+                Some(rate) if k >= 4 => rate * extents[2] * T::of(0.5),
+                _ => (gain * (s.pressure - self.servo_pressure(&s, k))).max(-s.max_speed).min(s.max_speed),
+            };
+            let velocity = normal * speed;
+            self.walls[w].geom = WallGeom::Plane { point: point + velocity * tau, normal };
+            self.walls[w].velocity = velocity;
+            self.external_work -= (self.wall_reaction[w].dot(velocity) * tau).f64();
+        }
     }
 
     /// One time step of the scene's integrator.
@@ -407,8 +490,24 @@ impl<T: Real> CpuEngine<T> {
     }
 }
 
-/// `wall_contacts` over every grain; returns the force on each wall (summed per fixed chunk,
-/// then over chunks in order) and its contact count.
+/// What the walls receive from one force pass, per wall.
+struct WallSums<T> {
+    /// Force the grains exert (N).
+    reaction: Vec<Vec3<T>>,
+    /// Touching grains.
+    count: Vec<u64>,
+    /// Sums of the contacts' normal tangent stiffness (N/m) and damping (N s/m).
+    response: Vec<(T, T)>,
+}
+
+impl<T: Real> WallSums<T> {
+    fn new(n: usize) -> Self {
+        WallSums { reaction: vec![Vec3::ZERO; n], count: vec![0; n], response: vec![(T::ZERO, T::ZERO); n] }
+    }
+}
+
+/// `wall_contacts` over every grain; returns the per-wall sums (per fixed chunk, then over
+/// chunks in order).
 fn wall_pass<T: Real>(
     ctx: &ForceContext<T>,
     body: &[Body<T>],
@@ -416,33 +515,33 @@ fn wall_pass<T: Real>(
     walls: &[WallState<T>],
     wall_load: &mut [Load<T>],
     wall_hist: &mut [T],
-) -> (Vec<Vec3<T>>, Vec<u64>) {
+) -> WallSums<T> {
     let n_walls = walls.len();
     let per_grain = n_walls * ctx.slots.stride;
     let run = |c: usize, loads: &mut [Load<T>], hist: &mut [T]| {
-        let mut reaction = vec![Vec3::ZERO; n_walls];
-        let mut count = vec![0u64; n_walls];
+        let mut sums = WallSums::new(n_walls);
         for (ii, l) in loads.iter_mut().enumerate() {
             let i = c * CHUNK + ii;
             let h = if per_grain == 0 { &mut [][..] } else { &mut hist[ii * per_grain..(ii + 1) * per_grain] };
-            *l = wall_contacts(&body[i], &prop[i], walls, ctx, h, &mut reaction, &mut count);
+            *l = wall_contacts(&body[i], &prop[i], walls, ctx, h, &mut sums.reaction, &mut sums.count, &mut sums.response);
         }
-        (reaction, count)
+        sums
     };
-    let parts: Vec<(Vec<Vec3<T>>, Vec<u64>)> = if per_grain == 0 {
+    let parts: Vec<WallSums<T>> = if per_grain == 0 {
         wall_load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, loads)| run(c, loads, &mut [])).collect()
     } else {
         wall_load.par_chunks_mut(CHUNK).zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, (loads, hist))| run(c, loads, hist)).collect()
     };
-    let mut reaction = vec![Vec3::ZERO; n_walls];
-    let mut count = vec![0u64; n_walls];
-    for (r, c) in parts {
+    let mut total = WallSums::new(n_walls);
+    for p in parts {
         for w in 0..n_walls {
-            reaction[w] += r[w];
-            count[w] += c[w];
+            total.reaction[w] += p.reaction[w];
+            total.count[w] += p.count[w];
+            total.response[w].0 += p.response[w].0;
+            total.response[w].1 += p.response[w].1;
         }
     }
-    (reaction, count)
+    total
 }
 
 /// Per-chunk partial sums of the statistics over grains.
@@ -589,7 +688,19 @@ impl<T: Real> Engine for CpuEngine<T> {
         };
         let (max_overlap, max_overlap_grain) = max_by_first(ps.max_overlap, gs.max_wall_overlap);
         let walls = (0..self.walls.len())
-            .map(|w| WallStats { name: self.wall_names[w].clone(), force: self.wall_reaction[w].f64(), contacts: self.wall_count[w] })
+            .map(|w| {
+                let servo = self.servo.and_then(|s| s.walls.iter().position(|&x| x == w).map(|k| (s, k)));
+                WallStats {
+                    name: self.wall_names[w].clone(),
+                    force: self.wall_reaction[w].f64(),
+                    contacts: self.wall_count[w],
+                    position: servo.map(|(_, k)| {
+                        let p = self.plane(w).0;
+                        [p.x, p.y, p.z][k / 2].f64()
+                    }),
+                    pressure: servo.map(|(s, k)| self.servo_pressure(&s, k).f64()),
+                }
+            })
             .collect();
         let piston = self.piston.map(|p| {
             let wall = &self.walls[p.wall];
@@ -683,6 +794,15 @@ impl<T: Real> Engine for CpuEngine<T> {
         }
     }
 
+    fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
+        if let Some(s) = &mut self.servo {
+            if let Some(p) = pressure {
+                s.pressure = T::of(p);
+            }
+            s.strain_rate = axial_strain_rate.map(T::of);
+        }
+    }
+
     fn wet(&mut self, volume: f64) -> anyhow::Result<()> {
         let CohesionLaw::Capillary { theta, .. } = self.model.cohesion else {
             anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
@@ -748,6 +868,12 @@ impl<T: Real> Engine for CpuEngine<T> {
             vec![z, self.walls[p.wall].velocity.z.f64(), p.pressure.f64()]
         });
         s.put_reals("piston", piston);
+        let servo = self.servo.map_or(Vec::new(), |sv| {
+            let mut v: Vec<f64> = sv.walls.iter().flat_map(|&w| [v3(&self.plane(w).0), v3(&self.walls[w].velocity)].concat()).collect();
+            v.extend([sv.pressure.f64(), sv.strain_rate.map_or(f64::NAN, |r| r.f64())]);
+            v
+        });
+        s.put_reals("servo", servo);
         let l = &self.pairs;
         for (name, v) in [("owner_start", &l.owner_start), ("owner", &l.owner), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
             s.put_ints(name, v.iter().map(|&x| x as u64));
@@ -792,6 +918,17 @@ impl<T: Real> Engine for CpuEngine<T> {
             self.walls[p.wall].geom = WallGeom::Piston { z: T::of(v[0]) };
             self.walls[p.wall].velocity.z = T::of(v[1]);
             p.pressure = T::of(v[2]);
+        }
+        if let Some(mut sv) = self.servo {
+            let v = s.reals("servo", 6 * 6 + 2)?;
+            for (k, &w) in sv.walls.iter().enumerate() {
+                let (_, normal) = self.plane(w);
+                self.walls[w].geom = WallGeom::Plane { point: v3(&v[6 * k..6 * k + 3]), normal };
+                self.walls[w].velocity = v3(&v[6 * k + 3..6 * k + 6]);
+            }
+            sv.pressure = T::of(v[36]);
+            sv.strain_rate = (!v[37].is_nan()).then(|| T::of(v[37]));
+            self.servo = Some(sv);
         }
         let u32s = |name: &str, len: Option<usize>| -> anyhow::Result<Vec<u32>> { Ok(s.ints(name, len)?.iter().map(|&x| x as u32).collect()) };
         let owner = u32s("owner", None)?;

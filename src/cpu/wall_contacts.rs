@@ -3,7 +3,7 @@
 
 use super::pair_force::ForceContext;
 use super::state::{Body, Load, Props};
-use crate::model::{contact_force, Bodies, Geometry, Kinematics};
+use crate::model::{contact_force, normal_damping, normal_stiffness, Bodies, Geometry, Kinematics};
 use crate::engine::WallContactRecord;
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
@@ -20,8 +20,9 @@ pub struct WallState<T> {
 }
 
 /// `wall_contacts` for grain `i`. `hist` holds the grain's history blocks, one per wall;
-/// the force each wall receives is added to `reaction[w]` and its contact count to
-/// `count[w]`. Returns the load on the grain.
+/// the force each wall receives is added to `reaction[w]`, its contact count to `count[w]`,
+/// and the contact's normal tangent stiffness (N/m) and damping coefficient (N s/m) to
+/// `response[w]`. Returns the load on the grain.
 #[inline]
 pub fn wall_contacts<T: Real>(
     b: &Body<T>,
@@ -31,6 +32,7 @@ pub fn wall_contacts<T: Real>(
     hist: &mut [T],
     reaction: &mut [Vec3<T>],
     count: &mut [u64],
+    response: &mut [(T, T)],
 ) -> Load<T> {
     let mut load = Load::default();
     let stride = ctx.slots.stride;
@@ -52,6 +54,8 @@ pub fn wall_contacts<T: Real>(
         load.torque += f.t_i;
         reaction[w] -= f.f_i;
         count[w] += 1;
+        response[w].0 += normal_stiffness(&ctx.model.normal, c, &geo);
+        response[w].1 += normal_damping(&ctx.model.damping, &ctx.model.normal, c, &geo);
     }
     load
 }

@@ -113,6 +113,9 @@ impl GpuEngine {
             if need > have { Err(GpuSetupError::Limit { adapter: adapter.clone(), what, need, have, fix }) } else { Ok(()) }
         };
         let binding = gpu.limits.max_storage_buffer_binding_size;
+        if scene.servo.is_some() {
+            anyhow::bail!("{}: a servo_box wall: the GPU backend has no servo walls yet; fix: run with --backend cpu", scene.path.display());
+        }
         if !matches!(scene.model.cohesion, crate::model::CohesionLaw::None) {
             anyhow::bail!("{}: model.cohesion: the GPU backend has no capillary cohesion yet; fix: run with --backend cpu", scene.path.display());
         }
@@ -829,6 +832,8 @@ impl Engine for GpuEngine {
                     name: self.wall_names[w].clone(),
                     force: [reaction[w][0] as f64, reaction[w][1] as f64, reaction[w][2] as f64],
                     contacts: reaction[w][3].round() as u64,
+                    position: None,
+                    pressure: None,
                 })
                 .collect(),
             piston,
@@ -887,6 +892,8 @@ impl Engine for GpuEngine {
             wall_contacts: wall_records,
         }
     }
+
+    fn set_servo(&mut self, _: Option<f64>, _: Option<f64>) {}
 
     fn wet(&mut self, _: f64) -> anyhow::Result<()> {
         anyhow::bail!("the GPU backend has no capillary cohesion yet; fix: run with --backend cpu")

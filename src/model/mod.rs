@@ -18,7 +18,7 @@ mod twisting;
 
 pub use capillary::{capillary_force, decay_length, rupture_distance};
 pub use geometry::{Bodies, Geometry, Kinematics};
-pub use normal::{normal_damping, normal_elastic, normal_force, restitution_beta};
+pub use normal::{normal_damping, normal_elastic, normal_force, normal_stiffness, restitution_beta};
 pub use rolling::rolling_sds;
 pub use tangential::{contact_tangential_velocity, mindlin_tangential, oquendo_tangential, rotate_into_plane, TangentialOut};
 pub use twisting::twisting_torque;
@@ -242,8 +242,9 @@ impl MaterialConstants {
 
 impl<T: Real> PairCoeffs<T> {
     /// Coefficients for a contact between materials `a` and `b`. Elastic constants combine
-    /// as PHYSICS.md rules; friction, damping and restitution take the arithmetic mean of the
-    /// two materials (equal materials give their own values).
+    /// as PHYSICS.md rules; friction coefficients and the rolling angle take the smaller of
+    /// the two (as YADE does: a frictionless wall makes frictionless contacts); damping and
+    /// restitution take the arithmetic mean. Equal materials give their own values.
     pub fn mix(a: &MaterialConstants, b: &MaterialConstants) -> Self {
         let (va, vb) = (a.stiffness(), b.stiffness());
         let g_inv = (2.0 - a.poisson_ratio) / a.shear_modulus() + (2.0 - b.poisson_ratio) / b.shear_modulus();
@@ -251,9 +252,9 @@ impl<T: Real> PairCoeffs<T> {
         PairCoeffs {
             v_eff: T::of(va * vb / (va + vb)),
             g_eff: T::of(1.0 / g_inv),
-            mu_s: T::of(mean(a.mu_s, b.mu_s)),
-            mu_k: T::of(mean(a.mu_k, b.mu_k)),
-            tan_roll: T::of(mean(a.rolling_angle, b.rolling_angle).tan()),
+            mu_s: T::of(a.mu_s.min(b.mu_s)),
+            mu_k: T::of(a.mu_k.min(b.mu_k)),
+            tan_roll: T::of(a.rolling_angle.min(b.rolling_angle).tan()),
             gamma_n: T::of(mean(a.gamma_n, b.gamma_n)),
             gamma_nt: T::of(mean(a.gamma_nt, b.gamma_nt)),
             beta: T::of(restitution_beta(mean(a.restitution, b.restitution))),

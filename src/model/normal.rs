@@ -51,3 +51,13 @@ pub fn restitution_beta(e: f64) -> f64 {
     let l = e.ln();
     l.abs() / (l * l + std::f64::consts::PI * std::f64::consts::PI).sqrt()
 }
+
+/// Tangent stiffness `dF/dh` (N/m) of the elastic normal law: Hertz `2 V_eff sqrt(R_eff h)`
+/// (3/2 of the secant), linear `k_n`.
+#[inline(always)]
+pub fn normal_stiffness<T: Real>(law: &NormalLaw<T>, c: &PairCoeffs<T>, g: &Geometry<T>) -> T {
+    match *law {
+        NormalLaw::Hertz => T::of(2.0) * c.v_eff * (g.r_eff * g.h).sqrt(),
+        NormalLaw::Linear { k_n } => k_n,
+    }
+}

@@ -142,6 +142,9 @@ fn run_stage(
     if let Some(v) = stage.wet_volume {
         engine.wet(v)?;
     }
+    if scene.servo.is_some() {
+        engine.set_servo(stage.servo_pressure, stage.axial_strain_rate);
+    }
     let mut initial_void_ratio = None;
     if stage.lower_piston {
         let f = engine.frame(false);

@@ -95,6 +95,24 @@ pub enum WallShape {
     },
 }
 
+/// The servo-controlled box of a scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ServoBox {
+    /// Wall indices of the x_min, x_max, y_min, y_max, z_min, z_max planes.
+    pub walls: [usize; 6],
+    /// Initial target pressure (Pa).
+    pub pressure: f64,
+    /// Wall speed per pressure error (m/(s Pa)).
+    pub gain: f64,
+    /// Largest wall speed (m/s).
+    pub max_speed: f64,
+}
+
+/// Default largest speed of servo walls (m/s).
+pub const DEFAULT_SERVO_SPEED: f64 = 0.005;
+/// Pressure (Pa) below which the default servo gain stops growing.
+pub const SERVO_PRESSURE_FLOOR: f64 = 10.0;
+
 /// A wall, validated.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Wall {
@@ -161,6 +179,10 @@ pub struct Stage {
     pub records_compression: bool,
     /// Wet the sample at the start with this liquid volume (m^3).
     pub wet_volume: Option<f64>,
+    /// Servo walls' target pressure during the stage (Pa), if it changes.
+    pub servo_pressure: Option<f64>,
+    /// Triaxial: strain rate (1/s) of the servo box's z walls, or `None` for all-servo.
+    pub axial_strain_rate: Option<f64>,
 }
 
 /// What `--out` records.
@@ -187,6 +209,8 @@ pub struct Scene {
     pub grains: Grains,
     /// Walls.
     pub walls: Vec<Wall>,
+    /// The servo-controlled box, if any (its planes are among the walls).
+    pub servo: Option<ServoBox>,
     /// Wrapping interval `[lo, hi)` (m) of each periodic axis.
     pub periodic: [Option<[f64; 2]>; 3],
     /// Gravity (m/s^2).
@@ -321,6 +345,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
     if grains.is_empty() {
         return Err(c.invalid("grain", "[]", "the scene has no grains", "add [[grain]] or [[generate]] tables"));
     }
+    let servo = servo_box(&walls);
     let walls = finish_walls(&c, walls, &grains, &periodic)?;
     check_overlaps(&c, &f, &grains, &walls)?;
     check_periodic(&c, &f, &grains, &periodic, f.simulation.skin)?;
@@ -357,7 +382,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         Some(v) => positive(&c, "model.liquid_density", v, "give the liquid's density in kg/m^3, e.g. 1000")?,
         None => DEFAULT_LIQUID_DENSITY,
     };
-    let stages = validate_stages(&c, &f.stages, &grains, gravity, d_mean, &walls, liquid_density)?;
+    let stages = validate_stages(&c, &f.stages, &grains, gravity, d_mean, &walls, servo.is_some(), liquid_density)?;
     let bridges = bridge_limits(&c, &model, &stages, &grains)?;
     let output = Output {
         frame_interval: non_negative(&c, "output.frame_interval", f.output.frame_interval, "give seconds, or 0 for a frame per stage")?,
@@ -371,6 +396,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         materials,
         grains,
         walls,
+        servo,
         periodic,
         gravity,
         model,
@@ -479,6 +505,8 @@ struct PendingWall {
     wall: Wall,
     piston_mass: Option<f64>,
     piston_area: Option<f64>,
+    /// The servo box this plane belongs to: (pressure, gain, max speed).
+    servo: Option<(f64, f64, f64)>,
 }
 
 fn validate_walls(
@@ -487,7 +515,7 @@ fn validate_walls(
     material_of: &dyn Fn(String, &str) -> Result<u16, SceneError>,
 ) -> Result<Vec<PendingWall>, SceneError> {
     let mut out = Vec::new();
-    let plain = |name: String, shape: WallShape, material: u16| PendingWall { wall: Wall { name, shape, material }, piston_mass: None, piston_area: None };
+    let plain = |name: String, shape: WallShape, material: u16| PendingWall { wall: Wall { name, shape, material }, piston_mass: None, piston_area: None, servo: None };
     for (i, w) in f.walls.iter().enumerate() {
         let key = |k: &str| format!("wall[{i}].{k}");
         match w {
@@ -523,6 +551,32 @@ fn validate_walls(
                     out.push(plain(format!("wall[{i}].{face}"), WallShape::Plane { point, normal }, m));
                 }
             }
+            WallSpec::ServoBox { material, min, max, pressure, gain, max_speed } => {
+                let m = material_of(key("material"), material)?;
+                let (lo, hi) = (finite3(c, &key("min"), *min)?, finite3(c, &key("max"), *max)?);
+                if (0..3).any(|k| hi[k] <= lo[k]) {
+                    return Err(c.invalid(key("max"), format!("{hi:?}"), format!("must exceed min {lo:?} on every axis"), "give the upper corner above the lower one"));
+                }
+                if out.iter().any(|p: &PendingWall| p.servo.is_some()) {
+                    return Err(c.invalid(key("type"), "\"servo_box\"", "a scene has at most one servo box", "remove the extra one"));
+                }
+                let pressure = non_negative(c, &key("pressure"), *pressure, "give the target pressure in Pa")?;
+                let max_speed = positive(c, &key("max_speed"), max_speed.unwrap_or(DEFAULT_SERVO_SPEED), "give the largest wall speed in m/s")?;
+                let gain = positive(c, &key("gain"), gain.unwrap_or(max_speed / pressure.max(SERVO_PRESSURE_FLOOR)), "give the wall speed per pressure error in m/(s Pa)")?;
+                let faces: [(&str, [f64; 3], [f64; 3]); 6] = [
+                    ("x_min", lo, [1.0, 0.0, 0.0]),
+                    ("x_max", hi, [-1.0, 0.0, 0.0]),
+                    ("y_min", lo, [0.0, 1.0, 0.0]),
+                    ("y_max", hi, [0.0, -1.0, 0.0]),
+                    ("z_min", lo, [0.0, 0.0, 1.0]),
+                    ("z_max", hi, [0.0, 0.0, -1.0]),
+                ];
+                for (face, point, normal) in faces {
+                    let mut w = plain(format!("wall[{i}].{face}"), WallShape::Plane { point, normal }, m);
+                    w.servo = Some((pressure, gain, max_speed));
+                    out.push(w);
+                }
+            }
             WallSpec::Cylinder { material, center, radius } => {
                 let m = material_of(key("material"), material)?;
                 let radius = positive(c, &key("radius"), *radius, "give the radius in metres")?;
@@ -543,6 +597,7 @@ fn validate_walls(
                     wall: Wall { name: format!("wall[{i}]"), shape: WallShape::Piston { z: *z, pressure, mass: 0.0, area: 0.0 }, material: m },
                     piston_mass,
                     piston_area,
+                    servo: None,
                 });
             }
         }
@@ -552,6 +607,13 @@ fn validate_walls(
 
 /// Fills in the piston's default mass (total grain mass) and area (cross-section of the
 /// cylinder, or of a box's side walls).
+/// The servo box among the walls, if any.
+fn servo_box(pending: &[PendingWall]) -> Option<ServoBox> {
+    let first = pending.iter().position(|p| p.servo.is_some())?;
+    let (pressure, gain, max_speed) = pending[first].servo?;
+    Some(ServoBox { walls: [0, 1, 2, 3, 4, 5].map(|k| first + k), pressure, gain, max_speed })
+}
+
 fn finish_walls(c: &Complainer, pending: Vec<PendingWall>, grains: &Grains, periodic: &[Option<[f64; 2]>; 3]) -> Result<Vec<Wall>, SceneError> {
     let section = cross_section(pending.iter().map(|p| &p.wall.shape), periodic);
     let total_mass: f64 = grains.mass.iter().sum();
@@ -841,6 +903,7 @@ fn validate_stages(
     gravity: [f64; 3],
     d_mean: f64,
     walls: &[Wall],
+    has_servo: bool,
     liquid_density: f64,
 ) -> Result<Vec<Stage>, SceneError> {
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
@@ -902,6 +965,16 @@ fn validate_stages(
             pressure_tolerance,
             lower_piston: false,
             records_compression: false,
+            servo_pressure: match s.servo_pressure {
+                Some(_) if !has_servo => return Err(c.invalid(key("servo_pressure"), "(set)", "the scene has no servo box", "add a [[wall]] with type = \"servo_box\" or remove the key")),
+                Some(p) => Some(non_negative(c, &key("servo_pressure"), p, "give the pressure in Pa")?),
+                None => None,
+            },
+            axial_strain_rate: match s.axial_strain_rate {
+                Some(_) if !has_servo => return Err(c.invalid(key("axial_strain_rate"), "(set)", "the scene has no servo box", "add a [[wall]] with type = \"servo_box\" or remove the key")),
+                Some(r) if !r.is_finite() => return Err(c.invalid(key("axial_strain_rate"), r, "must be finite", "give a strain rate in 1/s, positive to compress")),
+                other => other,
+            },
             wet_volume: match s.water_content {
                 Some(w) => Some(positive(c, &key("water_content"), w, "give the gravimetric water content, e.g. 0.007")? * grains.mass.iter().sum::<f64>() / liquid_density),
                 None => None,

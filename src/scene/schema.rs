@@ -181,6 +181,26 @@ pub enum WallSpec {
         /// Radius (m).
         radius: f64,
     },
+    /// Six planes bounding a box, each moved along its normal by a servo that holds a target
+    /// pressure: wall speed = gain x (target - measured pressure), capped at `max_speed`
+    /// (isotropic compaction); a stage's `axial_strain_rate` drives the two z planes at a
+    /// fixed strain rate instead (triaxial compression).
+    ServoBox {
+        /// Material name.
+        material: String,
+        /// Lower corner (m).
+        min: [f64; 3],
+        /// Upper corner (m).
+        max: [f64; 3],
+        /// Target pressure (Pa). Default 0 (the walls back off until nothing pushes them).
+        #[serde(default)]
+        pressure: f64,
+        /// Wall speed per pressure error (m/(s Pa)). Default: max_speed / max(pressure, 10 Pa),
+        /// full speed for an error as large as the target.
+        gain: Option<f64>,
+        /// Largest wall speed (m/s). Default 0.005.
+        max_speed: Option<f64>,
+    },
     /// Horizontal plate facing down whose height follows Newton's law under the grains' push
     /// and a target pressure (stages may change the pressure).
     Piston {
@@ -367,6 +387,11 @@ pub struct StageSpec {
     pub p_max: Option<f64>,
     /// "oedometer": pressure multiplier between steps. Default 2 (seed 000).
     pub factor: Option<f64>,
+    /// Target pressure (Pa) of the servo walls during this stage. Default: unchanged.
+    pub servo_pressure: Option<f64>,
+    /// Triaxial compression: the servo box's z walls close at this strain rate (1/s) while
+    /// the x and y walls hold the servo pressure. Default: none (all walls servo).
+    pub axial_strain_rate: Option<f64>,
     /// Wet the sample at the start of the stage: gravimetric water content w (liquid mass over
     /// solid mass), shared among pairs closer than their rupture distance in proportion to
     /// their reduced diameter. Needs `model.cohesion = "capillary"`.
