@@ -70,6 +70,17 @@ pub enum Command {
     },
     /// List the GPU adapters with their backend and limits.
     Devices,
+    /// Analyse the force transmission of a finished run's last frame (recorded with
+    /// `output.contact_forces = true`): force and pressure PDFs with their exponential tails,
+    /// bonds by sign, particle stresses, bi-percolation, fabric; writes analysis.json and
+    /// pictures into the run's directory.
+    Analyze {
+        /// The run's --out directory.
+        run: PathBuf,
+        /// Print the analysis as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
     /// Run a scene over a grid of parameter values (resumable) and gather the table, the
     /// power law h_s = a eta^b and its plot.
     Sweep {

@@ -103,6 +103,23 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
+        Command::Analyze { run, json } => {
+            let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).with_context(|| format!("{}: no summary.json; fix: give the --out directory of a finished run", run.display()))?)?;
+            let scene_file = summary["file"].as_str().context("summary.json names no scene file")?;
+            let scene = scene::load(Path::new(scene_file))?;
+            let frame = grains::output::mcap::last_frame(&run.join("frames.mcap"))?;
+            if frame.contacts.is_none() {
+                anyhow::bail!("{}: the frames hold no contact forces; fix: set output.contact_forces = true in the scene and run it again", run.display());
+            }
+            let stats: grains::engine::Stats = serde_json::from_value(summary["stages"].as_array().and_then(|s| s.last()).map(|s| s["stats"].clone()).context("summary.json has no stages")?)?;
+            let a = grains::output::network::write(&scene, &frame, &stats, &run)?;
+            if json {
+                println!("{}", serde_json::to_string(&a)?);
+            } else {
+                print!("{}", grains::output::network::human(&a));
+            }
+            Ok(())
+        }
         Command::Devices => {
             let list = grains::gpu::describe_all();
             if list.is_empty() {

@@ -129,7 +129,7 @@ impl Stats {
 }
 
 /// One recorded instant: what an MCAP frame holds.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Frame {
     /// Simulated time (s).
     pub time: f64,
@@ -148,11 +148,12 @@ pub struct Frame {
     /// Touching grain pairs with their forces, when asked for.
     pub contacts: Option<Vec<ContactRecord>>,
     /// Grain-wall contacts with their forces, when contacts are asked for.
+    #[serde(default)]
     pub wall_contacts: Option<Vec<WallContactRecord>>,
 }
 
 /// One touching pair.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ContactRecord {
     /// Permanent id of grain i (the lower id).
     pub i: u32,
@@ -173,7 +174,7 @@ pub struct ContactRecord {
 
 /// One grain touching one wall. Its force is evaluated from the state of the frame (springs
 /// as they stand, not advanced).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct WallContactRecord {
     /// Permanent id of the grain.
     pub grain: u32,

@@ -56,6 +56,13 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
                 eprintln!("warning: {e:#}");
             }
         }
+        if scene.output.analysis {
+            let stats = engine.stats();
+            let a = crate::output::network::write(scene, &engine.frame(true), &stats, dir)?;
+            if progress_bar {
+                eprint!("{}", crate::output::network::human(&a));
+            }
+        }
         let path = dir.join("summary.json");
         std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))?;
     }

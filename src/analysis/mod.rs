@@ -1,6 +1,7 @@
 //! Measures of a packing computed from a frame, and the fits of the experiments.
 
 pub mod fit;
+pub mod network;
 
 use crate::engine::Frame;
 use crate::periodic::Periodic;
@@ -110,4 +111,30 @@ pub fn macroscopic_stress(moments: &[Tensor], volume: f64) -> Tensor {
         }
     }
     s
+}
+
+/// The sample's box (lower, upper corner, m): the servo box's walls when there is one (from
+/// their positions in `stats`), the period along periodic axes, else the grains' extent.
+pub fn sample_bounds(scene: &Scene, stats: &crate::engine::Stats, frame: &Frame) -> network::Bounds {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for i in 0..frame.radius.len() {
+        for a in 0..3 {
+            lo[a] = lo[a].min(frame.position[i][a] - frame.radius[i]);
+            hi[a] = hi[a].max(frame.position[i][a] + frame.radius[i]);
+        }
+    }
+    for a in 0..3 {
+        if let Some([l, h]) = scene.periodic[a] {
+            (lo[a], hi[a]) = (l, h);
+        }
+    }
+    if let Some(servo) = scene.servo {
+        for a in 0..3 {
+            if let (Some(l), Some(h)) = (stats.walls[servo.walls[2 * a]].position, stats.walls[servo.walls[2 * a + 1]].position) {
+                (lo[a], hi[a]) = (l, h);
+            }
+        }
+    }
+    (lo, hi)
 }

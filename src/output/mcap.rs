@@ -90,3 +90,17 @@ fn scene_update(f: &Frame) -> serde_json::Value {
         }]
     })
 }
+
+/// The last `/grains` frame of a recording.
+pub fn last_frame(path: &Path) -> anyhow::Result<Frame> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut last = None;
+    for m in ::mcap::MessageStream::new(&bytes).with_context(|| format!("{}: not an MCAP file", path.display()))? {
+        let m = m.with_context(|| format!("{}: damaged", path.display()))?;
+        if m.channel.topic == "/grains" {
+            last = Some(m.data.into_owned());
+        }
+    }
+    let data = last.with_context(|| format!("{}: no /grains frame", path.display()))?;
+    Ok(serde_json::from_slice(&data)?)
+}

@@ -3,6 +3,7 @@
 //! on a terminal.
 
 pub mod mcap;
+pub mod network;
 pub mod plot;
 mod summary;
 

@@ -155,3 +155,105 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
     }
     both(stem, (900, 640), |r| draw(r, title, points, law), |r| draw(r, title, points, law))
 }
+
+/// A PDF on a log-linear scale, with the fitted exponential tails drawn as lines.
+pub fn pdf(stem: &Path, title: &str, x_label: &str, pdf: &crate::analysis::network::Pdf, tails: &[(f64, f64, f64)]) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, x_label: &str, pdf: &crate::analysis::network::Pdf, tails: &[(f64, f64, f64)]) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
+        root.fill(&WHITE).map_err(err)?;
+        let pts: Vec<(f64, f64)> = pdf.x.iter().zip(&pdf.p).filter(|(_, p)| **p > 0.0).map(|(x, p)| (*x, *p)).collect();
+        let (x_lo, x_hi) = (pdf.x.first().copied().unwrap_or(0.0), pdf.x.last().copied().unwrap_or(1.0));
+        let p_hi = pts.iter().map(|q| q.1).fold(1e-3, f64::max) * 2.0;
+        let p_lo = pts.iter().map(|q| q.1).fold(f64::INFINITY, f64::min).min(p_hi / 10.0) / 2.0;
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(64)
+            .build_cartesian_2d(x_lo..x_hi, (p_lo..p_hi).log_scale())
+            .map_err(err)?;
+        chart.configure_mesh().x_desc(x_label).y_desc("probability density").draw().map_err(err)?;
+        chart.draw_series(pts.iter().map(|&(x, p)| Circle::new((x, p), 4, BLACK.filled()))).map_err(err)?;
+        // Each tail: P = amplitude exp(-rate |x|) from |x| = start on the sign of start.
+        for &(start, rate, amplitude) in tails {
+            let end = if start >= 0.0 { x_hi } else { x_lo };
+            let line: Vec<(f64, f64)> = (0..=50).map(|k| start + (end - start) * k as f64 / 50.0).map(|x| (x, amplitude * (-rate * x.abs()).exp())).filter(|q| q.1 > p_lo).collect();
+            chart.draw_series(LineSeries::new(line, &BLUE)).map_err(err)?.label(format!("exp(-{rate:.2} |x|)")).legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE));
+        }
+        if !tails.is_empty() {
+            chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
+        }
+        Ok(())
+    }
+    both(stem, (800, 600), |r| draw(r, title, x_label, pdf, tails), |r| draw(r, title, x_label, pdf, tails))
+}
+
+/// A slice of the packing, about three diameters thick across y through the middle, seen
+/// along y: the bonds as segments between centres (width proportional to the force;
+/// compressive red, tensile green), and the grains coloured by the sign of their pressure
+/// (red positive, blue negative).
+pub fn slices(stem_network: &Path, stem_pressure: &Path, title: &str, frame: &crate::engine::Frame, pressures: &[f64]) -> anyhow::Result<()> {
+    let n = frame.radius.len();
+    let d_mean = 2.0 * frame.radius.iter().sum::<f64>() / n.max(1) as f64;
+    let (y_lo, y_hi) = frame.position.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| (l.min(p[1]), h.max(p[1])));
+    let mid = 0.5 * (y_lo + y_hi);
+    let in_slice: Vec<bool> = frame.position.iter().map(|p| (p[1] - mid).abs() <= 1.5 * d_mean).collect();
+    let (mut x0, mut x1, mut z0, mut z1) = (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY);
+    for i in (0..n).filter(|&i| in_slice[i]) {
+        let (p, r) = (frame.position[i], frame.radius[i]);
+        (x0, x1, z0, z1) = (x0.min(p[0] - r), x1.max(p[0] + r), z0.min(p[2] - r), z1.max(p[2] + r));
+    }
+    let bonds: Vec<(usize, usize, f64)> = frame
+        .contacts
+        .as_deref()
+        .unwrap_or(&[])
+        .iter()
+        .filter(|c| c.normal_force != 0.0 && in_slice[c.i as usize] && in_slice[c.j as usize])
+        // A bond across a periodic boundary would cross the picture: leave it out.
+        .filter(|c| {
+            let (a, b) = (frame.position[c.i as usize], frame.position[c.j as usize]);
+            ((a[0] - b[0]).powi(2) + (a[2] - b[2]).powi(2)).sqrt() < 2.0 * (frame.radius[c.i as usize] + frame.radius[c.j as usize])
+        })
+        .map(|c| (c.i as usize, c.j as usize, c.normal_force))
+        .collect();
+    let f_max = bonds.iter().map(|b| b.2.abs()).fold(1e-300, f64::max);
+    let size = (900u32, (900.0 * (z1 - z0) / (x1 - x0)).clamp(300.0, 1400.0) as u32);
+    fn network<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, frame: &crate::engine::Frame, bonds: &[(usize, usize, f64)], f_max: f64, range: (f64, f64, f64, f64)) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(root).caption(format!("{title}: force network (red compressive, green tensile)"), ("sans-serif", 16)).margin(10).build_cartesian_2d(range.0..range.1, range.2..range.3).map_err(err)?;
+        chart
+            .draw_series(bonds.iter().map(|&(i, j, f)| {
+                let color = if f > 0.0 { RED } else { GREEN };
+                let width = (1.0 + 7.0 * f.abs() / f_max) as u32;
+                PathElement::new(vec![(frame.position[i][0], frame.position[i][2]), (frame.position[j][0], frame.position[j][2])], color.stroke_width(width))
+            }))
+            .map_err(err)?;
+        Ok(())
+    }
+    fn pressure<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, frame: &crate::engine::Frame, in_slice: &[bool], pressures: &[f64], range: (f64, f64, f64, f64)) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(root).caption(format!("{title}: particle pressure sign (red > 0, blue < 0)"), ("sans-serif", 16)).margin(10).build_cartesian_2d(range.0..range.1, range.2..range.3).map_err(err)?;
+        let px_per_m = root.dim_in_pixel().0 as f64 / (range.1 - range.0);
+        chart
+            .draw_series((0..pressures.len()).filter(|&i| in_slice[i]).map(|i| {
+                let color = if pressures[i] > 0.0 { RED } else if pressures[i] < 0.0 { BLUE } else { BLACK };
+                Circle::new((frame.position[i][0], frame.position[i][2]), (frame.radius[i] * px_per_m).max(1.0) as u32, color.mix(0.8).filled())
+            }))
+            .map_err(err)?;
+        Ok(())
+    }
+    let range = (x0, x1, z0, z1);
+    both(stem_network, size, |r| network(r, title, frame, &bonds, f_max, range), |r| network(r, title, frame, &bonds, f_max, range))?;
+    both(stem_pressure, size, |r| pressure(r, title, frame, &in_slice, pressures, range), |r| pressure(r, title, frame, &in_slice, pressures, range))
+}

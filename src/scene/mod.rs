@@ -192,6 +192,8 @@ pub struct Output {
     pub frame_interval: f64,
     /// Record contact forces in frames.
     pub contact_forces: bool,
+    /// Analyse the force transmission at the end of the run.
+    pub analysis: bool,
 }
 
 /// A validated scene, in SI units and `f64`; engines convert to their precision.
@@ -387,6 +389,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
     let output = Output {
         frame_interval: non_negative(&c, "output.frame_interval", f.output.frame_interval, "give seconds, or 0 for a frame per stage")?,
         contact_forces: f.output.contact_forces,
+        analysis: f.output.analysis,
     };
     let name = f.name.clone().unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     Ok(Scene {

@@ -411,4 +411,8 @@ pub struct OutputSpec {
     /// Record contact forces in the MCAP frames. Default false.
     #[serde(default)]
     pub contact_forces: bool,
+    /// At the end of the run, analyse the force transmission (force and pressure PDFs, bonds,
+    /// particle stresses, percolation, fabric) into `analysis.json` and pictures. Default false.
+    #[serde(default)]
+    pub analysis: bool,
 }

@@ -1,0 +1,271 @@
+//! Force transmission in a packing (seed 001): normal-force statistics with their exponential
+//! tails, bonds counted by sign, particle stresses and pressures, the macroscopic stress, the
+//! bi-percolation of the positive- and negative-pressure phases, and the fabric anisotropy.
+
+use super::{contact_moments, Tensor};
+use crate::engine::Frame;
+use crate::periodic::Periodic;
+use crate::real::Vec3;
+use serde::Serialize;
+
+/// Histogram bins of the force and pressure PDFs.
+pub const PDF_BINS: usize = 40;
+
+/// A probability density on regular bins.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Pdf {
+    /// Bin centres (in the normalised variable).
+    pub x: Vec<f64>,
+    /// Density per unit of the variable.
+    pub p: Vec<f64>,
+}
+
+impl Pdf {
+    /// The density of `values` on `bins` bins over `[lo, hi]`.
+    pub fn of(values: &[f64], lo: f64, hi: f64, bins: usize) -> Self {
+        let w = (hi - lo) / bins as f64;
+        let mut counts = vec![0usize; bins];
+        for &v in values {
+            if v >= lo && v <= hi {
+                counts[(((v - lo) / w) as usize).min(bins - 1)] += 1;
+            }
+        }
+        let n = values.len().max(1) as f64;
+        Pdf { x: (0..bins).map(|k| lo + (k as f64 + 0.5) * w).collect(), p: counts.iter().map(|&c| c as f64 / (n * w)).collect() }
+    }
+
+    /// The decay rate `a` of `P ~ exp(-a |x|)` fitted by least squares on `ln P` over the bins
+    /// with `from <= |x|` (and density), on the side `sign` (+1 or -1) of zero.
+    pub fn exponential_tail(&self, from: f64, sign: f64) -> Option<f64> {
+        let pts: Vec<(f64, f64)> = self.x.iter().zip(&self.p).filter(|(x, p)| **p > 0.0 && x.signum() == sign && x.abs() >= from).map(|(x, p)| (x.abs(), p.ln())).collect();
+        if pts.len() < 3 {
+            return None;
+        }
+        let n = pts.len() as f64;
+        let (mx, my) = (pts.iter().map(|q| q.0).sum::<f64>() / n, pts.iter().map(|q| q.1).sum::<f64>() / n);
+        let sxx: f64 = pts.iter().map(|q| (q.0 - mx).powi(2)).sum();
+        let sxy: f64 = pts.iter().map(|q| (q.0 - mx) * (q.1 - my)).sum();
+        Some(-sxy / sxx)
+    }
+}
+
+/// Bonds (pairs exerting a force) per grain.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Coordination {
+    /// All bonds: `2 bonds / N`.
+    pub all: f64,
+    /// Compressive bonds (total normal force > 0).
+    pub compressive: f64,
+    /// Tensile bonds (total normal force < 0).
+    pub tensile: f64,
+    /// All bonds per grain among grains with at least 2 bonds (rattlers left out).
+    pub without_rattlers: f64,
+    /// Fraction of grains with fewer than 2 bonds.
+    pub rattlers: f64,
+}
+
+/// Whether a phase spans the sample along each axis.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct Percolation {
+    /// Grains in the phase.
+    pub grains: usize,
+    /// Clusters of the phase over the bond network.
+    pub clusters: usize,
+    /// Grains in its largest cluster.
+    pub largest: usize,
+    /// Whether some cluster touches both faces of the sample along x, y, z.
+    pub spans: [bool; 3],
+}
+
+/// Everything `grains analyze` reports on a packing.
+#[derive(Clone, Debug, Serialize)]
+pub struct NetworkAnalysis {
+    /// Simulated time of the frame (s).
+    pub time: f64,
+    /// The force scale: the mean compressive force (dry) or `f0 = kappa R_max` (wet) (N).
+    pub force_scale: f64,
+    /// "mean force" or "f0 = kappa R_max".
+    pub force_scale_is: String,
+    /// PDF of the normal forces over the force scale.
+    pub force_pdf: Pdf,
+    /// Dry: `beta` of `exp(-beta f/<f>)` above the mean. Wet: `alpha_w` of the compressive side.
+    pub tail_compressive: Option<f64>,
+    /// Wet: `alpha_w` of the tensile side.
+    pub tail_tensile: Option<f64>,
+    /// Fraction of compressive forces below their mean.
+    pub below_mean: f64,
+    /// Bonds per grain.
+    pub coordination: Coordination,
+    /// Solid fraction of the sample.
+    pub solid_fraction: f64,
+    /// Volume-weighted particle stress over the sample (Pa, compression positive).
+    pub macroscopic_stress: Tensor,
+    /// Mean particle pressure over the sample (Pa, compression positive).
+    pub mean_pressure: f64,
+    /// PDF of the particle pressures over their mean absolute value.
+    pub pressure_pdf: Pdf,
+    /// Grains of positive and of negative pressure as two phases over the bond network.
+    pub positive_phase: Percolation,
+    /// The negative-pressure phase.
+    pub negative_phase: Percolation,
+    /// Fabric tensor `<n (x) n>` over the bonds.
+    pub fabric: Tensor,
+    /// Axisymmetric fabric anisotropy about z, `5 (F_zz - (F_xx + F_yy)/2)`.
+    pub fabric_anisotropy: f64,
+    /// Particle pressure of each grain (Pa, compression positive), by slot.
+    #[serde(skip)]
+    pub pressures: Vec<f64>,
+}
+
+/// The sample's box: lower and upper corners (m).
+pub type Bounds = ([f64; 3], [f64; 3]);
+
+/// Analyses a frame taken with contacts. `f0` is the largest capillary force `kappa R_max` of
+/// a wet packing (forces are then normalised by it), `None` for a dry one; `bounds` is the
+/// sample's box.
+pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Option<f64>) -> NetworkAnalysis {
+    let n = frame.radius.len();
+    let contacts = frame.contacts.as_deref().unwrap_or(&[]);
+    let forces: Vec<f64> = contacts.iter().map(|c| c.normal_force).filter(|f| *f != 0.0).collect();
+    let compressive: Vec<f64> = forces.iter().copied().filter(|f| *f > 0.0).collect();
+    let mean_c = compressive.iter().sum::<f64>() / compressive.len().max(1) as f64;
+    let (scale, scale_is) = match f0 {
+        Some(f0) => (f0, "f0 = kappa R_max"),
+        None => (mean_c, "mean force"),
+    };
+    let normalised: Vec<f64> = forces.iter().map(|f| f / scale.max(1e-300)).collect();
+    let hi = normalised.iter().copied().fold(0.0, f64::max).max(1.0);
+    let lo = normalised.iter().copied().fold(0.0, f64::min);
+    let force_pdf = Pdf::of(&normalised, lo, hi, PDF_BINS);
+    let (tail_compressive, tail_tensile) = match f0 {
+        Some(_) => (force_pdf.exponential_tail(0.0, 1.0), force_pdf.exponential_tail(0.0, -1.0)),
+        None => (force_pdf.exponential_tail(1.0, 1.0), None),
+    };
+    let below_mean = compressive.iter().filter(|f| **f < mean_c).count() as f64 / compressive.len().max(1) as f64;
+
+    // Bonds per grain, by sign.
+    let mut bonds = vec![0usize; n];
+    let (mut n_comp, mut n_tens) = (0usize, 0usize);
+    for c in contacts.iter().filter(|c| c.normal_force != 0.0) {
+        bonds[c.i as usize] += 1;
+        bonds[c.j as usize] += 1;
+        if c.normal_force > 0.0 { n_comp += 1 } else { n_tens += 1 }
+    }
+    let rattlers = bonds.iter().filter(|b| **b < 2).count();
+    let kept: usize = bonds.iter().filter(|b| **b >= 2).sum();
+    let coordination = Coordination {
+        all: 2.0 * (n_comp + n_tens) as f64 / n as f64,
+        compressive: 2.0 * n_comp as f64 / n as f64,
+        tensile: 2.0 * n_tens as f64 / n as f64,
+        without_rattlers: kept as f64 / (n - rattlers).max(1) as f64,
+        rattlers: rattlers as f64 / n as f64,
+    };
+
+    // Particle stresses: sigma_i = moments_i / V_i with the free volume V_i = pi d^3 / (6 nu).
+    let (lo_b, hi_b) = bounds;
+    let volume: f64 = (0..3).map(|a| hi_b[a] - lo_b[a]).product();
+    let solid: f64 = frame.radius.iter().map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3)).sum();
+    let nu = solid / volume;
+    let moments = contact_moments(frame, periodic);
+    let pressures: Vec<f64> = (0..n)
+        .map(|i| {
+            let v_i = 4.0 / 3.0 * std::f64::consts::PI * frame.radius[i].powi(3) / nu;
+            -(moments[i][0][0] + moments[i][1][1] + moments[i][2][2]) / (3.0 * v_i)
+        })
+        .collect();
+    let mut macro_stress = [[0.0; 3]; 3];
+    for m in &moments {
+        for a in 0..3 {
+            for b in 0..3 {
+                macro_stress[a][b] -= m[a][b] / volume;
+            }
+        }
+    }
+    let mean_pressure = (macro_stress[0][0] + macro_stress[1][1] + macro_stress[2][2]) / 3.0;
+    let p_scale = pressures.iter().map(|p| p.abs()).sum::<f64>() / n.max(1) as f64;
+    let p_norm: Vec<f64> = pressures.iter().map(|p| p / p_scale.max(1e-300)).collect();
+    let pressure_pdf = Pdf::of(&p_norm, p_norm.iter().copied().fold(0.0, f64::min), p_norm.iter().copied().fold(0.0, f64::max).max(1e-12), PDF_BINS);
+
+    // Fabric over the bonds.
+    let mut fabric = [[0.0; 3]; 3];
+    let mut n_bonds = 0.0f64;
+    for c in contacts.iter().filter(|c| c.normal_force != 0.0) {
+        let d = periodic.min_image(Vec3::of(frame.position[c.i as usize]) - Vec3::of(frame.position[c.j as usize]));
+        let u = (d * (1.0 / d.norm())).f64();
+        for a in 0..3 {
+            for b in 0..3 {
+                fabric[a][b] += u[a] * u[b];
+            }
+        }
+        n_bonds += 1.0;
+    }
+    for row in &mut fabric {
+        for x in row.iter_mut() {
+            *x /= n_bonds.max(1.0);
+        }
+    }
+    let d_mean = 2.0 * frame.radius.iter().sum::<f64>() / n.max(1) as f64;
+    let phase = |positive: bool| percolation(frame, contacts, &pressures, positive, bounds, d_mean);
+    NetworkAnalysis {
+        time: frame.time,
+        force_scale: scale,
+        force_scale_is: scale_is.to_string(),
+        force_pdf,
+        tail_compressive,
+        tail_tensile,
+        below_mean,
+        coordination,
+        solid_fraction: nu,
+        macroscopic_stress: macro_stress,
+        mean_pressure,
+        pressure_pdf,
+        positive_phase: phase(true),
+        negative_phase: phase(false),
+        fabric_anisotropy: 5.0 * (fabric[2][2] - 0.5 * (fabric[0][0] + fabric[1][1])),
+        fabric,
+        pressures,
+    }
+}
+
+/// Clusters of the grains of one pressure sign linked by bonds; a cluster spans an axis when
+/// it holds grains within a mean diameter of both faces of the sample.
+fn percolation(frame: &Frame, contacts: &[crate::engine::ContactRecord], pressures: &[f64], positive: bool, bounds: Bounds, d_mean: f64) -> Percolation {
+    let n = pressures.len();
+    let member: Vec<bool> = pressures.iter().map(|p| if positive { *p > 0.0 } else { *p < 0.0 }).collect();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for c in contacts.iter().filter(|c| c.normal_force != 0.0) {
+        let (i, j) = (c.i as usize, c.j as usize);
+        if member[i] && member[j] {
+            let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+            if a != b {
+                parent[a.max(b)] = a.min(b);
+            }
+        }
+    }
+    let mut size = vec![0usize; n];
+    let mut lo = vec![[f64::INFINITY; 3]; n];
+    let mut hi = vec![[f64::NEG_INFINITY; 3]; n];
+    for i in (0..n).filter(|&i| member[i]) {
+        let r = root(&mut parent, i);
+        size[r] += 1;
+        for a in 0..3 {
+            lo[r][a] = lo[r][a].min(frame.position[i][a] - frame.radius[i]);
+            hi[r][a] = hi[r][a].max(frame.position[i][a] + frame.radius[i]);
+        }
+    }
+    let roots: Vec<usize> = (0..n).filter(|&r| size[r] > 0).collect();
+    let mut spans = [false; 3];
+    for &r in &roots {
+        for a in 0..3 {
+            spans[a] |= lo[r][a] <= bounds.0[a] + d_mean && hi[r][a] >= bounds.1[a] - d_mean;
+        }
+    }
+    Percolation { grains: member.iter().filter(|m| **m).count(), clusters: roots.len(), largest: roots.iter().map(|&r| size[r]).max().unwrap_or(0), spans }
+}
