@@ -32,6 +32,28 @@ pub enum Backend {
     Auto,
 }
 
+/// Backends `grains bench` measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BenchBackend {
+    /// The CPU engine.
+    Cpu,
+    /// The GPU engine.
+    Gpu,
+    /// Both.
+    All,
+}
+
+/// Parts of `grains bench`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BenchPart {
+    /// Particle-steps per second, memory and time per phase on the dense bed.
+    Throughput,
+    /// Wall time against error over a ladder of time steps.
+    Ladder,
+    /// Both.
+    All,
+}
+
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
@@ -78,6 +100,40 @@ pub enum Command {
         /// The run's --out directory.
         run: PathBuf,
         /// Print the analysis as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Measure: throughput on the peers' dense bed (poured once and cached, tiled in x-y for
+    /// larger sizes) on each backend and precision, and speed against error on fixed scenes.
+    Bench {
+        /// Grain counts of the throughput runs (multiples of 10,000), comma-separated.
+        #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 100_000, 1_000_000])]
+        sizes: Vec<usize>,
+        /// Backends: cpu, gpu or all (gpu: every run on the adapter --adapter names, or the best).
+        #[arg(long, value_enum, default_value = "cpu")]
+        backend: BenchBackend,
+        /// GPU adapter whose name contains this (case-insensitive).
+        #[arg(long)]
+        adapter: Option<String>,
+        /// CPU precisions, comma-separated.
+        #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Precision::F64, Precision::F32])]
+        precision: Vec<Precision>,
+        /// CPU thread counts, comma-separated (default: 1 and every core).
+        #[arg(long, value_delimiter = ',')]
+        threads: Vec<usize>,
+        /// Particle-steps per timed run (its steps are this over the grain count, at least 20).
+        #[arg(long, default_value_t = 1e8)]
+        work: f64,
+        /// Which parts to run.
+        #[arg(long, value_enum, default_value = "all")]
+        part: BenchPart,
+        /// Folder of the cached bed (default: $XDG_CACHE_HOME/grains or ~/.cache/grains).
+        #[arg(long)]
+        cache: Option<PathBuf>,
+        /// Write bench.json and the speed-against-error plots here.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print one JSON object on stdout (and nothing else).
         #[arg(long)]
         json: bool,
     },

@@ -1,6 +1,6 @@
 //! The subcommands' bodies.
 
-use crate::cli::{Backend, Cli, Command, FitLaw, Precision};
+use crate::cli::{Backend, BenchBackend, BenchPart, Cli, Command, FitLaw, Precision};
 use anyhow::Context;
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
@@ -117,6 +117,41 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 println!("{}", serde_json::to_string(&a)?);
             } else {
                 print!("{}", grains::output::network::human(&a));
+            }
+            Ok(())
+        }
+        Command::Bench { sizes, backend, adapter, precision, threads, work, part, cache, out, json } => {
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            let mut threads = if threads.is_empty() { vec![1, cores] } else { threads };
+            threads.dedup();
+            if let Some(t) = threads.iter().find(|&&t| t == 0) {
+                anyhow::bail!("--threads {t}: a run needs at least one thread; fix: give counts from 1 to {cores}");
+            }
+            let backends: Vec<String> = match backend {
+                BenchBackend::Cpu => vec!["cpu".into()],
+                BenchBackend::Gpu => vec!["gpu".into()],
+                BenchBackend::All => vec!["cpu".into(), "gpu".into()],
+            };
+            let opts = grains::bench::BenchOptions {
+                sizes,
+                backends,
+                precisions: precision.iter().map(|p| if *p == Precision::F32 { "f32".to_string() } else { "f64".to_string() }).collect(),
+                threads,
+                work,
+                throughput: part != BenchPart::Ladder,
+                ladder: part != BenchPart::Throughput,
+                cache: cache.unwrap_or_else(grains::bench::bed::default_cache),
+                adapter,
+                progress: !json,
+            };
+            let report = grains::bench::run(&opts)?;
+            if let Some(dir) = &out {
+                report.write(dir)?;
+            }
+            if json {
+                println!("{}", serde_json::to_string(&report)?);
+            } else {
+                print!("{}", report.human());
             }
             Ok(())
         }

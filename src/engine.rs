@@ -86,6 +86,8 @@ pub struct Stats {
     pub momentum: [f64; 3],
     /// Total angular momentum of the grains about the origin (kg m^2/s).
     pub angular_momentum: [f64; 3],
+    /// Grain-grain pairs in the neighbour list (touching or within the skin).
+    pub pairs: u64,
     /// Grain-grain pairs touching.
     pub contacts: u64,
     /// Grain-wall contacts.
@@ -223,4 +225,13 @@ pub trait Engine {
     /// Moves the piston to height `z` (m) and stops it; no effect without a piston. The host
     /// places it where it touches nothing yet, so the last forces stay valid.
     fn place_piston(&mut self, z: f64);
+    /// Bytes of the arrays and buffers the engine holds now (allocated, not just used).
+    fn memory_bytes(&self) -> u64;
+    /// Starts or stops timing each phase of the step; a no-op where the backend cannot.
+    fn set_profiling(&mut self, _on: bool) {}
+    /// Seconds spent in each phase while profiling, by phase name; empty where the backend
+    /// does not time its phases.
+    fn phase_seconds(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
 }

@@ -11,6 +11,7 @@ mod grid;
 mod integrate;
 mod pair_force;
 mod pairs;
+mod profile;
 mod reduce;
 mod state;
 mod wall_contacts;
@@ -18,6 +19,7 @@ mod wall_contacts;
 pub use integrate::rotate;
 pub use pairs::PairList;
 pub use pair_force::ForceContext;
+pub use profile::PHASE_NAMES;
 pub use state::{Body, HistorySlots, Load, Props};
 pub use wall_contacts::{wall_contact_records, WallState};
 
@@ -31,6 +33,7 @@ use crate::walls::WallGeom;
 use gather::gather;
 use grid::{hash_cells, CellGrid};
 use pair_force::pair_force;
+use profile::{Phase, PhaseClock};
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS};
 use wall_contacts::wall_contacts;
@@ -123,6 +126,8 @@ pub struct CpuEngine<T: Real> {
     time: f64,
     rebuilds: u64,
     external_work: f64,
+    /// Time per phase, when profiling.
+    clock: PhaseClock,
 }
 
 impl<T: Real> CpuEngine<T> {
@@ -205,6 +210,7 @@ impl<T: Real> CpuEngine<T> {
             time: 0.0,
             rebuilds: 0,
             external_work: 0.0,
+            clock: PhaseClock::default(),
         };
         engine.rebuild()?;
         Ok(engine)
@@ -213,6 +219,7 @@ impl<T: Real> CpuEngine<T> {
     /// Rebuilds the neighbour list now (`hash_cells`, `detect_pairs`, `remap_history`),
     /// carrying every contact's history over.
     pub fn rebuild(&mut self) -> Result<(), SimError> {
+        let t = self.clock.start();
         if self.periodic.any() {
             let p = self.periodic;
             self.body.par_iter_mut().zip(self.image.par_iter_mut()).with_min_len(PAR_MIN_ITEMS).for_each(|(b, image)| {
@@ -226,8 +233,12 @@ impl<T: Real> CpuEngine<T> {
         if !hash_cells(&self.body, self.cutoff, &self.periodic, &mut self.grid) {
             return Err(self.non_finite_error());
         }
+        self.clock.stop(Phase::Hash, t);
+        let t = self.clock.start();
         let pairs = PairList::detect(&self.body, &self.prop, &self.id, &self.grid, &self.periodic, self.detect_reach, self.capacity)
             .map_err(|(i, count)| SimError::Capacity { step: self.step, grain: self.id[i], count, capacity: self.capacity })?;
+        self.clock.stop(Phase::Detect, t);
+        let t = self.clock.start();
         self.hist = pairs::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
         self.pairs = pairs;
         self.out.clear();
@@ -237,6 +248,7 @@ impl<T: Real> CpuEngine<T> {
         }
         self.rebuilds += 1;
         self.forces_valid = false;
+        self.clock.stop(Phase::Remap, t);
         Ok(())
     }
 
@@ -318,6 +330,7 @@ impl<T: Real> CpuEngine<T> {
     /// Runs the force passes: `update_bridges` (capillary scenes), `pair_force`,
     /// `wall_contacts`, `gather`.
     fn evaluate_forces(&mut self) {
+        let t = self.clock.start();
         if self.slots.layout.bridge {
             self.update_bridges();
         }
@@ -342,30 +355,38 @@ impl<T: Real> CpuEngine<T> {
                 .enumerate()
                 .for_each(|(k, (o, h))| *o = pair_force(k, pairs, body, prop, &ctx, h));
         }
+        self.clock.stop(Phase::Force, t);
+        let t = self.clock.start();
         if !self.walls.is_empty() {
             let sums = wall_pass(&ctx, body, prop, &self.walls, &mut self.wall_load, &mut self.wall_hist);
             self.wall_reaction = sums.reaction;
             self.wall_count = sums.count;
             self.wall_response = sums.response;
         }
+        self.clock.stop(Phase::Walls, t);
+        let t = self.clock.start();
         let (out, wall_load, gravity) = (&self.out, &self.wall_load, self.gravity);
         self.load.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, l)| *l = gather(i, pairs, out, &wall_load[i], &prop[i], gravity));
         self.forces_valid = true;
+        self.clock.stop(Phase::Gather, t);
     }
 
     /// Kick of every grain and of the piston by `tau` (s).
     fn kick(&mut self, tau: T) {
+        let t = self.clock.start();
         let (load, prop) = (&self.load, &self.prop);
         self.body.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, b)| integrate::kick(b, &load[i], &prop[i], tau));
         if let Some(p) = self.piston {
             let push = self.wall_reaction[p.wall].z - p.pressure * p.area;
             self.walls[p.wall].velocity.z += push * tau / p.mass;
         }
+        self.clock.stop(Phase::Integrate, t);
     }
 
     /// Drift of every grain (and orientation, and piston) by `tau` (s); rebuilds the
     /// neighbour list when a grain has moved half the skin since the last build.
     fn drift(&mut self, tau: T) -> Result<(), SimError> {
+        let t = self.clock.start();
         let moved: Vec<T> = self
             .body
             .par_chunks_mut(CHUNK)
@@ -389,6 +410,7 @@ impl<T: Real> CpuEngine<T> {
         self.since_eval += tau;
         let max_moved = moved.into_iter().fold(T::ZERO, T::max);
         let half = self.skin * T::of(0.5);
+        self.clock.stop(Phase::Integrate, t);
         if !(max_moved < half * half) {
             self.rebuild()?;
         }
@@ -569,6 +591,12 @@ struct PairSums {
     max_overlap: (f64, u32),
 }
 
+/// Bytes a vector holds allocated.
+#[allow(clippy::ptr_arg)] // the capacity lives on the Vec, not the slice
+fn allocated<X>(v: &Vec<X>) -> u64 {
+    (v.capacity() * std::mem::size_of::<X>()) as u64
+}
+
 fn max_by_first(a: (f64, u32), b: (f64, u32)) -> (f64, u32) {
     if b.0 > a.0 { b } else { a }
 }
@@ -736,6 +764,7 @@ impl<T: Real> Engine for CpuEngine<T> {
             external_work: self.external_work,
             momentum: gs.momentum,
             angular_momentum: gs.angular,
+            pairs: self.pairs.len() as u64,
             contacts: ps.contacts,
             wall_contacts: gs.wall_contacts,
             clamped: ps.clamped,
@@ -844,6 +873,22 @@ impl<T: Real> Engine for CpuEngine<T> {
         }
         self.forces_valid = false;
         Ok(())
+    }
+
+    fn memory_bytes(&self) -> u64 {
+        let l = &self.pairs;
+        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.body) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
+        let walls = allocated(&self.wall_hist) + allocated(&self.wall_load) + self.orientation.as_ref().map_or(0, allocated);
+        let pairs = allocated(&self.hist) + allocated(&self.out) + allocated(&l.owner_start) + allocated(&l.owner) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
+        grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)
+    }
+
+    fn set_profiling(&mut self, on: bool) {
+        self.clock.enable(on);
+    }
+
+    fn phase_seconds(&self) -> Vec<(&'static str, f64)> {
+        self.clock.totals()
     }
 
     fn save(&self) -> Option<EngineState> {

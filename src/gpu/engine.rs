@@ -815,6 +815,7 @@ impl Engine for GpuEngine {
             external_work: self.piston.map_or(0.0, |w| walls[w].piston[3] as f64),
             momentum: [g(3), g(4), g(5)],
             angular_momentum: [g(6), g(7), g(8)],
+            pairs: control.n_pairs as u64,
             contacts,
             wall_contacts,
             clamped: p(1).round() as u64,
@@ -905,6 +906,10 @@ impl Engine for GpuEngine {
 
     fn restore(&mut self, _: &crate::checkpoint::EngineState) -> anyhow::Result<()> {
         anyhow::bail!("the GPU backend does not resume from checkpoints yet; fix: resume with --backend cpu")
+    }
+
+    fn memory_bytes(&self) -> u64 {
+        self.buffers.values().map(wgpu::Buffer::size).sum()
     }
 
     fn place_piston(&mut self, z: f64) {

@@ -257,3 +257,38 @@ pub fn slices(stem_network: &Path, stem_pressure: &Path, title: &str, frame: &cr
     both(stem_network, size, |r| network(r, title, frame, &bonds, f_max, range), |r| network(r, title, frame, &bonds, f_max, range))?;
     both(stem_pressure, size, |r| pressure(r, title, frame, &in_slice, pressures, range), |r| pressure(r, title, frame, &in_slice, pressures, range))
 }
+
+/// Wall time against error (log-log), one line per series (name, (error, seconds) points):
+/// the cheapest setting for an error budget is the lowest point left of it.
+pub fn speed_error(stem: &Path, title: &str, x_label: &str, series: &[(String, Vec<(f64, f64)>)]) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, x_label: &str, series: &[(String, Vec<(f64, f64)>)]) -> anyhow::Result<()>
+    where
+        DB::ErrorType: 'static,
+    {
+        let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
+        root.fill(&WHITE).map_err(err)?;
+        let points = || series.iter().flat_map(|(_, p)| p.iter().copied()).filter(|(e, t)| *e > 0.0 && *t > 0.0);
+        let (x_lo, x_hi) = points().fold((f64::INFINITY, 0.0f64), |(lo, hi), (e, _)| (lo.min(e), hi.max(e)));
+        let (y_lo, y_hi) = points().fold((f64::INFINITY, 0.0f64), |(lo, hi), (_, t)| (lo.min(t), hi.max(t)));
+        if !(x_lo < x_hi && y_lo < y_hi) {
+            anyhow::bail!("nothing to plot for {title}");
+        }
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(64)
+            .build_cartesian_2d((x_lo / 2.0..x_hi * 2.0).log_scale(), (y_lo / 1.5..y_hi * 1.5).log_scale())
+            .map_err(err)?;
+        chart.configure_mesh().x_desc(x_label).y_desc("wall time (s)").x_label_formatter(&|x| format!("{x:.0e}")).draw().map_err(err)?;
+        for (k, (name, pts)) in series.iter().enumerate() {
+            let color = Palette99::pick(k).to_rgba();
+            let pts: Vec<(f64, f64)> = pts.iter().copied().filter(|(e, t)| *e > 0.0 && *t > 0.0).collect();
+            chart.draw_series(LineSeries::new(pts.clone(), color.stroke_width(2))).map_err(err)?.label(name.as_str()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled()))).map_err(err)?;
+        }
+        chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
+        Ok(())
+    }
+    both(stem, (900, 640), |r| draw(r, title, x_label, series), |r| draw(r, title, x_label, series))
+}

@@ -1,0 +1,237 @@
+//! `grains bench`: throughput on the peers' dense bed at 10^4 to 10^6 grains on each backend
+//! and precision, and speed against error on fixed scenes. Headless; `--json` prints one
+//! [`BenchReport`].
+
+pub mod bed;
+pub mod ladder;
+pub mod memory;
+pub mod throughput;
+
+use crate::engine::Engine;
+use anyhow::Context;
+use bed::BedInfo;
+use ladder::Ladder;
+use serde::Serialize;
+use std::path::PathBuf;
+use throughput::Throughput;
+
+/// What to measure.
+#[derive(Clone, Debug)]
+pub struct BenchOptions {
+    /// Grain counts of the throughput runs (multiples of the 10^4-grain bed).
+    pub sizes: Vec<usize>,
+    /// Backends: "cpu", "gpu".
+    pub backends: Vec<String>,
+    /// CPU precisions: "f32", "f64" (the GPU computes in f32).
+    pub precisions: Vec<String>,
+    /// CPU thread counts.
+    pub threads: Vec<usize>,
+    /// Particle-steps per timed run (the steps are this over the grain count, at least 20).
+    pub work: f64,
+    /// Run the throughput part.
+    pub throughput: bool,
+    /// Run the speed-against-error part.
+    pub ladder: bool,
+    /// Where the poured bed is cached.
+    pub cache: PathBuf,
+    /// GPU adapter name (substring); the best one when absent.
+    pub adapter: Option<String>,
+    /// Print progress on stderr.
+    pub progress: bool,
+}
+
+/// The machine the figures were measured on.
+#[derive(Clone, Debug, Serialize)]
+pub struct Machine {
+    /// CPU model.
+    pub cpu: String,
+    /// Logical cores.
+    pub cores: usize,
+    /// Vector instruction sets the build may use.
+    pub build_features: Vec<String>,
+    /// grains version.
+    pub version: String,
+}
+
+/// Everything `grains bench` measured.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    /// Where it ran.
+    pub machine: Machine,
+    /// The bed (poured once, cached).
+    pub bed: BedInfo,
+    /// Throughput runs.
+    pub throughput: Vec<Throughput>,
+    /// Speed against error.
+    pub ladder: Option<Ladder>,
+}
+
+/// This machine.
+pub fn machine() -> Machine {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| t.lines().find(|l| l.starts_with("model name")).and_then(|l| l.split(':').nth(1)).map(|s| s.trim().to_string()))
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let mut build_features = Vec::new();
+    for (on, name) in [(cfg!(target_feature = "sse4.2"), "sse4.2"), (cfg!(target_feature = "avx2"), "avx2"), (cfg!(target_feature = "fma"), "fma"), (cfg!(target_feature = "avx512f"), "avx512f"), (cfg!(target_feature = "neon"), "neon")] {
+        if on {
+            build_features.push(name.to_string());
+        }
+    }
+    Machine { cpu, cores: std::thread::available_parallelism().map_or(1, |n| n.get()), build_features, version: env!("CARGO_PKG_VERSION").to_string() }
+}
+
+fn pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")
+}
+
+/// Runs the benchmark.
+pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
+    let say = |s: &str| {
+        if opts.progress {
+            eprintln!("bench: {s}");
+        }
+    };
+    let all = pool(0)?;
+    let (base, bed) = all.install(|| bed::settled_bed(&opts.cache, opts.progress))?;
+    let machine = machine();
+    let mut rows = Vec::new();
+    if opts.throughput {
+        for &n in &opts.sizes {
+            for backend in &opts.backends {
+                let configs: Vec<(String, usize)> = if backend == "gpu" {
+                    vec![("f32".into(), 1)]
+                } else {
+                    opts.precisions.iter().flat_map(|p| opts.threads.iter().map(move |&t| (p.clone(), t))).collect()
+                };
+                for (precision, threads) in configs {
+                    let steps = ((opts.work / n as f64).round() as u64).max(20);
+                    let warmup = (steps / 5).max(10);
+                    say(&format!("{backend} {precision} {threads} thread(s), {n} grains: {warmup} + {steps} steps"));
+                    let peak_reset = memory::reset_peak();
+                    let row = if backend == "gpu" {
+                        let gpu = crate::gpu::open(opts.adapter.as_deref())?;
+                        let device = gpu.info.name.clone();
+                        let mut engine = {
+                            let scene = bed::bed_of(&base, n)?;
+                            crate::gpu::GpuEngine::new(gpu, &scene)?
+                        };
+                        throughput::measure(&mut engine, &device, 1, warmup, steps, peak_reset)?
+                    } else {
+                        pool(threads)?.install(|| -> anyhow::Result<Throughput> {
+                            let mut engine: Box<dyn Engine> = {
+                                let scene = bed::bed_of(&base, n)?;
+                                crate::runner::cpu_engine(&scene, &precision)?
+                            };
+                            throughput::measure(engine.as_mut(), &machine.cpu, threads, warmup, steps, peak_reset)
+                        })?
+                    };
+                    say(&format!("  {:.3e} particle-steps/s, Z = {:.3}, {:.0} B/grain", row.particle_steps_per_second, row.contacts_per_grain, row.bytes_per_grain));
+                    rows.push(row);
+                }
+            }
+        }
+    }
+    let ladder = if opts.ladder { Some(all.install(|| ladder::ladder(&base, &say))?) } else { None };
+    Ok(BenchReport { machine, bed, throughput: rows, ladder })
+}
+
+impl BenchReport {
+    /// Tables for a person.
+    pub fn human(&self) -> String {
+        let m = &self.machine;
+        let mut s = format!("machine: {} ({} cores; build features: {})\n", m.cpu, m.cores, if m.build_features.is_empty() { "baseline".to_string() } else { m.build_features.join(", ") });
+        s.push_str(&format!(
+            "bed: the peers' pour, {:.3} s simulated ({}), Z = {:.3} at the end, poured in {:.0} s once and cached\n",
+            self.bed.time,
+            if self.bed.settled { "settled" } else { "not settled" },
+            self.bed.coordination,
+            self.bed.wall_seconds
+        ));
+        if !self.throughput.is_empty() {
+            s.push_str("\nthroughput (dense settled bed, Hertz-Mindlin, dt = 2e-6 s)\n");
+            s.push_str("backend prec thr    grains  particle-steps/s  ns/p-step     Z  pairs/grain  B/grain  peak RSS MiB  time shares\n");
+            for r in &self.throughput {
+                let mut phases = r.phases.clone();
+                phases.sort_by(|a, b| b.share.total_cmp(&a.share));
+                let shares: Vec<String> = phases.iter().filter(|p| p.share >= 0.005).map(|p| format!("{} {:.0}%", p.phase, 100.0 * p.share)).collect();
+                s.push_str(&format!(
+                    "{:<7} {:<4} {:>3} {:>9} {:>17.3e} {:>10.1} {:>5.2} {:>12.2} {:>8.0} {:>13} {}\n",
+                    r.backend,
+                    r.precision,
+                    r.threads,
+                    r.grains,
+                    r.particle_steps_per_second,
+                    r.ns_per_particle_step,
+                    r.contacts_per_grain,
+                    r.pairs_per_grain,
+                    r.bytes_per_grain,
+                    r.peak_rss_bytes.map_or("-".to_string(), |b| format!("{:.0}", b as f64 / (1 << 20) as f64)),
+                    shares.join(", ")
+                ));
+            }
+        }
+        if let Some(l) = &self.ladder {
+            s.push_str("\nspeed against error (errors against an f64 velocity-Verlet reference at a 4x smaller step than the smallest here)\n");
+            s.push_str("scene        integrator        prec        dt   steps  force evals   wall s  energy err  position err  force err\n");
+            let opt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.2e}"));
+            for r in &l.rungs {
+                if let Some(why) = &r.unstable {
+                    s.push_str(&format!("{:<12} {:<17} {:<4} {:>9.2e}  unstable: {why}\n", r.scene, r.integrator, r.precision, r.dt));
+                    continue;
+                }
+                s.push_str(&format!(
+                    "{:<12} {:<17} {:<4} {:>9.2e} {:>7} {:>12} {:>8.3} {:>11} {:>13} {:>10}\n",
+                    r.scene,
+                    r.integrator,
+                    r.precision,
+                    r.dt,
+                    r.steps,
+                    r.force_evaluations,
+                    r.seconds,
+                    opt(r.energy_error),
+                    opt(r.position_error),
+                    opt(r.force_error)
+                ));
+            }
+            if l.ovv_vs_vv.is_empty() {
+                s.push_str("optimised against plain velocity Verlet: no common energy-error range\n");
+            }
+            for c in &l.ovv_vs_vv {
+                s.push_str(&format!(
+                    "at energy error {:.2e}: optimised velocity Verlet costs {:.2}x the force evaluations and {:.2}x the wall time of velocity Verlet\n",
+                    c.energy_error, c.evaluation_ratio, c.time_ratio
+                ));
+            }
+        }
+        s
+    }
+
+    /// Writes `bench.json` and the speed-against-error plots into `dir`.
+    pub fn write(&self, dir: &std::path::Path) -> anyhow::Result<()> {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        let path = dir.join("bench.json");
+        std::fs::write(&path, serde_json::to_string_pretty(self)?).with_context(|| format!("cannot write {}", path.display()))?;
+        if let Some(l) = &self.ladder {
+            for (scene, label, pick) in [
+                ("elastic_gas", "largest relative energy drift", (|r: &ladder::Rung| r.energy_error) as fn(&ladder::Rung) -> Option<f64>),
+                ("dense_bed", "RMS position error / mean diameter", |r: &ladder::Rung| r.position_error),
+            ] {
+                let mut series: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+                for r in l.rungs.iter().filter(|r| r.scene == scene && r.unstable.is_none()) {
+                    let name = format!("{} {}", r.integrator.replace('_', " "), r.precision);
+                    let point = (pick(r).unwrap_or(0.0), r.seconds);
+                    match series.iter_mut().find(|(n, _)| *n == name) {
+                        Some((_, pts)) => pts.push(point),
+                        None => series.push((name, vec![point])),
+                    }
+                }
+                let stem = dir.join(format!("speed_error_{scene}"));
+                if let Err(e) = crate::output::plot::speed_error(&stem, &format!("{scene}: wall time against error"), label, &series) {
+                    eprintln!("warning: {e:#}");
+                }
+            }
+        }
+        Ok(())
+    }
+}

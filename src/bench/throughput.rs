@@ -1,0 +1,103 @@
+//! Throughput on the dense bed: particle-steps per second with what they were bought with
+//! (contacts and pairs per grain, bytes per grain, peak memory) and where the time goes.
+
+use super::memory;
+use crate::engine::Engine;
+use serde::Serialize;
+use std::time::Instant;
+
+/// Share of one phase in the timed steps.
+#[derive(Clone, Debug, Serialize)]
+pub struct PhaseShare {
+    /// Phase name (hash, detect, remap, force, walls, gather, integrate).
+    pub phase: String,
+    /// Fraction of the summed phase times (-).
+    pub share: f64,
+    /// Nanoseconds per particle-step spent in it.
+    pub ns_per_particle_step: f64,
+}
+
+/// One throughput measurement.
+#[derive(Clone, Debug, Serialize)]
+pub struct Throughput {
+    /// "cpu" or "gpu".
+    pub backend: String,
+    /// The CPU model or the GPU adapter.
+    pub device: String,
+    /// "f32" or "f64".
+    pub precision: String,
+    /// Worker threads (CPU); 1 for the GPU's host thread.
+    pub threads: usize,
+    /// Grains.
+    pub grains: usize,
+    /// Untimed steps before the timed ones.
+    pub warmup_steps: u64,
+    /// Timed steps.
+    pub steps: u64,
+    /// Wall seconds of the timed steps.
+    pub seconds: f64,
+    /// Grains x steps / seconds.
+    pub particle_steps_per_second: f64,
+    /// Nanoseconds per particle-step.
+    pub ns_per_particle_step: f64,
+    /// Touching grain-grain pairs per grain, x2 (the coordination number Z).
+    pub contacts_per_grain: f64,
+    /// Listed neighbour pairs per grain (each pair once).
+    pub pairs_per_grain: f64,
+    /// Neighbour-list rebuilds during the timed steps.
+    pub rebuilds: u64,
+    /// Translational kinetic energy per grain at the end (J): the bed stayed static.
+    pub ke_per_grain: f64,
+    /// Bytes of the engine's arrays or device buffers.
+    pub engine_bytes: u64,
+    /// `engine_bytes` per grain.
+    pub bytes_per_grain: f64,
+    /// Peak resident memory of the process while building and stepping this engine (bytes);
+    /// absent where the system does not report it.
+    pub peak_rss_bytes: Option<u64>,
+    /// Time per phase (CPU backend).
+    pub phases: Vec<PhaseShare>,
+}
+
+/// Times `steps` steps of `engine` after `warmup` untimed ones. `peak_reset` says whether
+/// the process's peak memory was reset before the engine was built.
+pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u64, steps: u64, peak_reset: bool) -> anyhow::Result<Throughput> {
+    engine.advance(warmup)?;
+    let before = engine.stats();
+    engine.set_profiling(true);
+    let started = Instant::now();
+    engine.advance(steps)?;
+    // The GPU queues work: the statistics' read-back waits for it.
+    let after = engine.stats();
+    let seconds = started.elapsed().as_secs_f64();
+    engine.set_profiling(false);
+    let n = engine.grain_count();
+    let work = (n as u64 * steps) as f64;
+    let phase_total: f64 = engine.phase_seconds().iter().map(|(_, s)| s).sum();
+    let phases = engine
+        .phase_seconds()
+        .into_iter()
+        .map(|(phase, s)| PhaseShare { phase: phase.to_string(), share: if phase_total > 0.0 { s / phase_total } else { 0.0 }, ns_per_particle_step: s * 1e9 / work })
+        .collect();
+    let engine_bytes = engine.memory_bytes();
+    Ok(Throughput {
+        backend: engine.backend().to_string(),
+        device: device.to_string(),
+        precision: engine.precision().to_string(),
+        threads,
+        grains: n,
+        warmup_steps: warmup,
+        steps,
+        seconds,
+        particle_steps_per_second: work / seconds,
+        ns_per_particle_step: seconds * 1e9 / work,
+        contacts_per_grain: after.coordination,
+        pairs_per_grain: after.pairs as f64 / n as f64,
+        rebuilds: after.rebuilds - before.rebuilds,
+        ke_per_grain: after.ke_translational / n as f64,
+        engine_bytes,
+        bytes_per_grain: engine_bytes as f64 / n as f64,
+        peak_rss_bytes: if peak_reset { memory::peak_rss() } else { None },
+        phases,
+    })
+}
