@@ -24,7 +24,12 @@ fn min_image(d_in: vec3<f32>) -> vec3<f32> {
     for (var a = 0u; a < 3u; a++) {
         let len = params.periodic_len[a];
         if (len > 0.0) {
-            d[a] -= len * floor(d[a] / len + 0.5);
+            // One period added or taken past half of it (the CPU twin's compares).
+            if (d[a] > 0.5 * len) {
+                d[a] -= len;
+            } else if (d[a] < -0.5 * len) {
+                d[a] += len;
+            }
         }
     }
     return d;

@@ -242,6 +242,7 @@ impl<T: Real> CpuEngine<T> {
         self.hist = pairs::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
         self.pairs = pairs;
         self.out.clear();
+        self.out.reserve_exact(self.pairs.len());
         self.out.resize(self.pairs.len(), ContactForce::default());
         for (b, at) in self.body.iter().zip(self.built_at.iter_mut()) {
             *at = b.pos;

@@ -55,7 +55,9 @@ impl PairList {
             }
             (counts, partners)
         });
-        let mut list = PairList { owner_start: Vec::with_capacity(n + 1), ..Default::default() };
+        // Exact sizes: a pair list of 10^6 grains is tens of megabytes, so no growth slack.
+        let total = parts.iter().map(|(_, partners)| partners.len()).sum();
+        let mut list = PairList { owner_start: Vec::with_capacity(n + 1), owner: Vec::with_capacity(total), partner: Vec::with_capacity(total), ..Default::default() };
         list.owner_start.push(0);
         for (counts, partners) in parts {
             for c in counts {
