@@ -47,6 +47,19 @@ pub struct Grains {
 }
 
 impl Grains {
+    /// The same grains renumbered: grain `k` of the result is grain `order[k]` of `self`.
+    pub fn permuted(&self, order: &[usize]) -> Grains {
+        let pick = |v: &[[f64; 3]]| order.iter().map(|&i| v[i]).collect();
+        Grains {
+            radius: order.iter().map(|&i| self.radius[i]).collect(),
+            mass: order.iter().map(|&i| self.mass[i]).collect(),
+            position: pick(&self.position),
+            velocity: pick(&self.velocity),
+            angular_velocity: pick(&self.angular_velocity),
+            material: order.iter().map(|&i| self.material[i]).collect(),
+        }
+    }
+
     /// Number of grains.
     pub fn len(&self) -> usize {
         self.radius.len()
