@@ -26,7 +26,7 @@ pub struct ForceContext<'a, T> {
 
 /// `pair_force` for pair `k`. A listed pair that does not touch forgets its springs and
 /// exerts only the capillary force of its liquid bridge, if it has one within reach.
-#[inline]
+#[inline(always)]
 pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, hist: &mut [T]) -> ContactForce<T> {
     let i = pairs.owner[k] as usize;
     let j = pairs.partner[k] as usize;

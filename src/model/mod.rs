@@ -285,7 +285,7 @@ pub struct ContactForce<T> {
 ///
 /// `elapsed` is the time (s) since the previous force evaluation: the tangential and rolling
 /// springs grow by the relative velocity times `elapsed`.
-#[inline]
+#[inline(always)]
 pub fn contact_force<T: Real>(
     model: &ContactModel<T>,
     c: &PairCoeffs<T>,
@@ -342,7 +342,7 @@ pub fn contact_force<T: Real>(
 }
 
 /// `k_t` (N/m) for the current overlap.
-#[inline]
+#[inline(always)]
 fn tangential_stiffness<T: Real>(s: &TangentialStiffness<T>, c: &PairCoeffs<T>, geo: &Geometry<T>, k_secant: T) -> T {
     match *s {
         TangentialStiffness::Mindlin => T::of(8.0) * c.g_eff * (geo.r_eff * geo.h).sqrt(),

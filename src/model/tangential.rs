@@ -119,7 +119,7 @@ fn rolling_regime<T: Real>(fr: T, m: T, inertia: T, rp: T, t: Vec3<T>, n: Vec3<T
 /// Hertz-Mindlin tangential force on i with history and one Coulomb coefficient `mu`:
 /// `F_t = -k_t xi - eta_t v_t`, capped at `mu F_n`; on the cap the spring is set to
 /// `-(F_t + eta_t v_t) / k_t` (LAMMPS `tangential mindlin`).
-#[inline]
+#[inline(always)]
 pub fn mindlin_tangential<T: Real>(
     mu: T,
     g: &Geometry<T>,
