@@ -53,10 +53,10 @@ fn geometry_grain_grain(d: vec3<f32>, dist: f32, r_i: f32, r_j: f32, m_i: f32, m
     var g: Geometry;
     g.h = r_i + r_j - dist;
     g.n = d * (1.0 / dist);
-    let sum = r_i + r_j;
-    g.rp_i = r_i - g.h * r_j / sum;
-    g.rp_j = r_j - g.h * r_i / sum;
-    g.r_eff = r_i * r_j / sum;
+    let inv_sum = 1.0 / (r_i + r_j);
+    g.rp_i = r_i - g.h * r_j * inv_sum;
+    g.rp_j = r_j - g.h * r_i * inv_sum;
+    g.r_eff = r_i * r_j * inv_sum;
     g.m_eff = m_i * m_j / (m_i + m_j);
     g.rp_eff = g.rp_i * g.rp_j / (g.rp_i + g.rp_j);
     return g;

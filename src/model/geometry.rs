@@ -61,13 +61,13 @@ impl<T: Real> Geometry<T> {
     pub fn grain_grain(d: Vec3<T>, dist: T, r_i: T, r_j: T, m_i: T, m_j: T) -> Self {
         let h = r_i + r_j - dist;
         let n = d * (T::ONE / dist);
-        let sum = r_i + r_j;
-        let rp_i = r_i - h * r_j / sum;
-        let rp_j = r_j - h * r_i / sum;
+        let inv_sum = T::ONE / (r_i + r_j);
+        let rp_i = r_i - h * r_j * inv_sum;
+        let rp_j = r_j - h * r_i * inv_sum;
         Geometry {
             n,
             h,
-            r_eff: r_i * r_j / sum,
+            r_eff: r_i * r_j * inv_sum,
             m_eff: m_i * m_j / (m_i + m_j),
             rp_i,
             rp_j,
