@@ -122,8 +122,11 @@ pub enum Command {
         #[arg(long, value_delimiter = ',')]
         threads: Vec<usize>,
         /// Particle-steps per timed run (its steps are this over the grain count, at least 20).
-        #[arg(long, default_value_t = 1e8)]
+        #[arg(long, default_value_t = 5e7)]
         work: f64,
+        /// Timed runs per configuration, one after the other; the median is reported.
+        #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u64).range(1..))]
+        repeats: u64,
         /// Which parts to run.
         #[arg(long, value_enum, default_value = "all")]
         part: BenchPart,

@@ -120,7 +120,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Bench { sizes, backend, adapter, precision, threads, work, part, cache, out, json } => {
+        Command::Bench { sizes, backend, adapter, precision, threads, work, repeats, part, cache, out, json } => {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             let mut threads = if threads.is_empty() { vec![1, cores] } else { threads };
             threads.dedup();
@@ -138,6 +138,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 precisions: precision.iter().map(|p| if *p == Precision::F32 { "f32".to_string() } else { "f64".to_string() }).collect(),
                 threads,
                 work,
+                repeats: repeats as usize,
                 throughput: part != BenchPart::Ladder,
                 ladder: part != BenchPart::Throughput,
                 cache: cache.unwrap_or_else(grains::bench::bed::default_cache),

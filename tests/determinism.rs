@@ -85,3 +85,29 @@ fn one_and_two_threads_give_bitwise_identical_trajectories_in_f64() {
 fn one_and_two_threads_give_bitwise_identical_trajectories_in_f32() {
     check::<f32>();
 }
+
+/// The hot loops compiled for each instruction-set level this CPU has (portable, AVX2,
+/// AVX-512) give the same trajectory, bit for bit. The other tests of this file may run
+/// meanwhile under the cap this one sets, which by this very claim changes nothing for them.
+fn check_levels<T: Real>() {
+    use grains::cpu::simd::{set_max_level, supported, Level};
+    let widest = supported();
+    let mut runs = Vec::new();
+    for cap in [Level::Portable, Level::V3, Level::V4].into_iter().filter(|l| *l <= widest) {
+        set_max_level(cap);
+        runs.push((cap, trajectory_bits::<T>(1, 300).0));
+    }
+    set_max_level(Level::V4);
+    println!("{}: levels compared: {:?} (this CPU's widest: {widest:?})", T::NAME, runs.iter().map(|r| r.0).collect::<Vec<_>>());
+    for (cap, bits) in &runs[1..] {
+        let first = runs[0].1.iter().zip(bits).position(|(a, b)| a != b);
+        assert_eq!(first, None, "{cap:?} differs from the portable build at value {first:?}");
+    }
+}
+
+#[test]
+fn every_instruction_set_level_gives_bitwise_identical_trajectories() {
+    // One test for both precisions, so that no two runs of this file move the cap at once.
+    check_levels::<f64>();
+    check_levels::<f32>();
+}

@@ -28,6 +28,8 @@ pub struct BenchOptions {
     pub threads: Vec<usize>,
     /// Particle-steps per timed run (the steps are this over the grain count, at least 20).
     pub work: f64,
+    /// Timed runs per configuration; the median is reported.
+    pub repeats: usize,
     /// Run the throughput part.
     pub throughput: bool,
     /// Run the speed-against-error part.
@@ -47,8 +49,10 @@ pub struct Machine {
     pub cpu: String,
     /// Logical cores.
     pub cores: usize,
-    /// Vector instruction sets the build may use.
+    /// Vector instruction sets the whole build may use (beyond x86-64's baseline).
     pub build_features: Vec<String>,
+    /// The level the CPU engine's hot loops ran at (`Portable`, `V3` = AVX2, `V4` = AVX-512).
+    pub simd_level: String,
     /// grains version.
     pub version: String,
 }
@@ -78,7 +82,7 @@ pub fn machine() -> Machine {
             build_features.push(name.to_string());
         }
     }
-    Machine { cpu, cores: std::thread::available_parallelism().map_or(1, |n| n.get()), build_features, version: env!("CARGO_PKG_VERSION").to_string() }
+    Machine { cpu, cores: std::thread::available_parallelism().map_or(1, |n| n.get()), build_features, simd_level: format!("{:?}", crate::cpu::simd::level()), version: env!("CARGO_PKG_VERSION").to_string() }
 }
 
 fn pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
@@ -107,7 +111,7 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
                 for (precision, threads) in configs {
                     let steps = ((opts.work / n as f64).round() as u64).max(20);
                     let warmup = (steps / 5).max(10);
-                    say(&format!("{backend} {precision} {threads} thread(s), {n} grains: {warmup} + {steps} steps"));
+                    say(&format!("{backend} {precision} {threads} thread(s), {n} grains: {warmup} + {} x {steps} steps", opts.repeats));
                     let peak_reset = memory::reset_peak();
                     let row = if backend == "gpu" {
                         let gpu = crate::gpu::open(opts.adapter.as_deref())?;
@@ -116,14 +120,14 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
                             let scene = bed::bed_of(&base, n)?;
                             crate::gpu::GpuEngine::new(gpu, &scene)?
                         };
-                        throughput::measure(&mut engine, &device, 1, warmup, steps, peak_reset)?
+                        throughput::measure(&mut engine, &device, 1, warmup, steps, opts.repeats, peak_reset)?
                     } else {
                         pool(threads)?.install(|| -> anyhow::Result<Throughput> {
                             let mut engine: Box<dyn Engine> = {
                                 let scene = bed::bed_of(&base, n)?;
                                 crate::runner::cpu_engine(&scene, &precision)?
                             };
-                            throughput::measure(engine.as_mut(), &machine.cpu, threads, warmup, steps, peak_reset)
+                            throughput::measure(engine.as_mut(), &machine.cpu, threads, warmup, steps, opts.repeats, peak_reset)
                         })?
                     };
                     say(&format!("  {:.3e} particle-steps/s, Z = {:.3}, {:.0} B/grain", row.particle_steps_per_second, row.contacts_per_grain, row.bytes_per_grain));
@@ -140,7 +144,7 @@ impl BenchReport {
     /// Tables for a person.
     pub fn human(&self) -> String {
         let m = &self.machine;
-        let mut s = format!("machine: {} ({} cores; build features: {})\n", m.cpu, m.cores, if m.build_features.is_empty() { "baseline".to_string() } else { m.build_features.join(", ") });
+        let mut s = format!("machine: {} ({} cores; build features: {}; hot loops at level {})\n", m.cpu, m.cores, if m.build_features.is_empty() { "baseline".to_string() } else { m.build_features.join(", ") }, m.simd_level);
         s.push_str(&format!(
             "bed: the peers' pour, {:.3} s simulated ({}), Z = {:.3} at the end, poured in {:.0} s once and cached\n",
             self.bed.time,
@@ -150,18 +154,19 @@ impl BenchReport {
         ));
         if !self.throughput.is_empty() {
             s.push_str("\nthroughput (dense settled bed, Hertz-Mindlin, dt = 2e-6 s)\n");
-            s.push_str("backend prec thr    grains  particle-steps/s  ns/p-step     Z  pairs/grain  B/grain  peak RSS MiB  time shares\n");
+            s.push_str("backend prec thr    grains  particle-steps/s  spread  ns/p-step     Z  pairs/grain  B/grain  peak RSS MiB  time shares\n");
             for r in &self.throughput {
                 let mut phases = r.phases.clone();
                 phases.sort_by(|a, b| b.share.total_cmp(&a.share));
                 let shares: Vec<String> = phases.iter().filter(|p| p.share >= 0.005).map(|p| format!("{} {:.0}%", p.phase, 100.0 * p.share)).collect();
                 s.push_str(&format!(
-                    "{:<7} {:<4} {:>3} {:>9} {:>17.3e} {:>10.1} {:>5.2} {:>12.2} {:>8.0} {:>13} {}\n",
+                    "{:<7} {:<4} {:>3} {:>9} {:>17.3e} {:>6.1}% {:>10.1} {:>5.2} {:>12.2} {:>8.0} {:>13} {}\n",
                     r.backend,
                     r.precision,
                     r.threads,
                     r.grains,
                     r.particle_steps_per_second,
+                    r.spread_percent(),
                     r.ns_per_particle_step,
                     r.contacts_per_grain,
                     r.pairs_per_grain,

@@ -32,13 +32,15 @@ pub struct Throughput {
     pub grains: usize,
     /// Untimed steps before the timed ones.
     pub warmup_steps: u64,
-    /// Timed steps.
+    /// Timed steps per repeat.
     pub steps: u64,
-    /// Wall seconds of the timed steps.
+    /// Wall seconds of the median repeat.
     pub seconds: f64,
-    /// Grains x steps / seconds.
+    /// Grains x steps / seconds, median over the repeats.
     pub particle_steps_per_second: f64,
-    /// Nanoseconds per particle-step.
+    /// Particle-steps per second of every repeat, in order (the spread is the noise).
+    pub repeats: Vec<f64>,
+    /// Nanoseconds per particle-step, median over the repeats.
     pub ns_per_particle_step: f64,
     /// Touching grain-grain pairs per grain, x2 (the coordination number Z).
     pub contacts_per_grain: f64,
@@ -59,25 +61,42 @@ pub struct Throughput {
     pub phases: Vec<PhaseShare>,
 }
 
-/// Times `steps` steps of `engine` after `warmup` untimed ones. `peak_reset` says whether
-/// the process's peak memory was reset before the engine was built.
-pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u64, steps: u64, peak_reset: bool) -> anyhow::Result<Throughput> {
+impl Throughput {
+    /// Half the range of the repeats over their median (%): the run-to-run noise.
+    pub fn spread_percent(&self) -> f64 {
+        let (lo, hi) = self.repeats.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+        50.0 * (hi - lo) / self.particle_steps_per_second
+    }
+}
+
+/// Times `repeats` runs of `steps` steps of `engine`, one after the other, after `warmup`
+/// untimed ones, and reports the median. `peak_reset` says whether the process's peak
+/// memory was reset before the engine was built.
+pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u64, steps: u64, repeats: usize, peak_reset: bool) -> anyhow::Result<Throughput> {
     engine.advance(warmup)?;
     let before = engine.stats();
     engine.set_profiling(true);
-    let started = Instant::now();
-    engine.advance(steps)?;
-    // The GPU queues work: the statistics' read-back waits for it.
-    let after = engine.stats();
-    let seconds = started.elapsed().as_secs_f64();
+    let mut seconds_each = Vec::with_capacity(repeats);
+    let mut after = before.clone();
+    for _ in 0..repeats.max(1) {
+        let started = Instant::now();
+        engine.advance(steps)?;
+        // The GPU queues work: the statistics' read-back waits for it.
+        after = engine.stats();
+        seconds_each.push(started.elapsed().as_secs_f64());
+    }
     engine.set_profiling(false);
     let n = engine.grain_count();
     let work = (n as u64 * steps) as f64;
+    let mut sorted = seconds_each.clone();
+    sorted.sort_by(f64::total_cmp);
+    let seconds = sorted[sorted.len() / 2];
+    let work_all = work * seconds_each.len() as f64;
     let phase_total: f64 = engine.phase_seconds().iter().map(|(_, s)| s).sum();
     let phases = engine
         .phase_seconds()
         .into_iter()
-        .map(|(phase, s)| PhaseShare { phase: phase.to_string(), share: if phase_total > 0.0 { s / phase_total } else { 0.0 }, ns_per_particle_step: s * 1e9 / work })
+        .map(|(phase, s)| PhaseShare { phase: phase.to_string(), share: if phase_total > 0.0 { s / phase_total } else { 0.0 }, ns_per_particle_step: s * 1e9 / work_all })
         .collect();
     let engine_bytes = engine.memory_bytes();
     Ok(Throughput {
@@ -90,6 +109,7 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u6
         steps,
         seconds,
         particle_steps_per_second: work / seconds,
+        repeats: seconds_each.iter().map(|s| work / s).collect(),
         ns_per_particle_step: seconds * 1e9 / work,
         contacts_per_grain: after.coordination,
         pairs_per_grain: after.pairs as f64 / n as f64,

@@ -8,7 +8,7 @@ use crate::model::ContactForce;
 use crate::real::{Real, Vec3};
 
 /// `gather` for grain `i`.
-#[inline]
+#[inline(always)]
 pub fn gather<T: Real>(i: usize, pairs: &PairList, out: &[ContactForce<T>], wall: &Load<T>, p: &Props<T>, gravity: Vec3<T>) -> Load<T> {
     let mut force = gravity * p.mass;
     let mut torque = Vec3::ZERO;
@@ -21,4 +21,18 @@ pub fn gather<T: Real>(i: usize, pairs: &PairList, out: &[ContactForce<T>], wall
         torque += out[k as usize].t_j;
     }
     Load { force: force + wall.force, torque: torque + wall.torque }
+}
+
+super::simd::dispatch! {
+    /// `gather` for grains `first..first + loads.len()`.
+    pub fn gather_block<T: Real>(first: usize, loads: &mut [Load<T>], pairs: &PairList, out: &[ContactForce<T>], wall: &[Load<T>], prop: &[Props<T>], gravity: Vec3<T>) => gather_block_portable
+}
+
+/// [`gather_block`] for whatever instruction set the caller is compiled for.
+#[inline(always)]
+fn gather_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], pairs: &PairList, out: &[ContactForce<T>], wall: &[Load<T>], prop: &[Props<T>], gravity: Vec3<T>) {
+    for (m, l) in loads.iter_mut().enumerate() {
+        let i = first + m;
+        *l = gather(i, pairs, out, &wall[i], &prop[i], gravity);
+    }
 }

@@ -13,6 +13,7 @@ mod pair_force;
 mod pairs;
 mod profile;
 mod reduce;
+pub mod simd;
 mod state;
 mod wall_contacts;
 
@@ -30,9 +31,9 @@ use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 use crate::scene::{Integrator, Scene, WallShape};
 use crate::walls::WallGeom;
-use gather::gather;
+use gather::gather_block;
 use grid::{hash_cells, CellGrid};
-use pair_force::pair_force;
+use pair_force::pair_block;
 use profile::{Phase, PhaseClock};
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS};
@@ -346,15 +347,16 @@ impl<T: Real> CpuEngine<T> {
         self.since_eval = T::ZERO;
         let (pairs, body, prop) = (&self.pairs, &self.body, &self.prop);
         let stride = self.slots.stride;
+        let min_blocks = PAR_MIN_ITEMS / pair_force::BLOCK;
         if stride == 0 {
-            self.out.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(k, o)| *o = pair_force(k, pairs, body, prop, &ctx, &mut []));
+            self.out.par_chunks_mut(pair_force::BLOCK).with_min_len(min_blocks).enumerate().for_each(|(b, o)| pair_block(b * pair_force::BLOCK, o, &mut [], pairs, body, prop, &ctx));
         } else {
             self.out
-                .par_iter_mut()
-                .zip(self.hist.par_chunks_mut(stride))
-                .with_min_len(PAR_MIN_ITEMS)
+                .par_chunks_mut(pair_force::BLOCK)
+                .zip(self.hist.par_chunks_mut(pair_force::BLOCK * stride))
+                .with_min_len(min_blocks)
                 .enumerate()
-                .for_each(|(k, (o, h))| *o = pair_force(k, pairs, body, prop, &ctx, h));
+                .for_each(|(b, (o, h))| pair_block(b * pair_force::BLOCK, o, h, pairs, body, prop, &ctx));
         }
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
@@ -367,7 +369,7 @@ impl<T: Real> CpuEngine<T> {
         self.clock.stop(Phase::Walls, t);
         let t = self.clock.start();
         let (out, wall_load, gravity) = (&self.out, &self.wall_load, self.gravity);
-        self.load.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, l)| *l = gather(i, pairs, out, &wall_load[i], &prop[i], gravity));
+        self.load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().for_each(|(c, l)| gather_block(c * CHUNK, l, pairs, out, wall_load, prop, gravity));
         self.forces_valid = true;
         self.clock.stop(Phase::Gather, t);
     }

@@ -1,5 +1,8 @@
 //! `pair_force`: one invocation computes the force of one listed pair, once, in canonical
 //! order (owner = lower permanent id = i), and reads and writes its history.
+//!
+//! The pass runs in blocks of [`BLOCK`] pairs, each compiled for the widest instruction set
+//! the CPU has (see `simd`).
 
 use super::pairs::PairList;
 use super::state::{Body, HistorySlots, Props};
@@ -54,4 +57,22 @@ pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &
     let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
     ctx.slots.store(&h, hist);
     f
+}
+
+/// Pairs per block of the pair pass.
+pub const BLOCK: usize = 256;
+
+super::simd::dispatch! {
+    /// `pair_force` for pairs `first..first + out.len()`; `hist` holds their history slots
+    /// (empty when the model keeps none).
+    pub fn pair_block<T: Real>(first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) => pair_block_portable
+}
+
+/// [`pair_block`] for whatever instruction set the caller is compiled for.
+#[inline(always)]
+fn pair_block_portable<T: Real>(first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
+    let stride = ctx.slots.stride;
+    for (m, o) in out.iter_mut().enumerate() {
+        *o = pair_force(first + m, pairs, body, prop, ctx, &mut hist[m * stride..(m + 1) * stride]);
+    }
 }

@@ -66,8 +66,13 @@ impl HistorySlots {
     /// Forgets the springs of a contact that has opened, keeping its liquid bridge.
     #[inline(always)]
     pub fn clear_springs<T: Real>(&self, s: &mut [T]) {
-        let end = if self.layout.bridge { self.bridge } else { self.stride };
-        s[..end].fill(T::ZERO);
+        // Fixed-size stores per block: a `fill` of run-time length becomes a call to memset.
+        if self.layout.tangential {
+            s[self.tangential..self.tangential + 3].copy_from_slice(&[T::ZERO; 3]);
+        }
+        if self.layout.rolling {
+            s[self.rolling..self.rolling + 3].copy_from_slice(&[T::ZERO; 3]);
+        }
     }
 
     /// Reads one contact's history (absent blocks read as zero).
