@@ -37,7 +37,7 @@ use pair_force::pair_block;
 use profile::{Phase, PhaseClock};
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS};
-use wall_contacts::wall_contacts;
+use wall_contacts::wall_block;
 
 /// Fraction of the largest stable servo gain used where a wall's contacts are stiff.
 pub const SERVO_RELAXATION: f64 = 0.5;
@@ -545,11 +545,7 @@ fn wall_pass<T: Real>(
     let per_grain = n_walls * ctx.slots.stride;
     let run = |c: usize, loads: &mut [Load<T>], hist: &mut [T]| {
         let mut sums = WallSums::new(n_walls);
-        for (ii, l) in loads.iter_mut().enumerate() {
-            let i = c * CHUNK + ii;
-            let h = if per_grain == 0 { &mut [][..] } else { &mut hist[ii * per_grain..(ii + 1) * per_grain] };
-            *l = wall_contacts(&body[i], &prop[i], walls, ctx, h, &mut sums.reaction, &mut sums.count, &mut sums.response);
-        }
+        wall_block(c * CHUNK, loads, hist, body, prop, walls, ctx, &mut sums.reaction, &mut sums.count, &mut sums.response);
         sums
     };
     let parts: Vec<WallSums<T>> = if per_grain == 0 {

@@ -69,20 +69,20 @@ fn detect() -> Level {
     Level::Portable
 }
 
-/// Defines `fn $name<T: Real>(args)` that calls `$portable(args)` (an `#[inline(always)]`
+/// Defines `fn $name<T: Real>(args) [-> R]` that calls `$portable(args)` (an `#[inline(always)]`
 /// function) compiled for the widest [`Level`] the CPU has.
 macro_rules! dispatch {
-    ($(#[$meta:meta])* $vis:vis fn $name:ident<$T:ident: Real>($($arg:ident: $ty:ty),* $(,)?) => $portable:ident) => {
+    ($(#[$meta:meta])* $vis:vis fn $name:ident<$T:ident: Real>($($arg:ident: $ty:ty),* $(,)?) $(-> $ret:ty)? => $portable:ident) => {
         $(#[$meta])*
-        $vis fn $name<$T: Real>($($arg: $ty),*) {
+        $vis fn $name<$T: Real>($($arg: $ty),*) $(-> $ret)? {
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,movbe,f16c,avx512f,avx512vl,avx512dq,avx512bw,avx512cd")]
-                fn v4<$T: Real>($($arg: $ty),*) {
+                fn v4<$T: Real>($($arg: $ty),*) $(-> $ret)? {
                     $portable($($arg),*)
                 }
                 #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,popcnt,movbe,f16c")]
-                fn v3<$T: Real>($($arg: $ty),*) {
+                fn v3<$T: Real>($($arg: $ty),*) $(-> $ret)? {
                     $portable($($arg),*)
                 }
                 match $crate::cpu::simd::level() {

@@ -23,7 +23,7 @@ pub struct WallState<T> {
 /// the force each wall receives is added to `reaction[w]`, its contact count to `count[w]`,
 /// and the contact's normal tangent stiffness (N/m) and damping coefficient (N s/m) to
 /// `response[w]`. Returns the load on the grain.
-#[inline]
+#[inline(always)]
 pub fn wall_contacts<T: Real>(
     b: &Body<T>,
     p: &Props<T>,
@@ -58,6 +58,23 @@ pub fn wall_contacts<T: Real>(
         response[w].1 += normal_damping(&ctx.model.damping, &ctx.model.normal, c, &geo);
     }
     load
+}
+
+super::simd::dispatch! {
+    /// `wall_contacts` for grains `first..first + loads.len()`; `hist` holds their history
+    /// blocks (empty when the model keeps none); the walls' sums accumulate as in
+    /// [`wall_contacts`].
+    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, reaction: &mut [Vec3<T>], count: &mut [u64], response: &mut [(T, T)]) => wall_block_portable
+}
+
+/// [`wall_block`] for whatever instruction set the caller is compiled for.
+#[inline(always)]
+fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, reaction: &mut [Vec3<T>], count: &mut [u64], response: &mut [(T, T)]) {
+    let per_grain = walls.len() * ctx.slots.stride;
+    for (m, l) in loads.iter_mut().enumerate() {
+        let i = first + m;
+        *l = wall_contacts(&body[i], &prop[i], walls, ctx, &mut hist[m * per_grain..(m + 1) * per_grain], reaction, count, response);
+    }
 }
 
 /// Every touching grain-wall contact, with its force evaluated from the current state
