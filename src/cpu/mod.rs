@@ -9,6 +9,7 @@
 mod gather;
 mod grid;
 mod integrate;
+mod lanes;
 mod pair_force;
 mod pairs;
 mod profile;

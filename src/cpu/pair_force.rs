@@ -72,6 +72,10 @@ super::simd::dispatch! {
 #[inline(always)]
 fn pair_block_portable<T: Real>(first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
     let stride = ctx.slots.stride;
+    if let Some(model) = super::lanes::hertz_mindlin(ctx.model) {
+        debug_assert!(stride == 3 && ctx.slots.tangential == 0, "Hertz-Mindlin keeps one spring per pair");
+        return super::lanes::hertz_mindlin_block(&model, first, out, hist, pairs, body, prop, ctx);
+    }
     for (m, o) in out.iter_mut().enumerate() {
         *o = pair_force(first + m, pairs, body, prop, ctx, &mut hist[m * stride..(m + 1) * stride]);
     }

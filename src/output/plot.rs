@@ -280,7 +280,9 @@ pub fn speed_error(stem: &Path, title: &str, x_label: &str, series: &[(String, V
             .y_label_area_size(64)
             .build_cartesian_2d((x_lo / 2.0..x_hi * 2.0).log_scale(), (y_lo / 1.5..y_hi * 1.5).log_scale())
             .map_err(err)?;
-        chart.configure_mesh().x_desc(x_label).y_desc("wall time (s)").x_label_formatter(&|x| format!("{x:.0e}")).draw().map_err(err)?;
+        // Two significant digits: log-scale ticks such as 0.30000000000000004 print as 0.3.
+        let short = |v: &f64| format!("{}", format!("{v:.1e}").parse::<f64>().unwrap_or(*v));
+        chart.configure_mesh().x_desc(x_label).y_desc("wall time (s)").x_labels(6).y_labels(8).x_label_formatter(&|x| format!("{x:.0e}")).y_label_formatter(&short).draw().map_err(err)?;
         for (k, (name, pts)) in series.iter().enumerate() {
             let color = Palette99::pick(k).to_rgba();
             let pts: Vec<(f64, f64)> = pts.iter().copied().filter(|(e, t)| *e > 0.0 && *t > 0.0).collect();

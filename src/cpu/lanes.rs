@@ -1,0 +1,242 @@
+//! The pair pass of the standard Hertz-Mindlin model (Hertz, restitution damping, Mindlin
+//! tangential spring with one mu; no rolling, twisting or cohesion: LAMMPS' and LIGGGHTS'
+//! default granular model) in lanes that the compiler turns into vector instructions.
+//!
+//! Each lane group is loaded one pair at a time (the scattered reads of the two grains),
+//! then every lane runs the very same `contact_force` as the one-pair pass, with the laws
+//! fixed at compile time and no branch on whether the pair touches (a third of a dense
+//! packing's listed pairs do not, in no order a branch predictor learns): the result of a
+//! pair that does not touch is dropped by a select. Same operations on the same inputs, so
+//! the same bits as `pair_force`; `tests` below check it.
+
+use super::pair_force::ForceContext;
+use super::pairs::PairList;
+use super::state::{Body, Props};
+use crate::model::{contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+use crate::real::{Real, Vec3};
+
+/// Pairs per lane group.
+const LANES: usize = 32;
+
+/// `model` with its laws as compile-time constants when it is the standard Hertz-Mindlin
+/// model, so that the composed `contact_force` folds to straight-line code.
+#[inline(always)]
+pub fn hertz_mindlin<T: Real>(model: &ContactModel<T>) -> Option<ContactModel<T>> {
+    match *model {
+        ContactModel {
+            normal: NormalLaw::Hertz,
+            damping: DampingLaw::Restitution,
+            tangential: TangentialLaw::Mindlin { damping_ratio, stiffness: TangentialStiffness::Mindlin },
+            rolling: RollingLaw::None,
+            twisting: TwistingLaw::None,
+            cohesion: CohesionLaw::None,
+        } => Some(ContactModel {
+            normal: NormalLaw::Hertz,
+            damping: DampingLaw::Restitution,
+            tangential: TangentialLaw::Mindlin { damping_ratio, stiffness: TangentialStiffness::Mindlin },
+            rolling: RollingLaw::None,
+            twisting: TwistingLaw::None,
+            cohesion: CohesionLaw::None,
+        }),
+        _ => None,
+    }
+}
+
+/// Three lanes of reals, one per component.
+#[derive(Clone, Copy)]
+struct V3s<T> {
+    x: [T; LANES],
+    y: [T; LANES],
+    z: [T; LANES],
+}
+
+impl<T: Real> V3s<T> {
+    const ZERO: Self = V3s { x: [T::ZERO; LANES], y: [T::ZERO; LANES], z: [T::ZERO; LANES] };
+
+    #[inline(always)]
+    fn get(&self, m: usize) -> Vec3<T> {
+        Vec3::new(self.x[m], self.y[m], self.z[m])
+    }
+
+    #[inline(always)]
+    fn set(&mut self, m: usize, v: Vec3<T>) {
+        self.x[m] = v.x;
+        self.y[m] = v.y;
+        self.z[m] = v.z;
+    }
+}
+
+/// What one lane group reads.
+struct Inputs<T> {
+    d: V3s<T>,
+    r_i: [T; LANES],
+    r_j: [T; LANES],
+    m_i: [T; LANES],
+    m_j: [T; LANES],
+    v_i: V3s<T>,
+    v_j: V3s<T>,
+    w_i: V3s<T>,
+    w_j: V3s<T>,
+    v_eff: [T; LANES],
+    g_eff: [T; LANES],
+    mu_s: [T; LANES],
+    beta: [T; LANES],
+    xi: V3s<T>,
+}
+
+/// What one lane group writes.
+struct Outputs<T> {
+    f_i: V3s<T>,
+    f_j: V3s<T>,
+    t_i: V3s<T>,
+    t_j: V3s<T>,
+    f_n: [T; LANES],
+    clamped: [bool; LANES],
+    xi: V3s<T>,
+}
+
+/// The pair pass for pairs `first..first + out.len()` under `model` (from [`hertz_mindlin`]);
+/// `hist` holds their tangential springs, three reals per pair.
+#[inline(always)]
+pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
+    let mut inp = Inputs {
+        d: V3s::ZERO,
+        r_i: [T::ZERO; LANES],
+        r_j: [T::ZERO; LANES],
+        m_i: [T::ONE; LANES],
+        m_j: [T::ONE; LANES],
+        v_i: V3s::ZERO,
+        v_j: V3s::ZERO,
+        w_i: V3s::ZERO,
+        w_j: V3s::ZERO,
+        v_eff: [T::ZERO; LANES],
+        g_eff: [T::ZERO; LANES],
+        mu_s: [T::ZERO; LANES],
+        beta: [T::ZERO; LANES],
+        xi: V3s::ZERO,
+    };
+    let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], clamped: [false; LANES], xi: V3s::ZERO };
+    for (g, (out, hist)) in out.chunks_mut(LANES).zip(hist.chunks_mut(3 * LANES)).enumerate() {
+        let base = first + g * LANES;
+        // Load: the scattered reads, one pair at a time.
+        for m in 0..out.len() {
+            let i = pairs.owner[base + m] as usize;
+            let j = pairs.partner[base + m] as usize;
+            let (bi, bj, pi, pj) = (&body[i], &body[j], &prop[i], &prop[j]);
+            inp.d.set(m, ctx.periodic.min_image(bi.pos - bj.pos));
+            (inp.r_i[m], inp.r_j[m], inp.m_i[m], inp.m_j[m]) = (pi.radius, pj.radius, pi.mass, pj.mass);
+            inp.v_i.set(m, bi.vel);
+            inp.v_j.set(m, bj.vel);
+            inp.w_i.set(m, bi.omega);
+            inp.w_j.set(m, bj.omega);
+            let c = &ctx.coeffs[pi.material as usize * ctx.n_materials + pj.material as usize];
+            (inp.v_eff[m], inp.g_eff[m], inp.mu_s[m], inp.beta[m]) = (c.v_eff, c.g_eff, c.mu_s, c.beta);
+            inp.xi.set(m, Vec3::new(hist[3 * m], hist[3 * m + 1], hist[3 * m + 2]));
+        }
+        // Compute: every lane, touching or not, with no branch the compiler cannot turn into
+        // a select (lanes past the end of a short last group recompute stale inputs, unstored).
+        for m in 0..LANES {
+            let d = inp.d.get(m);
+            let dist2 = d.norm2();
+            let reach = inp.r_i[m] + inp.r_j[m];
+            let touching = dist2 < reach * reach;
+            let geo = Geometry::grain_grain(d, dist2.sqrt(), inp.r_i[m], inp.r_j[m], inp.m_i[m], inp.m_j[m]);
+            let kin = Kinematics { v_i: inp.v_i.get(m), v_j: inp.v_j.get(m), w_i: inp.w_i.get(m), w_j: inp.w_j.get(m) };
+            let c = PairCoeffs { v_eff: inp.v_eff[m], g_eff: inp.g_eff[m], mu_s: inp.mu_s[m], beta: inp.beta[m], ..Default::default() };
+            let mut h = History { tangential: inp.xi.get(m), ..Default::default() };
+            let f = contact_force(model, &c, &geo, &kin, &Bodies::default(), &mut h, ctx.elapsed);
+            let f = if touching { f } else { ContactForce::default() };
+            res.f_i.set(m, f.f_i);
+            res.f_j.set(m, f.f_j);
+            res.t_i.set(m, f.t_i);
+            res.t_j.set(m, f.t_j);
+            res.f_n[m] = f.f_n;
+            res.clamped[m] = f.clamped;
+            res.xi.set(m, if touching { h.tangential } else { Vec3::ZERO });
+        }
+        // Store.
+        for (m, o) in out.iter_mut().enumerate() {
+            *o = ContactForce { f_i: res.f_i.get(m), f_j: res.f_j.get(m), t_i: res.t_i.get(m), t_j: res.t_j.get(m), f_n: res.f_n[m], f_c: T::ZERO, clamped: res.clamped[m] };
+            let xi = res.xi.get(m);
+            hist[3 * m..3 * m + 3].copy_from_slice(&[xi.x, xi.y, xi.z]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The lane kernel against the one-pair pass, bit for bit, on a dense, shaken,
+    //! periodic Hertz-Mindlin gas (touching and open pairs, sticking and slipping springs).
+    use super::*;
+    use crate::cpu::pair_force::pair_force;
+    use crate::cpu::CpuEngine;
+    use crate::engine::Engine;
+
+    const SCENE: &str = r#"
+seed = 5
+[[material]]
+name = "sand"
+density = 2650.0
+youngs_modulus = 7.0e7
+poisson_ratio = 0.3
+mu_s = 0.5
+restitution = 0.5
+
+[[generate]]
+material = "sand"
+count = 1300
+diameter = { min = 0.8e-3, max = 1.2e-3 }
+region = { shape = "box", min = [0.0, 0.0, 0.0], max = [14.0e-3, 14.0e-3, 14.0e-3] }
+random_speed = 0.5
+
+[periodic]
+x = [0.0, 14.0e-3]
+y = [0.0, 14.0e-3]
+z = [0.0, 14.0e-3]
+
+[model]
+normal = "hertz"
+damping = "restitution"
+tangential = "mindlin"
+tangential_damping_ratio = 0.9075
+
+[[stage]]
+kind = "run"
+duration = 1.0e-3
+"#;
+
+    fn check<T: Real>() {
+        let mut scene = crate::scene::parse(std::path::Path::new("lanes_test.toml"), SCENE).unwrap();
+        // Grown 10% after placement: a dense, jostling gas.
+        scene.grains.radius.iter_mut().for_each(|r| *r *= 1.1);
+        let mut e = CpuEngine::<T>::new(&scene).unwrap();
+        e.advance(400).unwrap();
+        let model = hertz_mindlin(&e.model).expect("the scene's model is Hertz-Mindlin");
+        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), periodic: e.periodic };
+        let n = e.pairs.len();
+        let (mut hist_one, mut hist_lanes) = (e.hist.clone(), e.hist.clone());
+        let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[3 * k..3 * k + 3])).collect();
+        let mut lanes = vec![ContactForce::default(); n];
+        hertz_mindlin_block(&model, 0, &mut lanes, &mut hist_lanes, &e.pairs, &e.body, &e.prop, &ctx);
+        let touching = one.iter().filter(|f| f.f_n > T::ZERO).count();
+        let springs = e.hist.chunks(3).filter(|s| s.iter().any(|x| *x != T::ZERO)).count();
+        println!("{}: {n} pairs, {touching} pushing, {springs} springs", T::NAME);
+        assert!(touching > 100 && touching < n, "the gas must hold touching and open pairs");
+        assert!(springs > 100, "the springs must have grown");
+        let bits = |f: &ContactForce<T>| [f.f_i, f.f_j, f.t_i, f.t_j].iter().flat_map(|v| [v.x, v.y, v.z]).chain([f.f_n, f.f_c]).map(|x| x.f64().to_bits()).chain([f.clamped as u64]).collect::<Vec<_>>();
+        let first = (0..n).find(|&k| bits(&one[k]) != bits(&lanes[k]));
+        assert_eq!(first, None, "forces differ at pair {first:?}");
+        let first = hist_one.iter().zip(&hist_lanes).position(|(a, b)| a.f64().to_bits() != b.f64().to_bits());
+        assert_eq!(first, None, "springs differ at real {first:?}");
+    }
+
+    #[test]
+    fn lanes_give_the_one_pair_pass_bits_in_f64() {
+        check::<f64>();
+    }
+
+    #[test]
+    fn lanes_give_the_one_pair_pass_bits_in_f32() {
+        check::<f32>();
+    }
+}
