@@ -144,11 +144,11 @@ pub fn tile(bed: &Scene, nx: usize, ny: usize) -> anyhow::Result<Scene> {
 /// tile counts no more than 4:1 apart, e.g. 10^5 = 5 x 2, 10^6 = 10 x 10).
 pub fn bed_of(base: &Scene, n: usize) -> anyhow::Result<Scene> {
     let per = base.grains.len();
-    if n % per != 0 {
+    if !n.is_multiple_of(per) {
         anyhow::bail!("bench size {n}: the bed is tiled from {per} grains; fix: give a multiple of {per}");
     }
     let copies = n / per;
-    let ny = (1..=copies).filter(|d| copies % d == 0 && d * d <= copies).max().unwrap_or(1);
+    let ny = (1..=copies).filter(|d| copies.is_multiple_of(*d) && d * d <= copies).max().unwrap_or(1);
     let nx = copies / ny;
     if nx > 4 * ny.max(1) && copies > 1 {
         anyhow::bail!("bench size {n}: {copies} copies tile only as {nx} x {ny}; fix: give a size whose number of copies is close to a square (e.g. 10^5, 4 x 10^5, 10^6)");
