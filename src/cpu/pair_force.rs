@@ -2,7 +2,8 @@
 //! order (owner = lower permanent id = i), and reads and writes its history.
 //!
 //! The pass runs in blocks of [`BLOCK`] pairs, each compiled for the widest instruction set
-//! the CPU has (see `simd`).
+//! the CPU has (see `simd`); under the standard Hertz-Mindlin model a block runs in vector
+//! lanes (see `lanes`), with the same bits.
 
 use super::pairs::PairList;
 use super::state::{Body, HistorySlots, Props};
