@@ -18,28 +18,20 @@ use crate::real::{Real, Vec3};
 /// Pairs per lane group.
 const LANES: usize = 32;
 
-/// `model` with its laws as compile-time constants when it is the standard Hertz-Mindlin
-/// model, so that the composed `contact_force` folds to straight-line code.
+/// `model` rebuilt with its laws as compile-time constants when it is the standard
+/// Hertz-Mindlin model, so that the composed `contact_force` folds to straight-line code.
 #[inline(always)]
 pub fn hertz_mindlin<T: Real>(model: &ContactModel<T>) -> Option<ContactModel<T>> {
-    match *model {
-        ContactModel {
-            normal: NormalLaw::Hertz,
-            damping: DampingLaw::Restitution,
-            tangential: TangentialLaw::Mindlin { damping_ratio, stiffness: TangentialStiffness::Mindlin },
-            rolling: RollingLaw::None,
-            twisting: TwistingLaw::None,
-            cohesion: CohesionLaw::None,
-        } => Some(ContactModel {
-            normal: NormalLaw::Hertz,
-            damping: DampingLaw::Restitution,
-            tangential: TangentialLaw::Mindlin { damping_ratio, stiffness: TangentialStiffness::Mindlin },
-            rolling: RollingLaw::None,
-            twisting: TwistingLaw::None,
-            cohesion: CohesionLaw::None,
-        }),
-        _ => None,
-    }
+    let TangentialLaw::Mindlin { damping_ratio, .. } = model.tangential else { return None };
+    let fixed = ContactModel {
+        normal: NormalLaw::Hertz,
+        damping: DampingLaw::Restitution,
+        tangential: TangentialLaw::Mindlin { damping_ratio, stiffness: TangentialStiffness::Mindlin },
+        rolling: RollingLaw::None,
+        twisting: TwistingLaw::None,
+        cohesion: CohesionLaw::None,
+    };
+    (*model == fixed).then_some(fixed)
 }
 
 /// Three lanes of reals, one per component.
