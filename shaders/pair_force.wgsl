@@ -1,6 +1,7 @@
 // One invocation computes the force of one listed pair, once, in canonical order (owner =
-// lower id = i), reading and writing its history. A pair that does not touch exerts nothing
-// and forgets its springs.
+// lower id = i), reading and writing its history (the tangential block's w is the sliding
+// flag); out_ti.w is its tangential regime. A pair that does not touch exerts nothing and
+// forgets its springs.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
 @group(0) @binding(2) var<storage, read> pos: array<vec4<f32>>;
@@ -20,16 +21,17 @@
 fn load_history(k: u32) -> History {
     var h: History;
     h.tangential = vec3<f32>(0.0);
+    h.sliding = false;
     h.rolling = vec3<f32>(0.0);
     var b = k * params.hist_blocks;
-    if (HAS_TANGENTIAL_HISTORY) { h.tangential = hist[b].xyz; b += 1u; }
+    if (HAS_TANGENTIAL_HISTORY) { h.tangential = hist[b].xyz; h.sliding = hist[b].w != 0.0; b += 1u; }
     if (HAS_ROLLING_HISTORY) { h.rolling = hist[b].xyz; }
     return h;
 }
 
 fn store_history(k: u32, h: History) {
     var b = k * params.hist_blocks;
-    if (HAS_TANGENTIAL_HISTORY) { hist[b] = vec4<f32>(h.tangential, 0.0); b += 1u; }
+    if (HAS_TANGENTIAL_HISTORY) { hist[b] = vec4<f32>(h.tangential, select(0.0, 1.0, h.sliding)); b += 1u; }
     if (HAS_ROLLING_HISTORY) { hist[b] = vec4<f32>(h.rolling, 0.0); }
 }
 
@@ -49,6 +51,7 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
     if (dist2 >= reach * reach) {
         var zero: History;
         zero.tangential = vec3<f32>(0.0);
+        zero.sliding = false;
         zero.rolling = vec3<f32>(0.0);
         store_history(k, zero);
         out_fi[k] = vec4<f32>(0.0);
@@ -70,6 +73,6 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
     store_history(k, h);
     out_fi[k] = vec4<f32>(f.f_i, f.f_n);
     out_fj[k] = vec4<f32>(f.f_j, select(0.0, 1.0, f.clamped));
-    out_ti[k] = vec4<f32>(f.t_i, 0.0);
+    out_ti[k] = vec4<f32>(f.t_i, f32(f.regime));
     out_tj[k] = vec4<f32>(f.t_j, 0.0);
 }

@@ -1,12 +1,12 @@
-// One workgroup sums the statistics rows in a fixed order: stats[0..16] over grains,
-// stats[16..32] over pairs (the pair rows beyond the current pair count are ignored).
+// One workgroup sums the statistics rows in a fixed order: stats[0..STAT_ROW] over grains,
+// stats[STAT_ROW..2 STAT_ROW] over pairs (the pair rows beyond the current pair count are ignored).
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> grain_rows: array<f32>;
 @group(0) @binding(2) var<storage, read> pair_rows: array<f32>;
 @group(0) @binding(3) var<storage, read> control: Control;
 @group(0) @binding(4) var<storage, read_write> stats: array<f32>;
 
-var<workgroup> row: array<f32, 1024>;
+var<workgroup> row: array<f32, WG * STAT_ROW>;
 
 fn fold(lid: u32, rows: u32, which: u32) {
     clear_row(lid);

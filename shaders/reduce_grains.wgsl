@@ -1,19 +1,20 @@
 // One invocation adds one grain to its workgroup's statistics row: kinetic and gravitational
-// energy, momentum, angular momentum, |net force|, wall contacts, their elastic energy and
-// the largest wall overlap.
+// energy, momentum, angular momentum, |net force|, wall contacts, their elastic energy, its
+// wall contacts sliding and rolling, and the largest wall overlap.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> vel: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> omega: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> force: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read> wall_force: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read> image: array<vec4<i32>>;
-@group(0) @binding(7) var<storage, read> material: array<u32>;
-@group(0) @binding(8) var<storage, read> coeffs: array<PairCoeffs>;
-@group(0) @binding(9) var<storage, read> walls: array<Wall>;
-@group(0) @binding(10) var<storage, read_write> grain_rows: array<f32>;
+@group(0) @binding(6) var<storage, read> wall_torque: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> image: array<vec4<i32>>;
+@group(0) @binding(8) var<storage, read> material: array<u32>;
+@group(0) @binding(9) var<storage, read> coeffs: array<PairCoeffs>;
+@group(0) @binding(10) var<storage, read> walls: array<Wall>;
+@group(0) @binding(11) var<storage, read_write> grain_rows: array<f32>;
 
-var<workgroup> row: array<f32, 1024>;
+var<workgroup> row: array<f32, WG * STAT_ROW>;
 
 @compute @workgroup_size(64)
 fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -41,6 +42,8 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         row[r + 8u] = l.z;
         row[r + 9u] = length(force[i].xyz);
         row[r + 10u] = length(wall_force[i].xyz);
+        row[r + 13u] = wall_force[i].w;
+        row[r + 14u] = wall_torque[i].w;
         for (var k = 0u; k < params.n_walls; k++) {
             let frame = wall_frame(walls[k], p.xyz);
             let h = p.w - frame.w;

@@ -1,6 +1,6 @@
 // One invocation adds one pair to its workgroup's statistics row: touching pairs, clamped
-// contacts, elastic energy, |contact force| (counted for both grains) and the largest
-// overlap over the smaller radius.
+// contacts, elastic energy, |contact force| (counted for both grains), sliding and rolling
+// contacts, and the largest overlap over the smaller radius.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> material: array<u32>;
@@ -9,10 +9,11 @@
 @group(0) @binding(5) var<storage, read> pair_j: array<u32>;
 @group(0) @binding(6) var<storage, read> out_fi: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read> out_fj: array<vec4<f32>>;
-@group(0) @binding(8) var<storage, read> control: Control;
-@group(0) @binding(9) var<storage, read_write> pair_rows: array<f32>;
+@group(0) @binding(8) var<storage, read> out_ti: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read> control: Control;
+@group(0) @binding(10) var<storage, read_write> pair_rows: array<f32>;
 
-var<workgroup> row: array<f32, 1024>;
+var<workgroup> row: array<f32, WG * STAT_ROW>;
 
 @compute @workgroup_size(64)
 fn reduce_pairs(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -31,6 +32,9 @@ fn reduce_pairs(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
             row[r + 1u] = out_fj[k].w;
             row[r + 2u] = normal_potential(c, pi.w * pj.w / (pi.w + pj.w), h);
             row[r + 3u] = 2.0 * length(out_fi[k].xyz);
+            let regime = u32(out_ti[k].w);
+            row[r + 4u] = select(0.0, 1.0, regime == REGIME_SLIDING);
+            row[r + 5u] = select(0.0, 1.0, regime == REGIME_ROLLING);
             row[r + STAT_MAX] = h / min(pi.w, pj.w);
             row[r + STAT_ARG] = bitcast<f32>(i);
         }

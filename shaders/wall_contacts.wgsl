@@ -1,5 +1,6 @@
 // One invocation computes one grain's contacts with every wall (the grain-grain laws with an
-// infinite partner), and each workgroup sums the forces its grains put on each wall.
+// infinite partner), and each workgroup sums the forces its grains put on each wall. The w of
+// wall_force and wall_torque count the grain's wall contacts sliding and rolling.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
 @group(0) @binding(2) var<storage, read> pos: array<vec4<f32>>;
@@ -21,6 +22,8 @@ fn wall_contacts(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
     let live = i < params.n_grains;
     var force = vec3<f32>(0.0);
     var torque = vec3<f32>(0.0);
+    var sliding = 0.0;
+    var rolling = 0.0;
     for (var w = 0u; w < MAX_WALLS; w++) {
         reaction[lid * MAX_WALLS + w] = vec4<f32>(0.0);
     }
@@ -42,20 +45,23 @@ fn wall_contacts(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
             let c = coeffs[wall.material * params.n_materials + material[i]];
             var h: History;
             h.tangential = vec3<f32>(0.0);
+            h.sliding = false;
             h.rolling = vec3<f32>(0.0);
             var b = base;
-            if (HAS_TANGENTIAL_HISTORY) { h.tangential = wall_hist[b].xyz; b += 1u; }
+            if (HAS_TANGENTIAL_HISTORY) { h.tangential = wall_hist[b].xyz; h.sliding = wall_hist[b].w != 0.0; b += 1u; }
             if (HAS_ROLLING_HISTORY) { h.rolling = wall_hist[b].xyz; }
             let f = contact_force(c, g, kin, bodies, &h, phase.elapsed);
             b = base;
-            if (HAS_TANGENTIAL_HISTORY) { wall_hist[b] = vec4<f32>(h.tangential, 0.0); b += 1u; }
+            if (HAS_TANGENTIAL_HISTORY) { wall_hist[b] = vec4<f32>(h.tangential, select(0.0, 1.0, h.sliding)); b += 1u; }
             if (HAS_ROLLING_HISTORY) { wall_hist[b] = vec4<f32>(h.rolling, 0.0); }
             force += f.f_i;
             torque += f.t_i;
             reaction[lid * MAX_WALLS + w] = vec4<f32>(-f.f_i, 1.0);
+            sliding += select(0.0, 1.0, f.regime == REGIME_SLIDING);
+            rolling += select(0.0, 1.0, f.regime == REGIME_ROLLING);
         }
-        wall_force[i] = vec4<f32>(force, 0.0);
-        wall_torque[i] = vec4<f32>(torque, 0.0);
+        wall_force[i] = vec4<f32>(force, sliding);
+        wall_torque[i] = vec4<f32>(torque, rolling);
     }
     workgroupBarrier();
     // Fixed-order tree over the workgroup's lanes.

@@ -96,6 +96,14 @@ pub struct Stats {
     pub wall_contacts: u64,
     /// Touching pairs whose damping the no-pull clamp cut off at the last force evaluation.
     pub clamped: u64,
+    /// Contacts (grain-grain and grain-wall) on their Coulomb limit at the last force
+    /// evaluation; 0 in checkpoints written before grains counted them.
+    #[serde(default)]
+    pub sliding: u64,
+    /// Contacts in seed 000's rolling regime at full rolling friction at the last force
+    /// evaluation (the rest of the touching contacts stick).
+    #[serde(default)]
+    pub rolling: u64,
     /// Mean grain-grain contacts per grain, `2 contacts / N`.
     pub coordination: f64,
     /// Largest overlap over the smaller radius of the pair (-).
@@ -120,7 +128,39 @@ pub struct Stats {
     pub piston: Option<PistonStats>,
 }
 
+/// Contacts counted per tangential regime.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RegimeCounts {
+    /// On the Coulomb limit.
+    pub sliding: u64,
+    /// At full rolling friction.
+    pub rolling: u64,
+}
+
+impl RegimeCounts {
+    /// Counts one contact.
+    #[inline(always)]
+    pub fn count(&mut self, r: crate::model::Regime) {
+        self.sliding += (r == crate::model::Regime::Sliding) as u64;
+        self.rolling += (r == crate::model::Regime::Rolling) as u64;
+    }
+    /// Adds another count.
+    pub fn add(&mut self, o: RegimeCounts) {
+        self.sliding += o.sliding;
+        self.rolling += o.rolling;
+    }
+}
+
 impl Stats {
+    /// Touching contacts, grain-grain and grain-wall.
+    pub fn all_contacts(&self) -> u64 {
+        self.contacts + self.wall_contacts
+    }
+    /// Fraction of the touching contacts on their Coulomb limit (-); 0 without contacts.
+    pub fn sliding_fraction(&self) -> f64 {
+        if self.all_contacts() == 0 { 0.0 } else { self.sliding as f64 / self.all_contacts() as f64 }
+    }
+
     /// Kinetic energy, translational and rotational (J).
     pub fn kinetic_energy(&self) -> f64 {
         self.ke_translational + self.ke_rotational
@@ -174,6 +214,9 @@ pub struct ContactRecord {
     pub force_j: [f64; 3],
     /// Tangential spring `xi` (m), zero when the model keeps none.
     pub tangential_spring: [f64; 3],
+    /// Rolling spring `psi` (m), zero when the model keeps none.
+    #[serde(default)]
+    pub rolling_spring: [f64; 3],
 }
 
 /// One grain touching one wall. Its force is evaluated from the state of the frame (springs

@@ -18,7 +18,7 @@ fn chain() -> Frame {
     let x = |k: f64| [k * (2.0 * r - h), 0.0, 0.0];
     let rec = |i: u32, j: u32, f: f64| {
         // n from j to i; i is left of j, so n = -x; the force on i is f n.
-        ContactRecord { i, j, overlap: h, normal_force: f, force: [-f, 0.0, 0.0], force_j: [f, 0.0, 0.0], tangential_spring: [0.0; 3] }
+        ContactRecord { i, j, overlap: h, normal_force: f, force: [-f, 0.0, 0.0], force_j: [f, 0.0, 0.0], tangential_spring: [0.0; 3], rolling_spring: [0.0; 3] }
     };
     Frame {
         time: 0.0,

@@ -71,15 +71,10 @@ fn hertz_mindlin_conserves_linear_and_angular_momentum_to_round_off() {
     assert!(dl.norm() < MOMENTUM_ROUNDOFF * scale_l, "angular momentum drift {dl:?}");
 }
 
-/// Seed 000's rolling regime applies eqs. 8-9 to each grain with its own m, I, R', along the
-/// same t for both (v_r is the same vector seen from either grain), so the pair's momentum
-/// changes at `2 |F_n| tan(theta_r) / (1 + I/(m R'^2))` along `-t`. Two counter-rotating
-/// equal grains in light contact (no slip at the contact point, like meshing gears) show it.
-#[test]
-fn the_rolling_regime_does_not_conserve_the_pairs_linear_momentum() {
-    const RATE_TOLERANCE: f64 = 1e-6;
-    let r: f64 = 5.0e-4;
-    let gap: f64 = -1.0e-7; // overlap 1e-7 m
+/// Two counter-rotating equal grains of radius `r` in light contact (overlap `-gap`; no slip
+/// at the contact point, like meshing gears) after one step under seed 000's rolling
+/// friction `friction`; returns the scene and the engine.
+fn counter_rotating_pair(friction: &str, r: f64, gap: f64) -> (grains::scene::Scene, CpuEngine<f64>) {
     let text = format!(
         r#"
 [[material]]
@@ -105,6 +100,7 @@ angular_velocity = [0.0, 0.0, -10.0]
 
 [model]
 tangential = "oquendo"
+rolling_friction = "{friction}"
 
 [simulation]
 gravity = [0.0, 0.0, 0.0]
@@ -120,18 +116,54 @@ duration = 1.0e-8
     scene.grains.position[1][0] = 2.0 * r + gap;
     let mut e: CpuEngine<f64> = common::engine(&scene);
     e.step().unwrap();
+    (scene, e)
+}
+
+/// The Hertz force of the pair at overlap `h` (N).
+fn hertz(scene: &grains::scene::Scene, r: f64, h: f64) -> f64 {
+    let c = grains::model::PairCoeffs::<f64>::mix(&scene.materials[0].constants, &scene.materials[0].constants);
+    4.0 / 3.0 * c.v_eff * (r / 2.0).sqrt() * h.powf(1.5)
+}
+
+/// Seed 000's rolling friction as the paper writes it applies eqs. 8-9 to each grain with its
+/// own m, I, R', along the same t for both (v_r is the same vector seen from either grain), so
+/// the pair's momentum changes at `2 |F_n| tan(theta_r) / (1 + I/(m R'^2))` along `-t`.
+#[test]
+fn the_rolling_regime_as_written_does_not_conserve_the_pairs_linear_momentum() {
+    const RATE_TOLERANCE: f64 = 1e-6;
+    let (r, gap) = (5.0e-4, -1.0e-7);
+    let (scene, e) = counter_rotating_pair("as_written", r, gap);
     let dt = e.dt();
     let p: Vec3<f64> = e.bodies().iter().zip(&scene.grains.mass).fold(Vec3::ZERO, |acc, (b, m)| acc + b.vel * *m);
     // Expected: both grains pushed along -t with |F_n| tan(theta_r) / (1 + I/(m R'^2)).
-    let (m, k_n_force) = (scene.grains.mass[0], {
-        let c = grains::model::PairCoeffs::<f64>::mix(&scene.materials[0].constants, &scene.materials[0].constants);
-        let h = -gap;
-        4.0 / 3.0 * c.v_eff * (r / 2.0).sqrt() * h.powf(1.5)
-    });
+    let m = scene.grains.mass[0];
     let rp = r - (-gap) / 2.0;
     let inertia = 0.4 * m * r * r;
-    let each = k_n_force * 10.0f64.to_radians().tan() / (1.0 + inertia / (m * rp * rp));
+    let each = hertz(&scene, r, -gap) * 10.0f64.to_radians().tan() / (1.0 + inertia / (m * rp * rp));
     let rate = p.norm() / dt;
-    println!("pair momentum rate {rate:.6e} N, expected 2 x {each:.6e} N; direction {:?}", p * (1.0 / p.norm()));
+    println!("as written: pair momentum rate {rate:.6e} N, expected 2 x {each:.6e} N; direction {:?}", p * (1.0 / p.norm()));
     assert!((rate / (2.0 * each) - 1.0).abs() < RATE_TOLERANCE, "rate {rate:e} vs {:e}", 2.0 * each);
+}
+
+/// The default realisation puts seed 000's rolling friction on the pair as a torque pair
+/// `+-R'_eff |F_n| tan(theta_r)`: the pair's momentum stays zero and the relative spin slows
+/// at the rate that torque gives.
+#[test]
+fn the_rolling_regime_as_a_torque_pair_conserves_momentum() {
+    const RATE_TOLERANCE: f64 = 1e-6;
+    let (r, gap) = (5.0e-4, -1.0e-7);
+    let (scene, e) = counter_rotating_pair("torque", r, gap);
+    let dt = e.dt();
+    let m = scene.grains.mass[0];
+    let b = e.bodies();
+    let p: Vec3<f64> = b.iter().fold(Vec3::ZERO, |acc, b| acc + b.vel * m);
+    let spin: f64 = b.iter().map(|b| b.omega.z).sum();
+    let rp_eff = (r - (-gap) / 2.0) / 2.0;
+    let inertia = 0.4 * m * r * r;
+    let torque = rp_eff * hertz(&scene, r, -gap) * 10.0f64.to_radians().tan();
+    let slowed = (10.0 - b[0].omega.z) * inertia / dt;
+    println!("torque pair: momentum {:.3e} kg m/s, total spin {spin:.3e} rad/s, torque {slowed:.6e} N m (R'_eff F_n tan(theta_r) = {torque:.6e})", p.norm());
+    assert!(p.norm() < MOMENTUM_ROUNDOFF * 2.0 * m * 1.0e-6, "momentum {p:?}");
+    assert!(spin.abs() < 1e-12 * 10.0, "the torques are equal and opposite: total spin {spin:e}");
+    assert!((slowed / torque - 1.0).abs() < RATE_TOLERANCE, "torque {slowed:e} vs {torque:e}");
 }

@@ -106,6 +106,12 @@ fn pair_force_wall_contacts_and_gather_match_the_cpu_twins() {
         println!("periodic {periodic}: largest load difference {worst:.3e} N, mean contact force {scale:.3e} N");
         assert!(scale > 0.0);
         assert!(worst < F32_LOAD_TOLERANCE * scale);
+        // Seed 000's regimes, contact by contact through the sliding flag and the rolling
+        // spring, counted alike.
+        let (sg, sc) = (g.stats(), c.stats());
+        println!("periodic {periodic}: gpu {} sliding, {} rolling; cpu {} sliding, {} rolling", sg.sliding, sg.rolling, sc.sliding, sc.rolling);
+        assert!(sc.sliding > 0 && sc.rolling > 0, "the gas slides and rolls");
+        assert_eq!((sg.sliding, sg.rolling), (sc.sliding, sc.rolling), "contacts per regime");
     }
 }
 
@@ -133,6 +139,7 @@ fn integrate_and_the_reductions_match_the_cpu_twins() {
         assert!((a - b).abs() <= F32_STATS_TOLERANCE * b.abs().max(1e-30), "{name}");
     }
     assert_eq!((sg.contacts, sg.wall_contacts, sg.rebuilds), (sc.contacts, sc.wall_contacts, sc.rebuilds));
+    assert_eq!((sg.sliding, sg.rolling), (sc.sliding, sc.rolling), "contacts per regime");
     assert_eq!(sg.max_overlap_grain, sc.max_overlap_grain);
     for (a, b) in sg.walls.iter().zip(&sc.walls) {
         for k in 0..3 {

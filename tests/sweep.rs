@@ -6,21 +6,19 @@ mod common;
 
 use std::process::Command;
 
-/// A tiny oedometer (50 grains, Hertz-Mindlin so that each step settles, four steps).
+/// A tiny oedometer of the shipped scene's grains and laws (50 grains, four steps).
 fn tiny_oedometer() -> String {
-    std::fs::read_to_string(common::scene_path("oedometer.toml"))
-        .unwrap()
-        .replace("count = 1200", "count = 50")
-        .replace("radius = 6.0e-3, z_min = 0.0, z_max = 20.0e-3", "radius = 2.5e-3, z_min = 0.0, z_max = 9.0e-3")
-        .replace("radius = 6.0e-3\n", "radius = 2.5e-3\n")
-        .replace("z = 21.0e-3", "z = 10.0e-3")
-        .replace("mu_k = 0.3\n", "")
-        .replace("rolling_angle = 2.0\n", "")
-        .replace("tangential = \"oquendo\"", "tangential = \"mindlin\"\ntangential_damping_ratio = 0.9\n#")
-        .replace("v_slip = 1.0e-3", "#")
-        .replace("v_roll = 1.0e-3", "#")
-        .replace("p_max = 1.6e6", "p_max = 100.0e3")
-        .replace("duration = 0.04 ", "duration = 0.02 ")
+    common::edit(
+        &std::fs::read_to_string(common::scene_path("oedometer.toml")).unwrap(),
+        &[
+            ("count = 280", "count = 50"),
+            ("radius = 3.75e-3, z_min = 0.0, z_max = 12.0e-3", "radius = 2.5e-3, z_min = 0.0, z_max = 9.0e-3"),
+            ("radius = 3.75e-3\n", "radius = 2.5e-3\n"),
+            ("z = 13.0e-3", "z = 10.0e-3"),
+            ("p_max = 1.6e6", "p_max = 100.0e3"),
+            ("duration = 0.05 ", "duration = 0.02 "),
+        ],
+    )
 }
 
 fn grains(args: &[&str]) -> std::process::Output {

@@ -42,10 +42,17 @@ struct ContactForce {
     t_j: vec3<f32>,
     f_n: f32,
     clamped: bool,
+    regime: u32,
 }
+
+// Tangential regimes, the codes of src/model/mod.rs `Regime`.
+const REGIME_STATIC: u32 = 0u;
+const REGIME_SLIDING: u32 = 1u;
+const REGIME_ROLLING: u32 = 2u;
 
 struct History {
     tangential: vec3<f32>,
+    sliding: bool,
     rolling: vec3<f32>,
 }
 
@@ -126,11 +133,35 @@ fn tangential_stiffness(c: PairCoeffs, g: Geometry, k_secant: f32) -> f32 {
     return 8.0 * c.g_eff * sqrt(g.r_eff * g.h);
 }
 
-// Seed 000 eqs. 8-9 for one grain: (force, torque).
-fn rolling_regime(fr: f32, m: f32, inertia: f32, rp: f32, t: vec3<f32>, n: vec3<f32>, out_f: ptr<function, vec3<f32>>, out_t: ptr<function, vec3<f32>>) {
+// An elastic-plastic spring (src/model/tangential.rs elastic_plastic): the force -k s - eta v
+// within `stick`, else `slip` along itself with the spring rescaled to match.
+struct ElasticPlastic {
+    force: vec3<f32>,
+    spring: vec3<f32>,
+    slipped: bool,
+}
+
+fn elastic_plastic(s: vec3<f32>, v: vec3<f32>, k: f32, eta: f32, stick: f32, slip: f32) -> ElasticPlastic {
+    var out: ElasticPlastic;
+    let damp = v * eta;
+    let f = -(s * k) - damp;
+    let mag = sqrt(dot(f, f));
+    out.slipped = mag > stick;
+    if (out.slipped) {
+        out.force = f * (slip / mag);
+        if (k > 0.0) { out.spring = (out.force + damp) * (-1.0 / k); } else { out.spring = vec3<f32>(0.0); }
+    } else {
+        out.force = f;
+        out.spring = s;
+    }
+    return out;
+}
+
+// Seed 000 eqs. 8-9 for one grain, fr = |F_n| tan(theta_r) t on the cap: (force, torque).
+fn rolling_regime(fr: vec3<f32>, m: f32, inertia: f32, rp: f32, n: vec3<f32>, out_f: ptr<function, vec3<f32>>, out_t: ptr<function, vec3<f32>>) {
     let mr2 = m * rp * rp;
-    *out_f = t * (-fr / (1.0 + inertia / mr2));
-    *out_t = cross(t, n) * (rp * fr / (1.0 + mr2 / inertia));
+    *out_f = fr * (-1.0 / (1.0 + inertia / mr2));
+    *out_t = cross(fr, n) * (rp / (1.0 + mr2 / inertia));
 }
 
 fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr<function, History>, elapsed: f32) -> ContactForce {
@@ -149,51 +180,61 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
     out.t_i = vec3<f32>(0.0);
     out.t_j = vec3<f32>(0.0);
 
+    out.regime = REGIME_STATIC;
     if (TANGENTIAL_LAW == 1u) {
+        // Seed 000's regimes (src/model/tangential.rs oquendo_tangential).
         let k_t = tangential_stiffness(c, g, el.y);
         let v_t = contact_tangential_velocity(g, k);
-        let speed = length(v_t);
-        var f_i = vec3<f32>(0.0);
-        var f_j = vec3<f32>(0.0);
-        var t_i = vec3<f32>(0.0);
-        var t_j = vec3<f32>(0.0);
-        var regime_done = false;
-        if (speed > params.v_slip) {
-            let f_t = v_t * (-c.mu_k * f_n / speed);
-            if (k_t > 0.0) { (*hist).tangential = f_t * (-1.0 / k_t); } else { (*hist).tangential = vec3<f32>(0.0); }
-            f_i = f_t;
-            f_j = -f_t;
-            t_i = -(cross(g.n, f_t) * g.rp_i);
-            t_j = -(cross(g.n, f_t) * g.rp_j);
-            regime_done = true;
-        }
-        if (!regime_done) {
-            (*hist).tangential = rotate_into_plane((*hist).tangential, g.n) + v_t * elapsed;
+        let xi = rotate_into_plane((*hist).tangential, g.n) + v_t * elapsed;
+        let mobility_i = 1.0 / b.m_i + g.rp_i * g.rp_i / b.inertia_i;
+        var mobility_j = 0.0;
+        if (!b.j_is_wall) { mobility_j = 1.0 / b.m_j + g.rp_j * g.rp_j / b.inertia_j; }
+        let eta_t = 2.0 * params.static_damping * sqrt(k_t / (mobility_i + mobility_j));
+        var mu = max(c.mu_s, c.mu_k);
+        if ((*hist).sliding) { mu = c.mu_k; }
+        let t = elastic_plastic(xi, v_t, k_t, eta_t, mu * f_n, c.mu_k * f_n);
+        (*hist).tangential = t.spring;
+        (*hist).sliding = t.slipped;
+        let f_t = t.force;
+        var f_i = f_t;
+        var f_j = -f_t;
+        var t_i = -(cross(g.n, f_t) * g.rp_i);
+        var t_j = -(cross(g.n, f_t) * g.rp_j);
+        if (t.slipped && mu * f_n > 0.0) { out.regime = REGIME_SLIDING; }
+        if (t.slipped) {
+            (*hist).rolling = vec3<f32>(0.0);
+        } else {
             let v_r = cross(k.w_i - k.w_j, g.n) * g.rp_eff;
-            let roll_speed = length(v_r);
-            if (roll_speed > params.v_roll) {
-                let t = v_r * (1.0 / roll_speed);
-                let fr = f_n * c.tan_roll;
-                rolling_regime(fr, b.m_i, b.inertia_i, g.rp_i, t, g.n, &f_i, &t_i);
-                if (b.j_is_wall) {
-                    f_j = -f_i;
-                } else {
-                    rolling_regime(fr, b.m_j, b.inertia_j, g.rp_j, t, -g.n, &f_j, &t_j);
-                }
+            let psi = rotate_into_plane((*hist).rolling, g.n) + v_r * elapsed;
+            var mobility = 1.0 / b.inertia_i;
+            if (!b.j_is_wall) { mobility = 1.0 / b.inertia_i + 1.0 / b.inertia_j; }
+            let mobility_r = g.rp_eff * g.rp_eff * mobility;
+            let eta_r = 2.0 * params.static_damping * sqrt(k_t / mobility_r);
+            let limit_r = f_n * c.tan_roll;
+            let r = elastic_plastic(psi, v_r, k_t, eta_r, limit_r, limit_r);
+            (*hist).rolling = r.spring;
+            if (params.rolling_as_written == 0u) {
+                let tau = cross(g.n, r.force) * g.rp_eff;
+                t_i += tau;
+                t_j -= tau;
             } else {
-                let damp = v_t * (eta_n * params.damping_ratio);
-                var f_t = -((*hist).tangential * k_t) - damp;
-                let limit = c.mu_s * f_n;
-                let mag = length(f_t);
-                if (mag > limit) {
-                    f_t = f_t * (c.mu_k * f_n / mag);
-                    if (k_t > 0.0) { (*hist).tangential = (f_t + damp) * (-1.0 / k_t); } else { (*hist).tangential = vec3<f32>(0.0); }
+                let fr = -r.force;
+                var rf_i = vec3<f32>(0.0);
+                var rf_j = vec3<f32>(0.0);
+                var rt_i = vec3<f32>(0.0);
+                var rt_j = vec3<f32>(0.0);
+                rolling_regime(fr, b.m_i, b.inertia_i, g.rp_i, g.n, &rf_i, &rt_i);
+                if (b.j_is_wall) {
+                    rf_j = -rf_i;
+                } else {
+                    rolling_regime(fr, b.m_j, b.inertia_j, g.rp_j, -g.n, &rf_j, &rt_j);
                 }
-                f_i = f_t;
-                f_j = -f_t;
-                t_i = -(cross(g.n, f_t) * g.rp_i);
-                t_j = -(cross(g.n, f_t) * g.rp_j);
+                f_i += rf_i;
+                f_j += rf_j;
+                t_i += rt_i;
+                t_j += rt_j;
             }
+            if (r.slipped && limit_r > 0.0) { out.regime = REGIME_ROLLING; }
         }
         out.f_i += f_i;
         out.f_j += f_j;
@@ -211,6 +252,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
         if (mag2 > limit * limit) {
             f_t = f_t * (limit / sqrt(mag2));
             if (k_t > 0.0) { (*hist).tangential = (f_t + damp) * (-1.0 / k_t); } else { (*hist).tangential = vec3<f32>(0.0); }
+            out.regime = REGIME_SLIDING;
         }
         out.f_i += f_t;
         out.f_j -= f_t;

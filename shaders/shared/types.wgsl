@@ -10,7 +10,7 @@ struct Params {
     hash_size: u32,
     max_neighbours: u32,
     piston: u32,          // wall index of the piston, or 0xffffffff
-    hist_blocks: u32,     // vec4 history blocks per contact (tangential, then rolling)
+    hist_blocks: u32,     // vec4 history blocks per contact (tangential with the sliding flag in w, then rolling)
     gravity: vec4<f32>,   // m/s^2 (xyz)
     cell: vec4<f32>,      // cell edge per axis (m)
     periodic_lo: vec4<f32>,
@@ -19,15 +19,15 @@ struct Params {
     skin: f32,            // m
     k_n: f32,             // linear normal stiffness (N/m)
     c_n: f32,             // viscous damping (N s/m)
-    v_slip: f32,          // m/s
-    v_roll: f32,          // m/s
+    _pad0: f32,
+    _pad1: f32,
     kt_ratio: f32,        // k_t / (F_el / h); <= 0 selects Mindlin's k_t
-    damping_ratio: f32,   // eta_t / eta_n (tangential dashpot)
+    damping_ratio: f32,   // eta_t / eta_n (Hertz-Mindlin tangential dashpot)
     k_r: f32,             // rolling stiffness (N/m)
     gamma_r: f32,         // rolling damping (N s/m)
     mu_r: f32,            // rolling friction
-    _pad1: f32,
-    _pad2: f32,
+    static_damping: f32,  // seed 000's static and rolling springs: fraction of critical damping
+    rolling_as_written: u32, // seed 000's rolling friction: 0 torque pair, 1 eqs. 8-9 on each grain
 }
 
 // What changes between the dispatches of one step (uniform, dynamic offset).
@@ -98,6 +98,6 @@ const ARGS_SLOTS: u32 = 9u;
 
 const MAX_WALLS: u32 = 8u;
 // Per-workgroup rows of the statistics reduction: sums, then (largest overlap, its grain).
-const STAT_ROW: u32 = 16u;
-const STAT_MAX: u32 = 14u;
-const STAT_ARG: u32 = 15u;
+const STAT_ROW: u32 = 20u;
+const STAT_MAX: u32 = 18u;
+const STAT_ARG: u32 = 19u;

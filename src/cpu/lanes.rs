@@ -12,7 +12,7 @@
 use super::pair_force::ForceContext;
 use super::pairs::PairList;
 use super::state::{Body, Props};
-use crate::model::{contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+use crate::model::{contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, Regime, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
 use crate::real::{Real, Vec3};
 
 /// Pairs per lane group.
@@ -84,6 +84,7 @@ struct Outputs<T> {
     t_j: V3s<T>,
     f_n: [T; LANES],
     clamped: [bool; LANES],
+    sliding: [bool; LANES],
     xi: V3s<T>,
 }
 
@@ -107,7 +108,7 @@ pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: 
         beta: [T::ZERO; LANES],
         xi: V3s::ZERO,
     };
-    let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], clamped: [false; LANES], xi: V3s::ZERO };
+    let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], clamped: [false; LANES], sliding: [false; LANES], xi: V3s::ZERO };
     for (g, (out, hist)) in out.chunks_mut(LANES).zip(hist.chunks_mut(3 * LANES)).enumerate() {
         let base = first + g * LANES;
         // Load: the scattered reads, one pair at a time.
@@ -144,11 +145,12 @@ pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: 
             res.t_j.set(m, f.t_j);
             res.f_n[m] = f.f_n;
             res.clamped[m] = f.clamped;
+            res.sliding[m] = f.regime == Regime::Sliding;
             res.xi.set(m, if touching { h.tangential } else { Vec3::ZERO });
         }
         // Store.
         for (m, o) in out.iter_mut().enumerate() {
-            *o = ContactForce { f_i: res.f_i.get(m), f_j: res.f_j.get(m), t_i: res.t_i.get(m), t_j: res.t_j.get(m), f_n: res.f_n[m], f_c: T::ZERO, clamped: res.clamped[m] };
+            *o = ContactForce { f_i: res.f_i.get(m), f_j: res.f_j.get(m), t_i: res.t_i.get(m), t_j: res.t_j.get(m), f_n: res.f_n[m], f_c: T::ZERO, clamped: res.clamped[m], regime: if res.sliding[m] { Regime::Sliding } else { Regime::Static } };
             let xi = res.xi.get(m);
             hist[3 * m..3 * m + 3].copy_from_slice(&[xi.x, xi.y, xi.z]);
         }
@@ -215,7 +217,7 @@ duration = 1.0e-3
         println!("{}: {n} pairs, {touching} pushing, {springs} springs", T::NAME);
         assert!(touching > 100 && touching < n, "the gas must hold touching and open pairs");
         assert!(springs > 100, "the springs must have grown");
-        let bits = |f: &ContactForce<T>| [f.f_i, f.f_j, f.t_i, f.t_j].iter().flat_map(|v| [v.x, v.y, v.z]).chain([f.f_n, f.f_c]).map(|x| x.f64().to_bits()).chain([f.clamped as u64]).collect::<Vec<_>>();
+        let bits = |f: &ContactForce<T>| [f.f_i, f.f_j, f.t_i, f.t_j].iter().flat_map(|v| [v.x, v.y, v.z]).chain([f.f_n, f.f_c]).map(|x| x.f64().to_bits()).chain([f.clamped as u64, f.regime as u64]).collect::<Vec<_>>();
         let first = (0..n).find(|&k| bits(&one[k]) != bits(&lanes[k]));
         assert_eq!(first, None, "forces differ at pair {first:?}");
         let first = hist_one.iter().zip(&hist_lanes).position(|(a, b)| a.f64().to_bits() != b.f64().to_bits());

@@ -26,8 +26,8 @@ pub use state::{Body, HistorySlots, Load, Props};
 pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::checkpoint::EngineState;
-use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
-use crate::model::{normal_potential, rupture_distance, CohesionLaw, ContactForce, ContactModel, PairCoeffs};
+use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats};
+use crate::model::{normal_potential, rupture_distance, CohesionLaw, ContactForce, ContactModel, PairCoeffs, Regime};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 use crate::scene::{Integrator, Scene, WallShape};
@@ -113,6 +113,8 @@ pub struct CpuEngine<T: Real> {
     wall_load: Vec<Load<T>>,
     wall_reaction: Vec<Vec3<T>>,
     wall_count: Vec<u64>,
+    /// Wall contacts sliding and rolling at the last force evaluation.
+    wall_regimes: RegimeCounts,
     /// Sum over each wall's contacts of the normal tangent stiffness (N/m) and damping
     /// coefficient (N s/m).
     wall_response: Vec<(T, T)>,
@@ -201,6 +203,7 @@ impl<T: Real> CpuEngine<T> {
             wall_load: vec![Load::default(); n],
             wall_reaction: vec![Vec3::ZERO; n_walls],
             wall_count: vec![0; n_walls],
+            wall_regimes: RegimeCounts::default(),
             wall_response: vec![(T::ZERO, T::ZERO); n_walls],
             grid: CellGrid::default(),
             pairs: PairList::default(),
@@ -366,6 +369,7 @@ impl<T: Real> CpuEngine<T> {
             self.wall_reaction = sums.reaction;
             self.wall_count = sums.count;
             self.wall_response = sums.response;
+            self.wall_regimes = sums.regimes;
         }
         self.clock.stop(Phase::Walls, t);
         let t = self.clock.start();
@@ -524,11 +528,13 @@ struct WallSums<T> {
     count: Vec<u64>,
     /// Sums of the contacts' normal tangent stiffness (N/m) and damping (N s/m).
     response: Vec<(T, T)>,
+    /// Contacts sliding and rolling, over all walls.
+    regimes: RegimeCounts,
 }
 
 impl<T: Real> WallSums<T> {
     fn new(n: usize) -> Self {
-        WallSums { reaction: vec![Vec3::ZERO; n], count: vec![0; n], response: vec![(T::ZERO, T::ZERO); n] }
+        WallSums { reaction: vec![Vec3::ZERO; n], count: vec![0; n], response: vec![(T::ZERO, T::ZERO); n], regimes: RegimeCounts::default() }
     }
 }
 
@@ -546,7 +552,7 @@ fn wall_pass<T: Real>(
     let per_grain = n_walls * ctx.slots.stride;
     let run = |c: usize, loads: &mut [Load<T>], hist: &mut [T]| {
         let mut sums = WallSums::new(n_walls);
-        wall_block(c * CHUNK, loads, hist, body, prop, walls, ctx, &mut sums.reaction, &mut sums.count, &mut sums.response);
+        wall_block(c * CHUNK, loads, hist, body, prop, walls, ctx, &mut sums.reaction, &mut sums.count, &mut sums.response, &mut sums.regimes);
         sums
     };
     let parts: Vec<WallSums<T>> = if per_grain == 0 {
@@ -562,6 +568,7 @@ fn wall_pass<T: Real>(
             total.response[w].0 += p.response[w].0;
             total.response[w].1 += p.response[w].1;
         }
+        total.regimes.add(p.regimes);
     }
     total
 }
@@ -586,6 +593,7 @@ struct GrainSums {
 struct PairSums {
     contacts: u64,
     clamped: u64,
+    regimes: RegimeCounts,
     elastic: f64,
     force: f64,
     max_overlap: (f64, u32),
@@ -677,6 +685,7 @@ impl<T: Real> Engine for CpuEngine<T> {
                 let r_eff = pi.radius * pj.radius / (pi.radius + pj.radius);
                 s.contacts += 1;
                 s.clamped += self.out[k].clamped as u64;
+                s.regimes.count(self.out[k].regime);
                 s.elastic += normal_potential(&self.model.normal, c, r_eff, h).f64();
                 s.force += 2.0 * self.out[k].f_i.norm().f64();
                 s.max_overlap = max_by_first(s.max_overlap, ((h / r_min).f64(), self.id[i]));
@@ -702,6 +711,7 @@ impl<T: Real> Engine for CpuEngine<T> {
         for s in pair_sums {
             ps.contacts += s.contacts;
             ps.clamped += s.clamped;
+            ps.regimes.add(s.regimes);
             ps.elastic += s.elastic;
             ps.force += s.force;
             ps.max_overlap = max_by_first(ps.max_overlap, s.max_overlap);
@@ -768,6 +778,8 @@ impl<T: Real> Engine for CpuEngine<T> {
             contacts: ps.contacts,
             wall_contacts: gs.wall_contacts,
             clamped: ps.clamped,
+            sliding: ps.regimes.sliding + self.wall_regimes.sliding,
+            rolling: ps.regimes.rolling + self.wall_regimes.rolling,
             coordination: 2.0 * ps.contacts as f64 / n,
             max_overlap,
             max_overlap_grain,
@@ -796,7 +808,7 @@ impl<T: Real> Engine for CpuEngine<T> {
                     .filter_map(|k| {
                         let (h, _) = self.pair_overlap(k);
                         (h > T::ZERO || self.out[k].f_c != T::ZERO).then(|| {
-                            let spring = if self.slots.layout.tangential { self.slots.load(&self.hist[k * self.slots.stride..]).tangential } else { Vec3::ZERO };
+                            let springs = self.slots.load(&self.hist[k * self.slots.stride..]);
                             ContactRecord {
                                 i: self.id[self.pairs.owner[k] as usize],
                                 j: self.id[self.pairs.partner[k] as usize],
@@ -804,7 +816,8 @@ impl<T: Real> Engine for CpuEngine<T> {
                                 normal_force: (self.out[k].f_n + self.out[k].f_c).f64(),
                                 force: self.out[k].f_i.f64(),
                                 force_j: self.out[k].f_j.f64(),
-                                tangential_spring: spring.f64(),
+                                tangential_spring: springs.tangential.f64(),
+                                rolling_spring: springs.rolling.f64(),
                             }
                         })
                     })
@@ -925,7 +938,14 @@ impl<T: Real> Engine for CpuEngine<T> {
         }
         s.put_reals("hist", self.hist.iter().map(|x| x.f64()));
         s.put_reals("liquid", self.liquid.iter().map(|x| x.f64()));
-        s.put_reals("out", self.out.iter().flat_map(|o| [v3(&o.f_i), v3(&o.f_j), v3(&o.t_i), v3(&o.t_j), [o.f_n.f64(), if o.clamped { 1.0 } else { 0.0 }, o.f_c.f64()]].concat()));
+        s.put_reals(
+            "out",
+            self.out.iter().flat_map(|o| {
+                let mut r = [v3(&o.f_i), v3(&o.f_j), v3(&o.t_i), v3(&o.t_j), [o.f_n.f64(), if o.clamped { 1.0 } else { 0.0 }, o.f_c.f64()]].concat();
+                r.push(o.regime as u8 as f64);
+                r
+            }),
+        );
         s.put_reals("clock", [self.since_eval.f64(), self.time, self.external_work]);
         s.put_ints("counters", [self.step, self.rebuilds, self.forces_valid as u64]);
         Some(s)
@@ -988,9 +1008,9 @@ impl<T: Real> Engine for CpuEngine<T> {
         self.hist = s.reals("hist", n_pairs * self.slots.stride)?.iter().map(|&x| T::of(x)).collect();
         self.liquid = s.reals("liquid", self.liquid.len())?.iter().map(|&x| T::of(x)).collect();
         self.out = s
-            .reals("out", 15 * n_pairs)?
-            .chunks_exact(15)
-            .map(|c| ContactForce { f_i: v3(&c[0..3]), f_j: v3(&c[3..6]), t_i: v3(&c[6..9]), t_j: v3(&c[9..12]), f_n: T::of(c[12]), clamped: c[13] != 0.0, f_c: T::of(c[14]) })
+            .reals("out", 16 * n_pairs)?
+            .chunks_exact(16)
+            .map(|c| ContactForce { f_i: v3(&c[0..3]), f_j: v3(&c[3..6]), t_i: v3(&c[6..9]), t_j: v3(&c[9..12]), f_n: T::of(c[12]), clamped: c[13] != 0.0, f_c: T::of(c[14]), regime: Regime::from_code(c[15] as u8) })
             .collect();
         let clock = s.reals("clock", 3)?;
         (self.since_eval, self.time, self.external_work) = (T::of(clock[0]), clock[1], clock[2]);

@@ -45,6 +45,8 @@ pub struct HistorySlots {
     pub layout: HistoryLayout,
     /// Offset of the tangential spring.
     pub tangential: usize,
+    /// Offset of the sliding flag.
+    pub sliding: usize,
     /// Offset of the rolling spring.
     pub rolling: usize,
     /// Offset of the bridge volume.
@@ -54,13 +56,14 @@ pub struct HistorySlots {
 }
 
 impl HistorySlots {
-    /// Packs the blocks a layout uses, in slot order (tangential, rolling, bridge).
+    /// Packs the blocks a layout uses, in slot order (tangential, sliding, rolling, bridge).
     pub fn new(layout: HistoryLayout) -> Self {
         let tangential = 0;
-        let rolling = if layout.tangential { 3 } else { 0 };
+        let sliding = if layout.tangential { 3 } else { 0 };
+        let rolling = sliding + if layout.sliding { 1 } else { 0 };
         let bridge = rolling + if layout.rolling { 3 } else { 0 };
         let stride = bridge + if layout.bridge { 1 } else { 0 };
-        HistorySlots { layout, tangential, rolling, bridge, stride }
+        HistorySlots { layout, tangential, sliding, rolling, bridge, stride }
     }
 
     /// Forgets the springs of a contact that has opened, keeping its liquid bridge.
@@ -69,6 +72,9 @@ impl HistorySlots {
         // Fixed-size stores per block: a `fill` of run-time length becomes a call to memset.
         if self.layout.tangential {
             s[self.tangential..self.tangential + 3].copy_from_slice(&[T::ZERO; 3]);
+        }
+        if self.layout.sliding {
+            s[self.sliding] = T::ZERO;
         }
         if self.layout.rolling {
             s[self.rolling..self.rolling + 3].copy_from_slice(&[T::ZERO; 3]);
@@ -81,6 +87,7 @@ impl HistorySlots {
         let v = |o: usize| Vec3::new(s[o], s[o + 1], s[o + 2]);
         History {
             tangential: if self.layout.tangential { v(self.tangential) } else { Vec3::ZERO },
+            sliding: self.layout.sliding && s[self.sliding] != T::ZERO,
             rolling: if self.layout.rolling { v(self.rolling) } else { Vec3::ZERO },
             bridge: if self.layout.bridge { s[self.bridge] } else { T::ZERO },
         }
@@ -89,6 +96,9 @@ impl HistorySlots {
     /// Writes one contact's history.
     #[inline(always)]
     pub fn store<T: Real>(&self, h: &History<T>, s: &mut [T]) {
+        if self.layout.sliding {
+            s[self.sliding] = if h.sliding { T::ONE } else { T::ZERO };
+        }
         let mut put = |o: usize, v: Vec3<T>| {
             s[o] = v.x;
             s[o + 1] = v.y;

@@ -4,7 +4,7 @@
 use super::pair_force::ForceContext;
 use super::state::{Body, Load, Props};
 use crate::model::{contact_force, normal_damping, normal_stiffness, Bodies, Geometry, Kinematics};
-use crate::engine::WallContactRecord;
+use crate::engine::{RegimeCounts, WallContactRecord};
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
 
@@ -21,8 +21,8 @@ pub struct WallState<T> {
 
 /// `wall_contacts` for grain `i`. `hist` holds the grain's history blocks, one per wall;
 /// the force each wall receives is added to `reaction[w]`, its contact count to `count[w]`,
-/// and the contact's normal tangent stiffness (N/m) and damping coefficient (N s/m) to
-/// `response[w]`. Returns the load on the grain.
+/// the contact's normal tangent stiffness (N/m) and damping coefficient (N s/m) to
+/// `response[w]`, and its tangential regime to `regimes`. Returns the load on the grain.
 #[inline(always)]
 pub fn wall_contacts<T: Real>(
     b: &Body<T>,
@@ -33,6 +33,7 @@ pub fn wall_contacts<T: Real>(
     reaction: &mut [Vec3<T>],
     count: &mut [u64],
     response: &mut [(T, T)],
+    regimes: &mut RegimeCounts,
 ) -> Load<T> {
     let mut load = Load::default();
     let stride = ctx.slots.stride;
@@ -54,6 +55,7 @@ pub fn wall_contacts<T: Real>(
         load.torque += f.t_i;
         reaction[w] -= f.f_i;
         count[w] += 1;
+        regimes.count(f.regime);
         response[w].0 += normal_stiffness(&ctx.model.normal, c, &geo);
         response[w].1 += normal_damping(&ctx.model.damping, &ctx.model.normal, c, &geo);
     }
@@ -64,16 +66,16 @@ super::simd::dispatch! {
     /// `wall_contacts` for grains `first..first + loads.len()`; `hist` holds their history
     /// blocks (empty when the model keeps none); the walls' sums accumulate as in
     /// [`wall_contacts`].
-    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, reaction: &mut [Vec3<T>], count: &mut [u64], response: &mut [(T, T)]) => wall_block_portable
+    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, reaction: &mut [Vec3<T>], count: &mut [u64], response: &mut [(T, T)], regimes: &mut RegimeCounts) => wall_block_portable
 }
 
 /// [`wall_block`] for whatever instruction set the caller is compiled for.
 #[inline(always)]
-fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, reaction: &mut [Vec3<T>], count: &mut [u64], response: &mut [(T, T)]) {
+fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, reaction: &mut [Vec3<T>], count: &mut [u64], response: &mut [(T, T)], regimes: &mut RegimeCounts) {
     let per_grain = walls.len() * ctx.slots.stride;
     for (m, l) in loads.iter_mut().enumerate() {
         let i = first + m;
-        *l = wall_contacts(&body[i], &prop[i], walls, ctx, &mut hist[m * per_grain..(m + 1) * per_grain], reaction, count, response);
+        *l = wall_contacts(&body[i], &prop[i], walls, ctx, &mut hist[m * per_grain..(m + 1) * per_grain], reaction, count, response, regimes);
     }
 }
 

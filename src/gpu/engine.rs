@@ -9,7 +9,7 @@ use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, 
 use crate::cpu::OVV_XI;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::kernels::{Access, KERNELS};
-use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
 use crate::scene::{Integrator, Scene, WallShape};
 use std::collections::HashMap;
 use wgpu::util::DeviceExt;
@@ -167,11 +167,10 @@ impl GpuEngine {
         };
         match model.tangential {
             TangentialLaw::None => {}
-            TangentialLaw::Oquendo { v_slip, v_roll, damping_ratio, stiffness: s } => {
-                params.v_slip = v_slip as f32;
-                params.v_roll = v_roll as f32;
-                params.damping_ratio = damping_ratio as f32;
-                params.kt_ratio = stiffness(s);
+            TangentialLaw::Oquendo(l) => {
+                params.static_damping = l.static_damping as f32;
+                params.rolling_as_written = (l.rolling_friction == RollingFriction::AsWritten) as u32;
+                params.kt_ratio = stiffness(l.stiffness);
             }
             TangentialLaw::Mindlin { damping_ratio, stiffness: s } => {
                 params.damping_ratio = damping_ratio as f32;
@@ -820,6 +819,8 @@ impl Engine for GpuEngine {
             contacts,
             wall_contacts,
             clamped: p(1).round() as u64,
+            sliding: (p(4) + g(13)).round() as u64,
+            rolling: (p(5) + g(14)).round() as u64,
             coordination: 2.0 * contacts as f64 / n,
             max_overlap,
             max_overlap_grain: if max_overlap_grain == NONE { 0 } else { max_overlap_grain },
@@ -877,6 +878,7 @@ impl Engine for GpuEngine {
                         force: xyz(&fi[k]),
                         force_j: xyz(&fj[k]),
                         tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
+                        rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + self.history.tangential as usize]) } else { [0.0; 3] },
                     })
                 })
                 .collect()

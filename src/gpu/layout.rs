@@ -40,10 +40,10 @@ pub struct Params {
     pub k_n: f32,
     /// Viscous damping (N s/m).
     pub c_n: f32,
-    /// Sliding threshold (m/s).
-    pub v_slip: f32,
-    /// Rolling threshold (m/s).
-    pub v_roll: f32,
+    /// Padding.
+    pub _pad0: f32,
+    /// Padding.
+    pub _pad1: f32,
     /// k_t over the normal secant stiffness; <= 0 selects Mindlin.
     pub kt_ratio: f32,
     /// Hertz-Mindlin tangential damping ratio.
@@ -54,10 +54,10 @@ pub struct Params {
     pub gamma_r: f32,
     /// Rolling friction.
     pub mu_r: f32,
-    /// Padding.
-    pub _pad1: f32,
-    /// Padding.
-    pub _pad2: f32,
+    /// Seed 000's static and rolling spring damping, fraction of critical (-).
+    pub static_damping: f32,
+    /// Seed 000's rolling friction: 0 a torque pair, 1 eqs. 8-9 on each grain as written.
+    pub rolling_as_written: u32,
 }
 
 /// What changes between dispatches of one step (WGSL `Phase`, uniform with dynamic offset).
@@ -159,7 +159,7 @@ pub const WG: u32 = 64;
 /// Walls a GPU scene may have (WGSL `MAX_WALLS`).
 pub const MAX_WALLS: usize = 8;
 /// Reals per statistics row (WGSL `STAT_ROW`).
-pub const STAT_ROW: usize = 16;
+pub const STAT_ROW: usize = 20;
 /// Largest element count the two-level scan handles: 2048 blocks of 2048.
 pub const MAX_SCAN: u64 = 2048 * 2048;
 /// Indirect-argument slots (WGSL `ARGS_*`).

@@ -71,18 +71,11 @@ pub enum TangentialStiffness<T> {
 pub enum TangentialLaw<T> {
     /// Frictionless.
     None,
-    /// Seed 000's three regimes: sliding (`|v_t| > v_slip`, `mu_k`), rolling
-    /// (`|v_r| > v_roll`, `theta_r`), static (history spring up to `mu_s`, slips at `mu_k`).
-    Oquendo {
-        /// Sliding threshold on the contact-point tangential speed (m/s).
-        v_slip: T,
-        /// Rolling threshold on the objective rolling speed (m/s).
-        v_roll: T,
-        /// Static spring damping as a fraction of the normal damping coefficient.
-        damping_ratio: T,
-        /// Static spring stiffness.
-        stiffness: TangentialStiffness<T>,
-    },
+    /// Seed 000's three regimes: static (history spring up to `mu_s`), sliding (at `mu_k`
+    /// once the spring's Coulomb test fails, until it unloads), rolling (eqs. 8-9's friction
+    /// once a rolling spring reaches `tan(theta_r) |F_n|`, when not sliding); see
+    /// [`oquendo_tangential`].
+    Oquendo(OquendoLaw<T>),
     /// Standard Hertz-Mindlin with history and one Coulomb `mu` (the materials' `mu_s`), as
     /// LAMMPS `tangential mindlin` / LIGGGHTS `tangential history`.
     Mindlin {
@@ -92,6 +85,39 @@ pub enum TangentialLaw<T> {
         /// Spring stiffness.
         stiffness: TangentialStiffness<T>,
     },
+}
+
+/// The parameters of seed 000's tangential regimes (see [`oquendo_tangential`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OquendoLaw<T> {
+    /// Damping of the static and rolling springs as a fraction of their critical damping (-).
+    pub static_damping: T,
+    /// Static spring stiffness (the rolling spring's too).
+    pub stiffness: TangentialStiffness<T>,
+    /// How rolling friction acts.
+    pub rolling_friction: RollingFriction,
+}
+
+/// How seed 000's rolling friction (eqs. 8-9) is applied (see [`oquendo_tangential`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RollingFriction {
+    /// A torque pair of magnitude `R'_eff |F_n| tan(theta_r)` when rolling: eqs. 8-9 for a
+    /// grain rolling on a wall, with the static spring supplying eq. 8's force;
+    /// momentum-conserving.
+    #[default]
+    Torque,
+    /// Eqs. 8-9 on each grain as the paper writes them (force and torque per grain).
+    AsWritten,
+}
+
+impl RollingFriction {
+    /// Name as written in scenes.
+    pub fn name(self) -> &'static str {
+        match self {
+            RollingFriction::Torque => "torque",
+            RollingFriction::AsWritten => "as_written",
+        }
+    }
 }
 
 /// Rolling-resistance law (the momentum-conserving alternative to seed 000's rolling regime).
@@ -158,19 +184,23 @@ impl<T: Real> ContactModel<T> {
     pub fn history_layout(&self) -> HistoryLayout {
         HistoryLayout {
             tangential: !matches!(self.tangential, TangentialLaw::None),
-            rolling: !matches!(self.rolling, RollingLaw::None),
+            sliding: matches!(self.tangential, TangentialLaw::Oquendo(_)),
+            rolling: !matches!(self.rolling, RollingLaw::None) || matches!(self.tangential, TangentialLaw::Oquendo(_)),
             bridge: !matches!(self.cohesion, CohesionLaw::None),
         }
     }
 }
 
-/// Which per-contact history blocks exist. Each block is one world-frame 3-vector (m) per
-/// contact; a block a model does not use is not allocated.
+/// Which per-contact history blocks exist: world-frame 3-vectors (m) and single reals; a
+/// block a model does not use is not allocated.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct HistoryLayout {
     /// Accumulated tangential spring displacement `xi` (m).
     pub tangential: bool,
-    /// Accumulated rolling displacement `psi` (m).
+    /// Whether the contact is sliding (one real, 0 or 1): friction with two coefficients.
+    pub sliding: bool,
+    /// Accumulated rolling displacement `psi` (m): the rolling law's, or seed 000's rolling
+    /// spring.
     pub rolling: bool,
     /// Liquid bridge volume `V_b` (m^3), one real.
     pub bridge: bool,
@@ -181,6 +211,8 @@ pub struct HistoryLayout {
 pub struct History<T> {
     /// Tangential spring displacement `xi` (m).
     pub tangential: Vec3<T>,
+    /// Sliding at the last evaluation (seed 000's regimes).
+    pub sliding: bool,
     /// Rolling spring displacement `psi` (m).
     pub rolling: Vec3<T>,
     /// Liquid bridge volume (m^3); 0 without a bridge.
@@ -279,6 +311,32 @@ pub struct ContactForce<T> {
     pub f_c: T,
     /// True when the no-pull clamp removed an attractive damping force.
     pub clamped: bool,
+    /// The tangential regime.
+    pub regime: Regime,
+}
+
+/// The tangential regime of a contact at one force evaluation.
+#[repr(u8)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Regime {
+    /// Sticking (or frictionless): the spring holds below its Coulomb limit.
+    #[default]
+    Static = 0,
+    /// On the Coulomb limit.
+    Sliding = 1,
+    /// Seed 000's rolling friction at full strength.
+    Rolling = 2,
+}
+
+impl Regime {
+    /// The regime whose `as u8` code is `code` (unknown codes read as static).
+    pub fn from_code(code: u8) -> Self {
+        match code {
+            1 => Regime::Sliding,
+            2 => Regime::Rolling,
+            _ => Regime::Static,
+        }
+    }
 }
 
 /// Composes the sub-models for one touching contact (`geo.h > 0`), updating its history.
@@ -304,22 +362,24 @@ pub fn contact_force<T: Real>(
 
     match model.tangential {
         TangentialLaw::None => {}
-        TangentialLaw::Oquendo { v_slip, v_roll, damping_ratio, stiffness } => {
-            let k_t = tangential_stiffness(&stiffness, c, geo, k_secant);
-            let t = oquendo_tangential(c, geo, kin, bodies, f_n, k_t, v_slip, v_roll, eta_n * damping_ratio, &mut hist.tangential, elapsed);
+        TangentialLaw::Oquendo(law) => {
+            let k_t = tangential_stiffness(&law.stiffness, c, geo, k_secant);
+            let t = oquendo_tangential(c, geo, kin, bodies, f_n, k_t, &law, hist, elapsed);
             out.f_i += t.f_i;
             out.f_j += t.f_j;
             out.t_i += t.t_i;
             out.t_j += t.t_j;
+            out.regime = t.regime;
         }
         TangentialLaw::Mindlin { damping_ratio, stiffness } => {
             let k_t = tangential_stiffness(&stiffness, c, geo, k_secant);
-            let f_t = mindlin_tangential(c.mu_s, geo, kin, f_n, k_t, eta_n * damping_ratio, &mut hist.tangential, elapsed);
+            let (f_t, slid) = mindlin_tangential(c.mu_s, geo, kin, f_n, k_t, eta_n * damping_ratio, &mut hist.tangential, elapsed);
             out.f_i += f_t;
             out.f_j -= f_t;
             // Lever arms to the contact point: -R'_i n on i, +R'_j n on j (force -f_t).
             out.t_i -= geo.n.cross(f_t) * geo.rp_i;
             out.t_j -= geo.n.cross(f_t) * geo.rp_j;
+            out.regime = if slid { Regime::Sliding } else { Regime::Static };
         }
     }
     if let RollingLaw::Sds { k_r, gamma_r, mu_r } = model.rolling {
@@ -381,9 +441,7 @@ impl ContactModel<f64> {
             },
             tangential: match self.tangential {
                 TangentialLaw::None => TangentialLaw::None,
-                TangentialLaw::Oquendo { v_slip, v_roll, damping_ratio, stiffness: s } => {
-                    TangentialLaw::Oquendo { v_slip: u(v_slip), v_roll: u(v_roll), damping_ratio: u(damping_ratio), stiffness: stiffness(s) }
-                }
+                TangentialLaw::Oquendo(l) => TangentialLaw::Oquendo(OquendoLaw { static_damping: u(l.static_damping), stiffness: stiffness(l.stiffness), rolling_friction: l.rolling_friction }),
                 TangentialLaw::Mindlin { damping_ratio, stiffness: s } => TangentialLaw::Mindlin { damping_ratio: u(damping_ratio), stiffness: stiffness(s) },
             },
             rolling: match self.rolling {
@@ -416,9 +474,7 @@ impl ContactModel<f64> {
         };
         let tangential = match self.tangential {
             TangentialLaw::None => "none".to_string(),
-            TangentialLaw::Oquendo { v_slip, v_roll, damping_ratio, stiffness } => {
-                format!("oquendo(v_slip={v_slip:e}, v_roll={v_roll:e}, damping_ratio={damping_ratio}, {})", stiff(stiffness))
-            }
+            TangentialLaw::Oquendo(l) => format!("oquendo(static_damping={}, rolling_friction={}, {})", l.static_damping, l.rolling_friction.name(), stiff(l.stiffness)),
             TangentialLaw::Mindlin { damping_ratio, stiffness } => format!("mindlin(damping_ratio={damping_ratio}, {})", stiff(stiffness)),
         };
         let rolling = match self.rolling {
@@ -521,32 +577,71 @@ mod tests {
         let (c, g) = pair();
         let k = Kinematics::default();
         let mut xi = Vec3::new(0.0, 1.0e-3, 0.0); // far beyond the Coulomb limit
-        let f = mindlin_tangential(c.mu_s, &g, &k, 2.0e-3, 1.0e3, 0.0, &mut xi, 0.0);
-        assert!(close(f.norm(), 0.5 * 2.0e-3));
+        let (f, slid) = mindlin_tangential(c.mu_s, &g, &k, 2.0e-3, 1.0e3, 0.0, &mut xi, 0.0);
+        assert!(close(f.norm(), 0.5 * 2.0e-3) && slid);
         assert!(f.y < 0.0, "opposes the spring");
         assert!(close(xi.norm() * 1.0e3, 0.5 * 2.0e-3));
     }
 
     #[test]
-    fn oquendo_regimes_are_chosen_by_the_slip_and_rolling_speeds() {
+    fn oquendo_slides_on_the_springs_coulomb_test_and_sticks_when_it_unloads() {
         let (c, g) = pair();
         let b = Bodies { m_i: 1.3875e-6, inertia_i: 0.4 * 1.3875e-6 * 2.5e-7, m_j: 1.3875e-6, inertia_j: 0.4 * 1.3875e-6 * 2.5e-7, j_is_wall: false };
-        let f_n = 1.0e-3;
-        // Sliding: v_t = 0.01 m/s along y > v_slip: F = -mu_k F_n t on i, opposite on j.
-        let k = Kinematics { v_i: Vec3::new(0.0, 0.01, 0.0), ..Default::default() };
-        let mut xi = Vec3::ZERO;
-        let o = oquendo_tangential(&c, &g, &k, &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, 0.0, &mut xi, 1.0e-6);
-        assert!(close(o.f_i.y, -0.4 * f_n) && o.f_j == -o.f_i);
-        // Static: no relative motion, the spring gives -k_t xi.
-        let mut xi = Vec3::new(0.0, 1.0e-7, 0.0);
-        let o = oquendo_tangential(&c, &g, &Kinematics::default(), &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, 0.0, &mut xi, 1.0e-6);
-        assert!(close(o.f_i.y, -1.0e-4));
-        // Rolling: counter-spinning grains, no slip at the contact, v_r > v_roll: eq. 8 on both.
-        let k = Kinematics { w_i: Vec3::new(0.0, 0.0, 10.0), w_j: Vec3::new(0.0, 0.0, -10.0), ..Default::default() };
-        let mut xi = Vec3::ZERO;
-        let o = oquendo_tangential(&c, &g, &k, &b, f_n, 1.0e3, 1.0e-4, 1.0e-4, 0.0, &mut xi, 1.0e-6);
+        let law = OquendoLaw { static_damping: 0.0, stiffness: TangentialStiffness::Mindlin, rolling_friction: RollingFriction::Torque };
+        let (f_n, k_t) = (1.0e-3, 1.0e3);
+        let spring = |y: f64| History { tangential: Vec3::new(0.0, y, 0.0), ..Default::default() };
+        // Static: a spring below mu_s F_n gives -k_t xi.
+        let mut h = spring(4.0e-7);
+        let o = oquendo_tangential(&c, &g, &Kinematics::default(), &b, f_n, k_t, &law, &mut h, 1.0e-6);
+        assert!(close(o.f_i.y, -4.0e-4) && !h.sliding && o.regime == Regime::Static);
+        // Past mu_s F_n = 5e-4 N the contact slides at mu_k F_n, the spring on the cap.
+        let mut h = spring(6.0e-7);
+        let o = oquendo_tangential(&c, &g, &Kinematics::default(), &b, f_n, k_t, &law, &mut h, 1.0e-6);
+        assert!(close(o.f_i.y, -0.4 * f_n) && o.f_j == -o.f_i && h.sliding && o.regime == Regime::Sliding);
+        assert!(close(h.tangential.y * k_t, 0.4 * f_n));
+        // Still slipping along the spring: stays on the mu_k cap (not mu_s).
+        let slip = Kinematics { v_i: Vec3::new(0.0, 0.01, 0.0), ..Default::default() };
+        let o = oquendo_tangential(&c, &g, &slip, &b, f_n, k_t, &law, &mut h, 1.0e-6);
+        assert!(close(o.f_i.y, -0.4 * f_n) && h.sliding);
+        // The slip reverses: the spring unloads below mu_k F_n and the contact sticks.
+        let back = Kinematics { v_i: Vec3::new(0.0, -0.01, 0.0), ..Default::default() };
+        let o = oquendo_tangential(&c, &g, &back, &b, f_n, k_t, &law, &mut h, 1.0e-6);
+        assert!(close(o.f_i.y, -(0.4 * f_n - k_t * 0.01 * 1.0e-6)) && !h.sliding && o.regime == Regime::Static);
+    }
+
+    #[test]
+    fn oquendo_rolling_friction_holds_below_tan_theta_f_n_and_is_eqs_8_9_on_the_cap() {
+        let (c, g) = pair();
+        let (m, inertia) = (1.3875e-6, 0.4 * 1.3875e-6 * 2.5e-7);
+        let b = Bodies { m_i: m, inertia_i: inertia, m_j: m, inertia_j: inertia, j_is_wall: false };
+        let (f_n, k_t) = (1.0e-3, 1.0e3);
+        let cap = f_n * c.tan_roll;
         let rp = g.rp_i;
-        let each = f_n * c.tan_roll / (1.0 + b.inertia_i / (b.m_i * rp * rp));
-        assert!(close(o.f_i.norm(), each) && o.f_i == o.f_j, "same force on both grains");
+        // Counter-spinning grains, no slip at the contact: v_r = R'_eff 20 rad/s along +y.
+        let k = Kinematics { w_i: Vec3::new(0.0, 0.0, 10.0), w_j: Vec3::new(0.0, 0.0, -10.0), ..Default::default() };
+        let v_r = 20.0 * g.rp_eff;
+        // A rolling spring below the cap holds: torque R'_eff k_t psi, no force.
+        let law = OquendoLaw { static_damping: 0.0, stiffness: TangentialStiffness::Mindlin, rolling_friction: RollingFriction::Torque };
+        let mut h = History { rolling: Vec3::new(0.0, -0.5 * cap / k_t, 0.0), ..Default::default() };
+        let o = oquendo_tangential(&c, &g, &Kinematics::default(), &b, f_n, k_t, &law, &mut h, 1.0e-6);
+        assert!(close(o.t_i.norm(), g.rp_eff * 0.5 * cap) && o.t_j == -o.t_i && o.f_i == Vec3::ZERO && o.regime == Regime::Static);
+        // Rolling for long enough loads it to the cap: the torque pair R'_eff tan(theta_r) F_n.
+        let mut h = History::default();
+        let o = oquendo_tangential(&c, &g, &k, &b, f_n, k_t, &law, &mut h, 1.0);
+        assert!(close(o.t_i.norm(), g.rp_eff * cap) && o.t_j == -o.t_i && o.regime == Regime::Rolling, "torque {:?}", o.t_i);
+        assert!(o.t_i.z < 0.0, "opposes w_i - w_j");
+        assert!(close(h.rolling.norm() * k_t, cap) && h.rolling.y > 0.0, "the spring on the cap, along v_r = {v_r:e} y");
+        // As written: eq. 8 on both grains, same direction, and eq. 9's torque on each.
+        let written = OquendoLaw { rolling_friction: RollingFriction::AsWritten, ..law };
+        let mut h = History::default();
+        let o = oquendo_tangential(&c, &g, &k, &b, f_n, k_t, &written, &mut h, 1.0);
+        let each = cap / (1.0 + inertia / (m * rp * rp));
+        let torque = rp * cap / (1.0 + m * rp * rp / inertia);
+        assert!(close(o.f_i.y, -each), "eq. 8 against v_r: {:?}", o.f_i);
+        assert!(o.f_i.y == o.f_j.y && close(o.t_i.norm(), torque) && close(o.t_j.norm(), torque), "eqs. 8-9 on both grains");
+        // A sliding contact drops its rolling spring.
+        let mut h = History { tangential: Vec3::new(0.0, 0.0, 1.0), rolling: Vec3::new(0.0, 1.0e-9, 0.0), ..Default::default() };
+        let o = oquendo_tangential(&c, &g, &k, &b, f_n, k_t, &law, &mut h, 0.0);
+        assert!(o.regime == Regime::Sliding && h.rolling == Vec3::ZERO);
     }
 }

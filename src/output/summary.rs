@@ -96,11 +96,20 @@ impl Summary {
 
     /// The compression points as CSV (the input of `grains fit bauer`).
     pub fn compression_csv(&self) -> String {
-        let mut s = String::from("target_pressure_Pa,pressure_Pa,piston_z_m,void_ratio,stress_zz_Pa,coordination,kinetic_energy_J,settled\n");
+        let mut s = String::from("target_pressure_Pa,pressure_Pa,piston_z_m,void_ratio,stress_zz_Pa,stress_trace_Pa,lateral_ratio,coordination,kinetic_energy_J,settled\n");
         for c in &self.compression {
             s.push_str(&format!(
-                "{:e},{:e},{:e},{},{:e},{},{:e},{}\n",
-                c.target_pressure, c.pressure, c.piston_z, c.void_ratio, c.stress_zz, c.coordination, c.kinetic_energy, c.settled
+                "{:e},{:e},{:e},{},{:e},{:e},{},{},{:e},{}\n",
+                c.target_pressure,
+                c.pressure,
+                c.piston_z,
+                c.void_ratio,
+                c.stress_zz,
+                c.stress_trace(),
+                c.lateral_ratio(),
+                c.coordination,
+                c.kinetic_energy,
+                c.settled
             ));
         }
         s
@@ -117,13 +126,13 @@ impl Summary {
                 Some(false) => " NOT settled (duration ran out)",
                 None => "",
             };
-            let _ = writeln!(s, "  stage {:<12} {:>6} {:>9} steps  t = {:.4e} s  KE/grain = {:.3e} J  unbalanced = {:.3e}  Z = {:.3}  max overlap = {:.3e}{settled}",
-                st.name, st.kind, st.steps, st.time_end, st.ke_per_grain, st.unbalanced_force, st.stats.coordination, st.stats.max_overlap);
+            let _ = writeln!(s, "  stage {:<12} {:>6} {:>9} steps  t = {:.4e} s  KE/grain = {:.3e} J  unbalanced = {:.3e}  Z = {:.3}  sliding = {:.1}%  max overlap = {:.3e}{settled}",
+                st.name, st.kind, st.steps, st.time_end, st.ke_per_grain, st.unbalanced_force, st.stats.coordination, 100.0 * st.stats.sliding_fraction(), st.stats.max_overlap);
         }
         if !self.compression.is_empty() {
-            let _ = writeln!(s, "  oedometer: p (kPa), e, sigma_zz from particle stresses (kPa), Z");
+            let _ = writeln!(s, "  oedometer: p (kPa), e, sigma_zz from particle stresses (kPa), K0 = lateral / vertical stress, Z");
             for c in &self.compression {
-                let _ = writeln!(s, "    {:>9.2} {:.4} {:>9.2} {:.3}{}", c.pressure / 1e3, c.void_ratio, c.stress_zz / 1e3, c.coordination, if c.settled { "" } else { "  (not settled)" });
+                let _ = writeln!(s, "    {:>9.2} {:.4} {:>9.2} {:.3} {:.3}{}", c.pressure / 1e3, c.void_ratio, c.stress_zz / 1e3, c.lateral_ratio(), c.coordination, if c.settled { "" } else { "  (not settled)" });
             }
         }
         match (&self.bauer, &self.bauer_error) {

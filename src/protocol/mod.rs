@@ -70,6 +70,17 @@ pub struct CompressionPoint {
     pub settled: bool,
 }
 
+impl CompressionPoint {
+    /// Trace of the macroscopic stress, `3 p_mean` (Pa, compression positive).
+    pub fn stress_trace(&self) -> f64 {
+        self.stress[0][0] + self.stress[1][1] + self.stress[2][2]
+    }
+    /// Lateral over vertical stress, `(sigma_xx + sigma_yy) / (2 sigma_zz)`: K0 at rest (-).
+    pub fn lateral_ratio(&self) -> f64 {
+        0.5 * (self.stress[0][0] + self.stress[1][1]) / self.stress[2][2]
+    }
+}
+
 /// Receives what the host loop produces as it goes.
 pub trait Recorder {
     /// A statistics read.
@@ -179,7 +190,11 @@ fn run_stage(
         };
         // Translational energy: a rattler spinning in its cage (nothing to brake it on a
         // frictionless wall) says nothing about whether the packing stands.
-        if settles && stats.ke_translational / n < stage.ke_per_grain && stats.unbalanced_force < stage.unbalanced_force && pressure_reached {
+        let still = match stage.ke_ratio {
+            Some(r) => stats.ke_translational < r * stats.elastic_energy,
+            None => stats.ke_translational / n < stage.ke_per_grain,
+        };
+        if settles && still && stats.unbalanced_force < stage.unbalanced_force && pressure_reached {
             settled = true;
             break;
         }

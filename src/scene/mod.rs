@@ -7,7 +7,7 @@ pub mod schema;
 pub use error::SceneError;
 
 use crate::model::{
-    CohesionLaw, ContactModel, DampingLaw, MaterialConstants, NormalLaw, RollingLaw, TangentialLaw,
+    CohesionLaw, ContactModel, DampingLaw, MaterialConstants, NormalLaw, OquendoLaw, RollingFriction, RollingLaw, TangentialLaw,
     TangentialStiffness, TwistingLaw,
 };
 use crate::timestep::{self, TimeStep};
@@ -155,6 +155,7 @@ impl Integrator {
             Integrator::OptimizedVerlet => "optimized_verlet",
         }
     }
+
 }
 
 /// What a stage waits for.
@@ -179,6 +180,9 @@ pub struct Stage {
     pub duration: f64,
     /// Settled when the kinetic energy per grain (J) is below this ...
     pub ke_per_grain: f64,
+    /// ... or, when set, when the translational kinetic energy over the elastic energy of
+    /// the contacts is below this (-), in place of `ke_per_grain` ...
+    pub ke_ratio: Option<f64>,
     /// ... and the unbalanced-force ratio is below this (-).
     pub unbalanced_force: f64,
     /// Piston target pressure during the stage (Pa), if it changes.
@@ -266,8 +270,8 @@ pub struct BridgeLimits {
     pub reach: f64,
 }
 
-/// Default sliding and rolling thresholds of seed 000's tangential regimes (m/s).
-pub const DEFAULT_V_THRESHOLD: f64 = 1e-4;
+/// Default damping of seed 000's static spring, as a fraction of critical (-).
+pub const DEFAULT_STATIC_DAMPING: f64 = 0.3;
 /// Default tangential-to-normal stiffness ratio for the linear law (the classic 2/7).
 pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
 /// Default settle criterion on the unbalanced-force ratio.
@@ -808,23 +812,37 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
             (None, NormalLaw::Linear { .. }) => Ok(TangentialStiffness::RatioToNormal(DEFAULT_LINEAR_KT_RATIO)),
         }
     };
+    for (key, v, why) in [
+        ("v_slip", m.v_slip, "seed 000's contacts slide when their static spring fails its Coulomb test (mu_s), not above a speed"),
+        ("v_roll", m.v_roll, "seed 000's contacts roll when their rolling spring reaches the rolling friction, not above a speed"),
+    ] {
+        if let Some(v) = v {
+            return Err(c.invalid(format!("model.{key}"), v, format!("is no longer used: {why}"), format!("remove `{key}` (see the README's \"Seed 000's contact law\")")));
+        }
+    }
     let tangential_name = law(&m.tangential, "none");
     let tangential = match tangential_name.as_str() {
         "none" => {
-            for (k, set) in [("v_slip", m.v_slip.is_some()), ("v_roll", m.v_roll.is_some()), ("kt_ratio", m.kt_ratio.is_some()), ("tangential_damping_ratio", m.tangential_damping_ratio.is_some())] {
+            for (k, set) in [("static_damping", m.static_damping.is_some()), ("rolling_friction", m.rolling_friction.is_some()), ("kt_ratio", m.kt_ratio.is_some()), ("tangential_damping_ratio", m.tangential_damping_ratio.is_some())] {
                 unused(k, set, "tangential = \"none\"")?;
             }
             TangentialLaw::None
         }
-        "oquendo" => TangentialLaw::Oquendo {
-            v_slip: positive(c, "model.v_slip", m.v_slip.unwrap_or(DEFAULT_V_THRESHOLD), "give a small speed in m/s, e.g. 1e-4")?,
-            v_roll: positive(c, "model.v_roll", m.v_roll.unwrap_or(DEFAULT_V_THRESHOLD), "give a small speed in m/s, e.g. 1e-4")?,
-            damping_ratio: non_negative(c, "model.tangential_damping_ratio", m.tangential_damping_ratio.unwrap_or(0.0), "give a fraction such as 0.9")?,
-            stiffness: stiffness(m.kt_ratio)?,
-        },
+        "oquendo" => {
+            unused("tangential_damping_ratio", m.tangential_damping_ratio.is_some(), "tangential = \"oquendo\" (its static spring is damped by static_damping)")?;
+            TangentialLaw::Oquendo(OquendoLaw {
+                static_damping: non_negative(c, "model.static_damping", m.static_damping.unwrap_or(DEFAULT_STATIC_DAMPING), "give a fraction of critical damping such as 0.3")?,
+                stiffness: stiffness(m.kt_ratio)?,
+                rolling_friction: match m.rolling_friction.as_deref().unwrap_or("torque") {
+                    "torque" => RollingFriction::Torque,
+                    "as_written" => RollingFriction::AsWritten,
+                    other => return Err(c.invalid("model.rolling_friction", format!("\"{other}\""), "unknown rolling friction", "use \"torque\" (momentum-conserving) or \"as_written\" (eqs. 8-9 on each grain)")),
+                },
+            })
+        }
         "mindlin" => {
-            unused("v_slip", m.v_slip.is_some(), "tangential = \"mindlin\"")?;
-            unused("v_roll", m.v_roll.is_some(), "tangential = \"mindlin\"")?;
+            unused("static_damping", m.static_damping.is_some(), "tangential = \"mindlin\"")?;
+            unused("rolling_friction", m.rolling_friction.is_some(), "tangential = \"mindlin\"")?;
             for (i, mat) in materials.iter().enumerate() {
                 if mat.constants.mu_k != mat.constants.mu_s {
                     return Err(c.invalid(format!("material[{i}].mu_k"), mat.constants.mu_k, "the Hertz-Mindlin law has one friction coefficient (mu_s)", "remove mu_k or set it equal to mu_s"));
@@ -940,7 +958,7 @@ fn validate_stages(
             return Err(c.invalid(key("kind"), "\"fill\"", "deposition needs gravity", "set simulation.gravity or use kind = \"settle\""));
         }
         if kind == StageKind::Run {
-            for (k, set) in [("ke_per_grain", s.ke_per_grain.is_some()), ("unbalanced_force", s.unbalanced_force.is_some()), ("pressure_tolerance", s.pressure_tolerance.is_some())] {
+            for (k, set) in [("ke_per_grain", s.ke_per_grain.is_some()), ("ke_ratio", s.ke_ratio.is_some()), ("unbalanced_force", s.unbalanced_force.is_some()), ("pressure_tolerance", s.pressure_tolerance.is_some())] {
                 if set {
                     return Err(c.invalid(key(k), "(set)", "is a settle criterion; a \"run\" stage ends after its duration", format!("remove `{k}` or use kind = \"settle\"")));
                 }
@@ -953,9 +971,13 @@ fn validate_stages(
                 }
             }
         }
+        if s.ke_per_grain.is_some() && s.ke_ratio.is_some() {
+            return Err(c.invalid(key("ke_ratio"), "(set)", "replaces ke_per_grain, which is set too", "keep one of `ke_per_grain` (J per grain) and `ke_ratio` (kinetic over elastic energy)"));
+        }
+        let ke_ratio = s.ke_ratio.map(|r| positive(c, &key("ke_ratio"), r, "give a ratio such as 1e-4")).transpose()?;
         let ke_per_grain = match s.ke_per_grain {
             Some(v) => positive(c, &key("ke_per_grain"), v, "give an energy in J")?,
-            None if kind == StageKind::Run => 0.0,
+            None if kind == StageKind::Run || ke_ratio.is_some() => 0.0,
             None if g > 0.0 => {
                 let v = DEFAULT_SETTLE_SPEED_FRACTION * (g * d_mean).sqrt();
                 0.5 * m_mean * v * v
@@ -976,6 +998,7 @@ fn validate_stages(
             kind,
             duration,
             ke_per_grain,
+            ke_ratio,
             unbalanced_force,
             piston_pressure: s.piston_pressure.map(|p| non_negative(c, &key("piston_pressure"), p, "give the pressure in Pa")).transpose()?,
             pressure_tolerance,

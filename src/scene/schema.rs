@@ -260,15 +260,23 @@ pub struct ModelSpec {
     pub k_n: Option<f64>,
     /// Viscous coefficient c_n (N s/m), `damping = "viscous"`.
     pub c_n: Option<f64>,
-    /// Sliding threshold (m/s), `tangential = "oquendo"`. Default 1e-4.
+    /// No longer used (seed 000's contacts slide on their spring's Coulomb test); read only to
+    /// say so.
     pub v_slip: Option<f64>,
-    /// Rolling threshold (m/s), `tangential = "oquendo"`. Default 1e-4.
+    /// No longer used (seed 000's contacts roll on their rolling spring's limit); read only to
+    /// say so.
     pub v_roll: Option<f64>,
+    /// Damping of seed 000's static and rolling springs as a fraction of their critical
+    /// damping (-), `tangential = "oquendo"`. Default 0.3.
+    pub static_damping: Option<f64>,
+    /// How seed 000's rolling friction acts, `tangential = "oquendo"`: "torque" (default, a
+    /// momentum-conserving torque pair) or "as_written" (eqs. 8-9 on each grain).
+    pub rolling_friction: Option<String>,
     /// Tangential spring as a ratio of the normal secant stiffness (-). Default: Mindlin
     /// `8 G_eff sqrt(R_eff h)` for Hertz, 2/7 for linear.
     pub kt_ratio: Option<f64>,
     /// Tangential damping as a fraction of the normal damping coefficient (-): the dashpot of
-    /// the Hertz-Mindlin spring, or of seed 000's static-regime spring. Default 0.
+    /// the Hertz-Mindlin spring (LAMMPS' `x_gammat`). Default 0.
     pub tangential_damping_ratio: Option<f64>,
     /// Rolling stiffness k_r (N/m), `rolling = "sds"`.
     pub rolling_k: Option<f64>,
@@ -376,6 +384,10 @@ pub struct StageSpec {
     /// counts as settled (rattlers spinning in their cages do not count).
     /// Default: that of a grain of mean mass moving at 1e-2 sqrt(|g| d_mean) (1 mm/s for 1 mm grains).
     pub ke_per_grain: Option<f64>,
+    /// Settle criterion in place of `ke_per_grain`: translational kinetic energy over the
+    /// contacts' elastic energy (-), for loaded packings whose stiff contacts keep a little
+    /// vibration.
+    pub ke_ratio: Option<f64>,
     /// "fill"/"settle": unbalanced-force ratio (mean net force on a grain over mean contact
     /// force) below which the sample counts as settled. Default 0.01.
     pub unbalanced_force: Option<f64>,

@@ -49,3 +49,12 @@ pub fn gpu_engine(scene: &Scene) -> Option<grains::gpu::GpuEngine> {
     let gpu = gpu()?;
     Some(grains::gpu::GpuEngine::new(gpu, scene).unwrap_or_else(|e| panic!("{e}")))
 }
+
+/// `text` with each `(from, to)` replaced, failing loudly when a `from` is absent (so that a
+/// change to a shipped scene cannot silently leave a test on the wrong parameters).
+pub fn edit(text: &str, edits: &[(&str, &str)]) -> String {
+    edits.iter().fold(text.to_string(), |t, (from, to)| {
+        assert!(t.contains(from), "the scene text has no {from:?}");
+        t.replace(from, to)
+    })
+}
