@@ -16,7 +16,7 @@ fn tiny_oedometer() -> String {
             ("radius = 3.75e-3\n", "radius = 2.5e-3\n"),
             ("z = 13.0e-3", "z = 10.0e-3"),
             ("p_max = 1.6e6", "p_max = 100.0e3"),
-            ("duration = 0.05 ", "duration = 0.02 "),
+            ("duration = 0.1 ", "duration = 0.02 "),
         ],
     )
 }
