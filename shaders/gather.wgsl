@@ -1,5 +1,6 @@
 // One invocation sums the load on one grain in a fixed order: gravity, the pairs it owns,
-// the pairs where it is partner, its wall contacts. No float atomics.
+// the pairs where it is partner, its wall contacts. No float atomics. force.w counts the
+// grain's pairs that push (f_n > 0), for the statistics' rattlers.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> vel: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> pair_start: array<u32>;
@@ -22,16 +23,19 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index
     }
     var f = params.gravity.xyz * vel[i].w;
     var t = vec3<f32>(0.0);
+    var pushing = 0.0;
     let end = min(pair_start[i + 1u], params.pair_capacity);
     for (var k = pair_start[i]; k < end; k++) {
         f += out_fi[k].xyz;
         t += out_ti[k].xyz;
+        pushing += select(0.0, 1.0, out_fi[k].w > 0.0);
     }
     for (var s = rev_start[i]; s < rev_start[i + 1u]; s++) {
         let k = rev_pair[s];
         f += out_fj[k].xyz;
         t += out_tj[k].xyz;
+        pushing += select(0.0, 1.0, out_fi[k].w > 0.0);
     }
-    force[i] = vec4<f32>(f + wall_force[i].xyz, 0.0);
+    force[i] = vec4<f32>(f + wall_force[i].xyz, pushing);
     torque[i] = vec4<f32>(t + wall_torque[i].xyz, 0.0);
 }

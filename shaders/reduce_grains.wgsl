@@ -1,11 +1,12 @@
 // One invocation adds one grain to its workgroup's statistics row: kinetic and gravitational
-// energy, momentum, angular momentum, |net force|, wall contacts, their elastic energy, its
-// wall contacts sliding and rolling, and the largest wall overlap.
+// energy, momentum, angular momentum, |net force| (all, and loaded grains), wall contacts, their
+// elastic energy, its wall contacts sliding and rolling, whether it is a rattler and its
+// kinetic energy if so, and the largest wall overlap.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> vel: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> omega: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read> force: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> force: array<vec4<f32>>; // w: pushing pairs
 @group(0) @binding(5) var<storage, read> wall_force: array<vec4<f32>>;
 @group(0) @binding(6) var<storage, read> wall_torque: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read> image: array<vec4<i32>>;
@@ -40,15 +41,16 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         row[r + 6u] = l.x;
         row[r + 7u] = l.y;
         row[r + 8u] = l.z;
-        row[r + 9u] = length(force[i].xyz);
         row[r + 10u] = length(wall_force[i].xyz);
         row[r + 13u] = wall_force[i].w;
         row[r + 14u] = wall_torque[i].w;
+        var contacts = force[i].w;
         for (var k = 0u; k < params.n_walls; k++) {
             let frame = wall_frame(walls[k], p.xyz);
             let h = p.w - frame.w;
             if (h > 0.0) {
                 let c = coeffs[walls[k].material * params.n_materials + material[i]];
+                contacts += 1.0;
                 row[r + 11u] += 1.0;
                 row[r + 12u] += normal_potential(c, p.w, h);
                 if (h / p.w > row[r + STAT_MAX]) {
@@ -56,6 +58,14 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
                     row[r + STAT_ARG] = bitcast<f32>(i);
                 }
             }
+        }
+        // A rattler (fewer than RATTLER_CONTACTS contacts) is counted apart.
+        row[r + 9u] = length(force[i].xyz);
+        if (contacts < f32(RATTLER_CONTACTS)) {
+            row[r + 15u] = 1.0;
+            row[r + 16u] = row[r + 0u];
+        } else {
+            row[r + 17u] = row[r + 9u];
         }
     }
     reduce_rows(lid);

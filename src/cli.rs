@@ -192,6 +192,28 @@ pub enum Command {
     },
 }
 
+/// How `grains fit bauer` treats e0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum E0Choice {
+    /// Fitted with h_s and eta.
+    Free,
+    /// Held at this void ratio.
+    Fixed(f64),
+}
+
+impl std::str::FromStr for E0Choice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "free" => Ok(E0Choice::Free),
+            v => match v.parse::<f64>() {
+                Ok(x) if x.is_finite() && x > 0.0 => Ok(E0Choice::Fixed(x)),
+                _ => Err(format!("`{v}` is neither \"free\" nor a positive void ratio; fix: give e.g. --e0 free or --e0 0.93")),
+            },
+        }
+    }
+}
+
 /// Laws `grains fit` knows.
 #[derive(Debug, Subcommand)]
 pub enum FitLaw {
@@ -205,12 +227,19 @@ pub enum FitLaw {
         /// Column of the void ratio.
         #[arg(long, default_value = "void_ratio")]
         e_column: String,
-        /// Fit the mean-stress form e = e0 exp(-(3p/h_s)^eta) (the abstract's).
+        /// Fit the mean-stress form e = e0 exp(-(3p/h_s)^eta) (the abstract's), with 3p the
+        /// measured trace of the stress (column --trace-column), not 3 times the vertical stress.
         #[arg(long)]
         mean_stress: bool,
-        /// Hold e0 at this value instead of fitting it.
+        /// Column of the stress trace 3p (Pa), for --mean-stress.
+        #[arg(long, default_value = "stress_trace_Pa")]
+        trace_column: String,
+        /// e0: "free" to fit it, or a void ratio to hold it at (e.g. the measured one).
+        #[arg(long, default_value = "free")]
+        e0: E0Choice,
+        /// Also fit with e0 held at a range of values and print how h_s and eta follow it.
         #[arg(long)]
-        e0: Option<f64>,
+        profile: bool,
         /// Print one JSON object on stdout.
         #[arg(long)]
         json: bool,

@@ -1,6 +1,6 @@
 //! The subcommands' bodies.
 
-use crate::cli::{Backend, BenchBackend, BenchPart, Cli, Command, FitLaw, Precision};
+use crate::cli::{Backend, BenchBackend, BenchPart, Cli, Command, E0Choice, FitLaw, Precision};
 use anyhow::Context;
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
@@ -46,13 +46,32 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             print!("{}", grains::output::check_report(&scene));
             Ok(())
         }
-        Command::Fit { law: FitLaw::Bauer { file, p_column, e_column, mean_stress, e0, json } } => {
-            let points = read_columns(&file, &p_column, &e_column)?;
-            let fit = grains::analysis::fit::fit_bauer(&points, e0, if mean_stress { 3.0 } else { 1.0 }).with_context(|| format!("{}: cannot fit Bauer's law", file.display()))?;
+        Command::Fit { law: FitLaw::Bauer { file, p_column, e_column, mean_stress, trace_column, e0, profile, json } } => {
+            use grains::analysis::fit::{e0_profile, fit_bauer, profile_e0s};
+            // The mean-stress form takes 3p as the measured trace of the stress.
+            let points = read_columns(&file, if mean_stress { &trace_column } else { &p_column }, &e_column)?;
+            let held = match e0 {
+                E0Choice::Free => None,
+                E0Choice::Fixed(v) => Some(v),
+            };
+            let fit = fit_bauer(&points, held, 1.0).with_context(|| format!("{}: cannot fit Bauer's law", file.display()))?;
+            let profile = profile.then(|| e0_profile(&points, &profile_e0s(&points, fit.e0.value, grains::output::PROFILE_POINTS), 1.0));
             if json {
-                println!("{}", serde_json::to_string(&fit)?);
+                println!("{}", serde_json::json!({ "fit": fit, "profile": profile }));
             } else {
-                println!("{} ({} points, rms residual {:.2e}{})", fit.line(), fit.points, fit.rms, if mean_stress { ", mean-stress form 3p/h_s" } else { "" });
+                let c = &fit.correlations;
+                let r = |x: Option<f64>| x.map_or(String::new(), |x| format!(", ln h_s-e0 {x:.3}"));
+                let form = if mean_stress { format!(", mean-stress form: 3p = {trace_column}") } else { String::new() };
+                println!("{} ({} points, rms residual {:.2e}{form}; correlation ln h_s-eta {:.3}{})", fit.line(), fit.points, fit.rms, c.ln_h_s_eta, r(c.ln_h_s_e0));
+                if let Some(p) = profile {
+                    println!("e0 held at    h_s (MPa)     eta      rms");
+                    for q in &p.points {
+                        println!("{:>9.4}  {:>11.4e}  {:.4}  {:.2e}", q.e0, q.h_s / 1e6, q.eta, q.rms);
+                    }
+                    if let Some(l) = p.power_law {
+                        println!("along the profile: h_s = {} eta^{} MPa (seed 000's sweep: 0.068(4) eta^-9.88(3))", l.a.concise(), l.b.concise());
+                    }
+                }
             }
             Ok(())
         }
@@ -87,7 +106,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 let fitted: Vec<_> = table.rows.iter().filter_map(|r| Some((r.eta?, r.h_s?))).collect();
                 if !fitted.is_empty() {
                     let title = sweep.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-                    if let Err(e) = grains::output::plot::hardness(&out.join("hardness"), &title, &fitted, table.power_law.as_ref()) {
+                    if let Err(e) = grains::output::plot::hardness(&out.join("hardness"), &title, &fitted, table.power_law.as_ref(), true) {
                         eprintln!("warning: {e:#}");
                     }
                 }

@@ -112,6 +112,16 @@ pub struct Stats {
     pub max_overlap_grain: u32,
     /// Mean |net force| on a grain over mean |contact force| (-); 0 when nothing acts.
     pub unbalanced_force: f64,
+    /// The same over the loaded grains only (rattlers left out).
+    #[serde(default)]
+    pub unbalanced_force_loaded: f64,
+    /// Rattlers: grains with fewer than [`RATTLER_CONTACTS`] contacts (pushing grain-grain
+    /// contacts and touching walls); 0 in checkpoints from before they were counted.
+    #[serde(default)]
+    pub rattlers: u64,
+    /// Translational kinetic energy of the rattlers (J).
+    #[serde(default)]
+    pub ke_rattlers: f64,
     /// First grain whose position or velocity is not finite.
     pub non_finite_grain: Option<u32>,
     /// Neighbour-list rebuilds since the start.
@@ -126,6 +136,22 @@ pub struct Stats {
     pub walls: Vec<WallStats>,
     /// The piston, if any.
     pub piston: Option<PistonStats>,
+}
+
+/// Grains with fewer contacts than this are rattlers: they carry no load, and a rattler
+/// bouncing in its cage says nothing about whether the packing stands (shared with WGSL
+/// `RATTLER_CONTACTS`).
+pub const RATTLER_CONTACTS: u64 = 2;
+
+/// The unbalanced-force ratio: mean |net force| over `grains` (the summed `net` N) against the
+/// mean |contact force| (`contact_force` N summed over `contact_ends`, each contact counted
+/// once per grain it touches); 0 when nothing acts, infinite when forces act without contacts.
+pub fn unbalanced(net: f64, grains: f64, contact_force: f64, contact_ends: u64) -> f64 {
+    if contact_ends == 0 || grains <= 0.0 {
+        if net > 0.0 { f64::INFINITY } else { 0.0 }
+    } else {
+        (net / grains) / (contact_force / contact_ends as f64)
+    }
 }
 
 /// Contacts counted per tangential regime.

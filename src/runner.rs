@@ -1,5 +1,6 @@
 //! Running a scene end to end with its outputs: what `grains run` and every sweep point do.
 
+use crate::analysis::fit::{BauerFit, Estimate};
 use crate::checkpoint::{CheckpointHeader, EngineState, RunIdentity};
 use crate::cpu::CpuEngine;
 use crate::engine::Engine;
@@ -52,8 +53,16 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
         if !summary.compression.is_empty() {
             let path = dir.join("compression.csv");
             std::fs::write(&path, summary.compression_csv()).with_context(|| format!("cannot write {}", path.display()))?;
-            if let Err(e) = crate::output::plot::compression(&dir.join("compression"), &scene.name, &summary.compression, summary.bauer.as_ref()) {
+            let fits: Vec<(&str, &BauerFit)> = [("e0 levelled", summary.bauer.as_ref()), ("e0 fitted", summary.bauer_free.as_ref())].into_iter().filter_map(|(n, f)| f.map(|f| (n, f))).collect();
+            if let Err(e) = crate::output::plot::compression(&dir.join("compression"), &scene.name, &summary.compression, &fits) {
                 eprintln!("warning: {e:#}");
+            }
+            if let Some(profile) = summary.bauer_profile.as_ref().filter(|p| !p.points.is_empty()) {
+                let points: Vec<_> = profile.points.iter().map(|p| (Estimate { value: p.eta, error: 0.0 }, Estimate { value: p.h_s / 1e6, error: 0.0 })).collect();
+                let title = format!("{}: Bauer fit with e0 held from {:.4} to {:.4}", scene.name, profile.points[0].e0, profile.points[profile.points.len() - 1].e0);
+                if let Err(e) = crate::output::plot::hardness(&dir.join("bauer_profile"), &title, &points, profile.power_law.as_ref(), true) {
+                    eprintln!("warning: {e:#}");
+                }
             }
         }
         if scene.output.analysis {

@@ -95,3 +95,66 @@ fn the_power_law_across_runs_recovers_the_papers_figure_5() {
     assert!((law.b.value - -9.88).abs() <= 3.355 * law.b.error);
     assert!((law.a.value / 0.068).ln().abs() <= 3.355 * law.a.error / law.a.value);
 }
+
+#[test]
+fn an_e0_profile_passes_through_the_truth_and_trades_h_s_against_eta() {
+    use grains::analysis::fit::{e0_profile, profile_e0s};
+    let data = curve(0.72, 19.1e6, 0.57, 0.0, 0);
+    let mut e0s = profile_e0s(&data, 0.8, 12);
+    e0s.push(0.72);
+    e0s.sort_by(f64::total_cmp);
+    let profile = e0_profile(&data, &e0s, 1.0);
+    assert_eq!(profile.points.len(), e0s.len(), "every e0 above the largest e fits");
+    let truth = profile.points.iter().find(|p| p.e0 == 0.72).unwrap();
+    assert!((truth.h_s / 19.1e6 - 1.0).abs() < EXACT && (truth.eta / 0.57 - 1.0).abs() < EXACT, "{truth:?}");
+    // A larger e0 reads the same curve as a harder, flatter law.
+    for w in profile.points.windows(2) {
+        assert!(w[1].h_s > w[0].h_s && w[1].eta < w[0].eta, "{w:?}");
+    }
+    let law = profile.power_law.unwrap();
+    println!("along the profile: h_s = {} eta^{} MPa", law.a.concise(), law.b.concise());
+    assert!(law.b.value < -1.0);
+}
+
+#[test]
+fn the_free_fit_reports_how_its_parameters_are_correlated() {
+    let fit = fit_bauer(&curve(0.72, 19.1e6, 0.57, 1e-4, 3), None, 1.0).unwrap();
+    let c = fit.correlations;
+    println!("ln h_s-eta {:.3}, ln h_s-e0 {:?}, eta-e0 {:?}", c.ln_h_s_eta, c.ln_h_s_e0, c.eta_e0);
+    for r in [c.ln_h_s_eta, c.ln_h_s_e0.unwrap(), c.eta_e0.unwrap()] {
+        assert!(r.abs() <= 1.0 + 1e-12);
+    }
+    // A harder sample (larger h_s) fits the same points with a smaller eta.
+    assert!(c.ln_h_s_eta < -0.5);
+    assert!(fit_bauer(&curve(0.72, 19.1e6, 0.57, 1e-4, 3), Some(0.72), 1.0).unwrap().correlations.ln_h_s_e0.is_none());
+}
+
+/// `grains fit bauer` on a compression CSV: e0 free or held, and the mean-stress form taking
+/// 3p from the measured trace of the stress, not three times the vertical stress.
+#[test]
+fn fit_bauer_holds_or_frees_e0_and_takes_the_mean_stress_from_the_trace() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("compression.csv");
+    let mut csv = String::from("pressure_Pa,stress_trace_Pa,void_ratio\n");
+    for p in pressures() {
+        // A settled oedometer: the trace of the stress is about twice the vertical stress.
+        let trace = 2.0 * p;
+        csv.push_str(&format!("{p},{trace},{}\n", 0.72 * (-(trace / 19.1e6f64).powf(0.57)).exp()));
+    }
+    std::fs::write(&path, csv).unwrap();
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_grains")).args(["fit", "bauer", path.to_str().unwrap()]).args(args).output().unwrap();
+        (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
+    };
+    let (code, out, err) = run(&["--mean-stress"]);
+    println!("{out}{err}");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(out.starts_with("h_s = 19.1") && out.contains("eta = 0.57"), "the trace is 3p: {out}");
+    let (_, out, _) = run(&["--e0", "0.72"]);
+    assert!(out.contains("e0 = 0.7200 (measured)"), "{out}");
+    let (_, out, _) = run(&["--e0", "free", "--profile"]);
+    assert!(out.contains("e0 held at") && out.contains("along the profile"), "{out}");
+    let (code, _, err) = run(&["--e0", "loose"]);
+    assert_eq!(code, Some(2), "clap refuses the value");
+    assert!(err.contains("`loose`") && err.contains("fix:"), "{err}");
+}

@@ -95,6 +95,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     assert_eq!(constant("WG"), layout::WG);
     assert_eq!(constant("MAX_WALLS") as usize, layout::MAX_WALLS);
     assert_eq!(constant("STAT_ROW") as usize, layout::STAT_ROW);
+    assert_eq!(constant("RATTLER_CONTACTS") as u64, grains::engine::RATTLER_CONTACTS);
     assert_eq!(constant("NONE"), layout::NONE);
     for (name, slot) in [("ARGS_GRAINS", layout::args::GRAINS), ("ARGS_HASH", layout::args::HASH), ("ARGS_HASH_BLOCKS", layout::args::HASH_BLOCKS), ("ARGS_GRAIN_BLOCKS", layout::args::GRAIN_BLOCKS), ("ARGS_ONE", layout::args::ONE), ("ARGS_OLD_PAIRS", layout::args::OLD_PAIRS), ("ARGS_PAIRS", layout::args::PAIRS), ("ARGS_NEW_PAIRS", layout::args::NEW_PAIRS), ("ARGS_GRAIN_STARTS", layout::args::GRAIN_STARTS), ("ARGS_SLOTS", layout::args::SLOTS)] {
         assert_eq!(constant(name) as u64, slot, "{name}");

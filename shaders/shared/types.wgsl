@@ -97,6 +97,8 @@ const ARGS_GRAIN_STARTS: u32 = 8u;  // one per entry of n_grains + 1, if rebuild
 const ARGS_SLOTS: u32 = 9u;
 
 const MAX_WALLS: u32 = 8u;
+// Grains with fewer contacts are rattlers (src/engine.rs RATTLER_CONTACTS).
+const RATTLER_CONTACTS: u32 = 2u;
 // Per-workgroup rows of the statistics reduction: sums, then (largest overlap, its grain).
 const STAT_ROW: u32 = 20u;
 const STAT_MAX: u32 = 18u;

@@ -70,6 +70,20 @@ pub struct BauerFit {
     pub rms: f64,
     /// Points fitted.
     pub points: usize,
+    /// Correlations of the fitted parameters, from the covariance.
+    pub correlations: Correlations,
+}
+
+/// Correlation coefficients (-1..1) of the fitted parameters: `ln h_s` with `eta`, and with
+/// `e0` when e0 was fitted.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Correlations {
+    /// `ln h_s` with `eta`.
+    pub ln_h_s_eta: f64,
+    /// `ln h_s` with `e0`.
+    pub ln_h_s_e0: Option<f64>,
+    /// `eta` with `e0`.
+    pub eta_e0: Option<f64>,
 }
 
 impl BauerFit {
@@ -231,6 +245,8 @@ pub fn fit_bauer(points: &[(f64, f64)], e0: Option<f64>, stress_factor: f64) -> 
     let (a, _) = normal(&theta);
     let cov = invert(&a).ok_or(FitError::NoConvergence(MAX_ITERATIONS))?;
     let err = |i: usize| (s2 * cov[i][i]).max(0.0).sqrt();
+    let corr = |i: usize, j: usize| cov[i][j] / (cov[i][i] * cov[j][j]).sqrt();
+    let free = theta.len() == 3;
     let h_s = theta[0].exp();
     Ok(BauerFit {
         e0: if theta.len() == 3 { Estimate { value: theta[2], error: err(2) } } else { Estimate { value: e0.unwrap_or(1.0), error: 0.0 } },
@@ -240,7 +256,49 @@ pub fn fit_bauer(points: &[(f64, f64)], e0: Option<f64>, stress_factor: f64) -> 
         stress_factor,
         rms: (cost / points.len() as f64).sqrt(),
         points: points.len(),
+        correlations: Correlations { ln_h_s_eta: corr(0, 1), ln_h_s_e0: free.then(|| corr(0, 2)), eta_e0: free.then(|| corr(1, 2)) },
     })
+}
+
+/// One point of a profile of Bauer's law over e0: the fit with e0 held at `e0`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ProfilePoint {
+    /// The e0 held (-).
+    pub e0: f64,
+    /// Fitted h_s (Pa).
+    pub h_s: f64,
+    /// Fitted eta.
+    pub eta: f64,
+    /// Root-mean-square residual in e.
+    pub rms: f64,
+}
+
+/// Bauer's law fitted with e0 held at each of a range of values: how much the fitted h_s and
+/// eta depend on the e0 assumed, and the power law `h_s = a eta^b` they trace as e0 slides.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct E0Profile {
+    /// The fits, by increasing e0 (those that converged).
+    pub points: Vec<ProfilePoint>,
+    /// `h_s = a eta^b` through the profile (h_s in MPa), when three or more fits converged.
+    pub power_law: Option<PowerLaw>,
+}
+
+/// Values of e0 for [`e0_profile`]: from just above the largest measured void ratio (Bauer's
+/// e0 must exceed every e) to `up_to`, or at least 0.1 above it, spaced evenly in the log of
+/// the distance to the largest e, from 1e-3 of it.
+pub fn profile_e0s(points: &[(f64, f64)], up_to: f64, count: usize) -> Vec<f64> {
+    let e_max = points.iter().map(|q| q.1).fold(0.0, f64::max);
+    let span = (up_to - e_max).max(0.1);
+    let first = 1e-3 * span;
+    (0..count).map(|k| e_max + first * (span / first).powf(k as f64 / (count - 1).max(1) as f64)).collect()
+}
+
+/// Bauer's law fitted with e0 held at each of `e0s`.
+pub fn e0_profile(points: &[(f64, f64)], e0s: &[f64], stress_factor: f64) -> E0Profile {
+    let fits: Vec<ProfilePoint> =
+        e0s.iter().filter_map(|&e0| fit_bauer(points, Some(e0), stress_factor).ok().map(|f| ProfilePoint { e0, h_s: f.h_s.value, eta: f.eta.value, rms: f.rms })).collect();
+    let power_law = if fits.len() >= 3 { fit_power_law(&fits.iter().map(|f| (f.eta, f.h_s / 1e6)).collect::<Vec<_>>()).ok() } else { None };
+    E0Profile { points: fits, power_law }
 }
 
 /// The power law `h_s = a eta^b` fitted as a straight line in log-log, with standard errors.

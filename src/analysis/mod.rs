@@ -2,6 +2,7 @@
 
 pub mod fit;
 pub mod network;
+pub mod seed000;
 
 use crate::engine::Frame;
 use crate::periodic::Periodic;

@@ -26,7 +26,7 @@ pub use state::{Body, HistorySlots, Load, Props};
 pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::checkpoint::EngineState;
-use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats};
+use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
 use crate::model::{normal_potential, rupture_distance, CohesionLaw, ContactForce, ContactModel, PairCoeffs, Regime};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
@@ -582,6 +582,9 @@ struct GrainSums {
     momentum: [f64; 3],
     angular: [f64; 3],
     net_force: f64,
+    net_force_loaded: f64,
+    rattlers: u64,
+    ke_rattlers: f64,
     wall_force: f64,
     wall_contacts: u64,
     wall_elastic: f64,
@@ -657,11 +660,14 @@ impl<T: Real> Engine for CpuEngine<T> {
                 s.angular[0] += x[1] * mv[2] - x[2] * mv[1] + ii * w[0];
                 s.angular[1] += x[2] * mv[0] - x[0] * mv[2] + ii * w[1];
                 s.angular[2] += x[0] * mv[1] - x[1] * mv[0] + ii * w[2];
-                s.net_force += l.force.norm().f64();
+                let pushes = |k: u32| (self.out[k as usize].f_n > T::ZERO) as u64;
+                let pl = &self.pairs;
+                let mut contacts: u64 = (pl.owner_start[i]..pl.owner_start[i + 1]).map(pushes).sum::<u64>() + pl.rev_pair[pl.rev_start[i] as usize..pl.rev_start[i + 1] as usize].iter().map(|&k| pushes(k)).sum::<u64>();
                 for wall in &self.walls {
                     let (_, dist) = wall.geom.frame(b.pos);
                     let h = p.radius - dist;
                     if h > T::ZERO {
+                        contacts += 1;
                         let c = &self.coeffs[wall.material as usize * self.n_materials + p.material as usize];
                         s.wall_contacts += 1;
                         s.wall_elastic += normal_potential(&self.model.normal, c, p.radius, h).f64();
@@ -669,6 +675,14 @@ impl<T: Real> Engine for CpuEngine<T> {
                     }
                 }
                 s.wall_force += self.wall_load[i].force.norm().f64();
+                let net = l.force.norm().f64();
+                s.net_force += net;
+                if contacts < RATTLER_CONTACTS {
+                    s.rattlers += 1;
+                    s.ke_rattlers += 0.5 * m * b.vel.norm2().f64();
+                } else {
+                    s.net_force_loaded += net;
+                }
             }
             s
         });
@@ -702,6 +716,9 @@ impl<T: Real> Engine for CpuEngine<T> {
                 gs.angular[a] += s.angular[a];
             }
             gs.net_force += s.net_force;
+            gs.net_force_loaded += s.net_force_loaded;
+            gs.rattlers += s.rattlers;
+            gs.ke_rattlers += s.ke_rattlers;
             gs.wall_force += s.wall_force;
             gs.wall_contacts += s.wall_contacts;
             gs.wall_elastic += s.wall_elastic;
@@ -719,11 +736,8 @@ impl<T: Real> Engine for CpuEngine<T> {
         let n = self.body.len() as f64;
         // Each touching pair counts once per grain; each wall contact once.
         let contact_ends = 2 * ps.contacts + gs.wall_contacts;
-        let unbalanced_force = if contact_ends == 0 {
-            if gs.net_force > 0.0 { f64::INFINITY } else { 0.0 }
-        } else {
-            (gs.net_force / n) / ((ps.force + gs.wall_force) / contact_ends as f64)
-        };
+        let unbalanced_force = crate::engine::unbalanced(gs.net_force, n, ps.force + gs.wall_force, contact_ends);
+        let unbalanced_force_loaded = crate::engine::unbalanced(gs.net_force_loaded, n - gs.rattlers as f64, ps.force + gs.wall_force, contact_ends);
         let (max_overlap, max_overlap_grain) = max_by_first(ps.max_overlap, gs.max_wall_overlap);
         let walls = (0..self.walls.len())
             .map(|w| {
@@ -784,6 +798,9 @@ impl<T: Real> Engine for CpuEngine<T> {
             max_overlap,
             max_overlap_grain,
             unbalanced_force,
+            unbalanced_force_loaded,
+            rattlers: gs.rattlers,
+            ke_rattlers: gs.ke_rattlers,
             non_finite_grain: self.body.iter().position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|i| self.id[i]),
             rebuilds: self.rebuilds,
             bridges,

@@ -784,12 +784,9 @@ impl Engine for GpuEngine {
         let contacts = p(0).round() as u64;
         let wall_contacts = g(11).round() as u64;
         let contact_ends = 2 * contacts + wall_contacts;
-        let net = g(9);
-        let unbalanced_force = if contact_ends == 0 {
-            if net > 0.0 { f64::INFINITY } else { 0.0 }
-        } else {
-            (net / n) / ((p(3) + g(10)) / contact_ends as f64)
-        };
+        let rattlers = g(15).round() as u64;
+        let unbalanced_force = crate::engine::unbalanced(g(9), n, p(3) + g(10), contact_ends);
+        let unbalanced_force_loaded = crate::engine::unbalanced(g(17), n - rattlers as f64, p(3) + g(10), contact_ends);
         let (max_overlap, max_overlap_grain) = {
             let (gv, gi) = (g(STAT_ROW - 2), s[STAT_ROW - 1].to_bits());
             let (pv, pi) = (p(STAT_ROW - 2), s[2 * STAT_ROW - 1].to_bits());
@@ -825,6 +822,9 @@ impl Engine for GpuEngine {
             max_overlap,
             max_overlap_grain: if max_overlap_grain == NONE { 0 } else { max_overlap_grain },
             unbalanced_force,
+            unbalanced_force_loaded,
+            rattlers,
+            ke_rattlers: g(16),
             non_finite_grain: (control.non_finite != NONE).then_some(control.non_finite),
             rebuilds: control.rebuilds as u64,
             bridges: 0,

@@ -7,7 +7,7 @@ pub mod network;
 pub mod plot;
 mod summary;
 
-pub use summary::{check_report, Summary, ESTIMATE_PAIRS_PER_GRAIN};
+pub use summary::{check_report, Summary, ESTIMATE_PAIRS_PER_GRAIN, PROFILE_POINTS};
 
 use crate::checkpoint::{CheckpointHeader, RunIdentity};
 use crate::engine::{Engine, Frame, Stats};

@@ -7,6 +7,7 @@
 //! error names the fix; the run's data files are unaffected.
 
 use crate::analysis::fit::{BauerFit, Estimate, PowerLaw};
+use crate::analysis::seed000::{self, GUAMO};
 use crate::protocol::CompressionPoint;
 use anyhow::Context;
 use plotters::coord::Shift;
@@ -25,9 +26,6 @@ pub const FONT_CANDIDATES: &[&str] = &[
     "/System/Library/Fonts/Supplemental/Arial.ttf",
     "C:\\Windows\\Fonts\\arial.ttf",
 ];
-
-/// The paper's experimental Guamo sand: h_s = 19.1(1.1) MPa, eta = 0.57(1).
-pub const GUAMO: (Estimate, Estimate) = (Estimate { value: 0.57, error: 0.01 }, Estimate { value: 19.1, error: 1.1 });
 
 /// Registers a font for bitmap text once; `false` when none is found.
 fn font_ready() -> bool {
@@ -58,9 +56,10 @@ fn both(stem: &Path, size: (u32, u32), draw: impl Fn(&DrawingArea<SVGBackend, Sh
     Ok(())
 }
 
-/// e against p, linear and logarithmic in p, with the Bauer curve: `<stem>.png`, `<stem>.svg`.
-pub fn compression(stem: &Path, title: &str, points: &[CompressionPoint], fit: Option<&BauerFit>) -> anyhow::Result<()> {
-    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, points: &[CompressionPoint], fit: Option<&BauerFit>) -> anyhow::Result<()>
+/// e against p, linear and logarithmic in p, with a Bauer curve per fit (labelled):
+/// `<stem>.png`, `<stem>.svg`.
+pub fn compression(stem: &Path, title: &str, points: &[CompressionPoint], fits: &[(&str, &BauerFit)]) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, points: &[CompressionPoint], fits: &[(&str, &BauerFit)]) -> anyhow::Result<()>
     where
         DB::ErrorType: 'static,
     {
@@ -72,8 +71,7 @@ pub fn compression(stem: &Path, title: &str, points: &[CompressionPoint], fit: O
         let (e_min, e_max) = (e.iter().copied().fold(f64::INFINITY, f64::min), e.iter().copied().fold(0.0, f64::max));
         let pad = 0.1 * (e_max - e_min).max(1e-3);
         let e_range = (e_min - pad)..(e_max + pad);
-        let curve = |p_lo: f64, p_hi: f64, log: bool| -> Vec<(f64, f64)> {
-            let Some(f) = fit else { return Vec::new() };
+        let curve = |f: &BauerFit, p_lo: f64, p_hi: f64, log: bool| -> Vec<(f64, f64)> {
             (0..=200)
                 .map(|k| {
                     let t = k as f64 / 200.0;
@@ -82,7 +80,7 @@ pub fn compression(stem: &Path, title: &str, points: &[CompressionPoint], fit: O
                 })
                 .collect()
         };
-        let label = fit.map(|f| format!("Bauer: {}", f.line())).unwrap_or_else(|| "no fit".into());
+        let colours = [BLUE, RED, GREEN];
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
         {
             let mut chart = ChartBuilder::on(&left)
@@ -93,7 +91,10 @@ pub fn compression(stem: &Path, title: &str, points: &[CompressionPoint], fit: O
                 .build_cartesian_2d(0.0..p_max * 1.05, e_range.clone())
                 .map_err(err)?;
             chart.configure_mesh().x_desc("p (kPa)").y_desc("void ratio e").draw().map_err(err)?;
-            chart.draw_series(LineSeries::new(curve(0.0, p_max * 1.05, false), &BLUE)).map_err(err)?.label(label.clone()).legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE));
+            for (k, (name, f)) in fits.iter().enumerate() {
+                let c = colours[k % colours.len()];
+                chart.draw_series(LineSeries::new(curve(f, 0.0, p_max * 1.05, false), c)).map_err(err)?.label(format!("Bauer, {name}: {}", f.line())).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c));
+            }
             chart.draw_series(p_kpa.iter().zip(&e).map(|(&x, &y)| Circle::new((x, y), 4, BLACK.filled()))).map_err(err)?;
             chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
         }
@@ -105,22 +106,26 @@ pub fn compression(stem: &Path, title: &str, points: &[CompressionPoint], fit: O
             .build_cartesian_2d((p_min * 0.8..p_max * 1.25).log_scale(), e_range)
             .map_err(err)?;
         chart.configure_mesh().x_desc("p (kPa)").y_desc("void ratio e").draw().map_err(err)?;
-        chart.draw_series(LineSeries::new(curve(p_min * 0.8, p_max * 1.25, true), &BLUE)).map_err(err)?;
+        for (k, (_, f)) in fits.iter().enumerate() {
+            chart.draw_series(LineSeries::new(curve(f, p_min * 0.8, p_max * 1.25, true), colours[k % colours.len()])).map_err(err)?;
+        }
         chart.draw_series(p_kpa.iter().zip(&e).map(|(&x, &y)| Circle::new((x, y), 4, BLACK.filled()))).map_err(err)?;
         Ok(())
     }
-    both(stem, (1200, 520), |r| draw(r, title, points, fit), |r| draw(r, title, points, fit))
+    both(stem, (1200, 520), |r| draw(r, title, points, fits), |r| draw(r, title, points, fits))
 }
 
-/// h_s against eta (log-log) across a sweep, with the power law and the Guamo point.
-pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: Option<&PowerLaw>) -> anyhow::Result<()> {
-    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, points: &[(Estimate, Estimate)], law: Option<&PowerLaw>) -> anyhow::Result<()>
+/// h_s against eta (log-log) across a sweep, with the power law and the Guamo point; with
+/// `paper`, seed 000's Tables 2-3 and its power law beside them.
+pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: Option<&PowerLaw>, paper: bool) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, points: &[(Estimate, Estimate)], law: Option<&PowerLaw>, paper: bool) -> anyhow::Result<()>
     where
         DB::ErrorType: 'static,
     {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
         root.fill(&WHITE).map_err(err)?;
-        let all: Vec<&(Estimate, Estimate)> = points.iter().chain(std::iter::once(&GUAMO)).collect();
+        let published: Vec<(Estimate, Estimate)> = if paper { seed000::TABLES.iter().map(|r| (r.eta, r.h_s)).collect() } else { Vec::new() };
+        let all: Vec<&(Estimate, Estimate)> = points.iter().chain(&published).chain(std::iter::once(&GUAMO)).collect();
         let x_lo = all.iter().map(|p| (p.0.value - p.0.error).max(p.0.value * 0.5)).fold(f64::INFINITY, f64::min) * 0.8;
         let x_hi = all.iter().map(|p| p.0.value + p.0.error).fold(0.0, f64::max) * 1.25;
         let y_lo = all.iter().map(|p| (p.1.value - p.1.error).max(p.1.value * 0.2)).fold(f64::INFINITY, f64::min) * 0.5;
@@ -141,6 +146,24 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
                 .label(format!("h_s = {} eta^{} MPa", l.a.concise(), l.b.concise()))
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE));
         }
+        if paper {
+            let grey = RGBColor(150, 150, 150);
+            let l = seed000::POWER_LAW;
+            let line: Vec<(f64, f64)> = (0..=100).map(|k| x_lo * (x_hi / x_lo).powf(k as f64 / 100.0)).map(|x| (x, l.a.value * x.powf(l.b.value))).collect();
+            chart
+                .draw_series(DashedLineSeries::new(line, 6, 4, grey.stroke_width(2)))
+                .map_err(err)?
+                .label("seed 000: h_s = 0.068(4) eta^-9.88(3) MPa")
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey));
+            chart
+                .draw_series(published.iter().map(|(eta, h)| ErrorBar::new_vertical(eta.value, (h.value - h.error).max(y_lo), h.value, h.value + h.error, grey.filled(), 6)))
+                .map_err(err)?;
+            chart
+                .draw_series(published.iter().map(|(eta, h)| Rectangle::new([(eta.value * 0.985, h.value * 0.93), (eta.value * 1.015, h.value * 1.07)], grey.filled())))
+                .map_err(err)?
+                .label("seed 000, Tables 2-3")
+                .legend(move |(x, y)| Rectangle::new([(x + 4, y - 4), (x + 12, y + 4)], grey.filled()));
+        }
         chart
             .draw_series(points.iter().map(|(eta, h)| ErrorBar::new_vertical(eta.value, (h.value - h.error).max(y_lo), h.value, h.value + h.error, BLACK.filled(), 6)))
             .map_err(err)?;
@@ -153,7 +176,7 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
         chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
         Ok(())
     }
-    both(stem, (900, 640), |r| draw(r, title, points, law), |r| draw(r, title, points, law))
+    both(stem, (900, 640), |r| draw(r, title, points, law, paper), |r| draw(r, title, points, law, paper))
 }
 
 /// A PDF on a log-linear scale, with the fitted exponential tails drawn as lines.

@@ -1,6 +1,6 @@
 //! The run summary (`--json`, `summary.json`) and the `check` report.
 
-use crate::analysis::fit::{fit_bauer, BauerFit};
+use crate::analysis::fit::{e0_profile, fit_bauer, profile_e0s, BauerFit, E0Profile};
 use crate::analysis::packing_fraction;
 use crate::cpu::HistorySlots;
 use crate::engine::Engine;
@@ -52,10 +52,19 @@ pub struct Summary {
     pub final_state: FinalState,
     /// Oedometer points, one per pressure step.
     pub compression: Vec<CompressionPoint>,
-    /// Bauer's law fitted to the compression points (at least 4), if it could be.
+    /// Bauer's law fitted to the compression points (at least 4, the seating load's left
+    /// out) with e0 held at the measured one (`e0_seat`, else `e0_top`), if it could be.
     pub bauer: Option<BauerFit>,
     /// Why Bauer's law could not be fitted, when there were points to fit.
     pub bauer_error: Option<String>,
+    /// Bauer's law with e0 fitted too.
+    pub bauer_free: Option<BauerFit>,
+    /// The void ratio under the seating load, when the oedometer has one.
+    pub e0_seat: Option<f64>,
+    /// The void ratio up to the top of the highest grain when the piston was lowered.
+    pub e0_top: Option<f64>,
+    /// Bauer's law with e0 held at a range of values (see [`e0_profile`]).
+    pub bauer_profile: Option<E0Profile>,
     /// Validation warnings.
     pub warnings: Vec<String>,
 }
@@ -67,8 +76,18 @@ impl Summary {
         let frame = engine.frame(false);
         let piston_z = last.and_then(|s| s.piston.as_ref().map(|p| p.z));
         let compression: Vec<CompressionPoint> = stages.iter().filter_map(|s| s.compression.clone()).collect();
-        let e0 = stages.iter().find_map(|s| s.initial_void_ratio);
-        let bauer = fit_compression(&compression, e0);
+        // Bauer's e0: the void ratio under the seating load when there is one, else with the
+        // piston at the top of the highest grain.
+        let seat = compression.iter().find(|c| c.seating).map(|c| c.void_ratio);
+        let e0_top = stages.iter().find_map(|s| s.initial_void_ratio);
+        let e0 = seat.or(e0_top);
+        let fitted: Vec<CompressionPoint> = compression.iter().filter(|c| !c.seating).cloned().collect();
+        let bauer = fit_compression(&fitted, e0);
+        let data = compression_data(&fitted);
+        let enough = fitted.len() >= MIN_BAUER_POINTS;
+        let bauer_free = if enough { fit_bauer(&data, None, 1.0).ok() } else { None };
+        let reach = e0_top.into_iter().chain(e0).chain(bauer_free.map(|b| b.e0.value)).fold(0.0, f64::max);
+        let bauer_profile = enough.then(|| e0_profile(&data, &profile_e0s(&data, reach, PROFILE_POINTS), 1.0));
         Summary {
             scene: scene.name.clone(),
             file: scene.path.display().to_string(),
@@ -89,6 +108,10 @@ impl Summary {
             compression: compression.clone(),
             bauer: bauer.as_ref().ok().and_then(|b| *b),
             bauer_error: bauer.err(),
+            bauer_free,
+            e0_seat: seat,
+            e0_top,
+            bauer_profile,
             stages,
             warnings: scene.warnings.clone(),
         }
@@ -137,12 +160,23 @@ impl Summary {
         }
         match (&self.bauer, &self.bauer_error) {
             (Some(b), _) => {
-                let _ = writeln!(s, "  Bauer's law: {}", b.line());
+                let top = self.e0_top.map_or(String::new(), |e| format!(" (the piston on the highest grain: e = {e:.4})"));
+                let held = if self.e0_seat.is_some() { "e0 under the seating load" } else { "e0 with the piston on the highest grain" };
+                let _ = writeln!(s, "  Bauer's law, {held}{top}: {}", b.line());
             }
             (None, Some(e)) => {
                 let _ = writeln!(s, "  Bauer's law: not fitted: {e}");
             }
             _ => {}
+        }
+        if let Some(b) = &self.bauer_free {
+            let c = &b.correlations;
+            let r = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.3}"));
+            let _ = writeln!(s, "  Bauer's law, e0 fitted: {}; correlations ln h_s-eta {:.3}, ln h_s-e0 {}, eta-e0 {}", b.line(), c.ln_h_s_eta, r(c.ln_h_s_e0), r(c.eta_e0));
+        }
+        if let Some((p, a, b)) = self.bauer_profile.as_ref().and_then(|p| Some((p, p.points.first()?, p.points.last()?))) {
+            let law = p.power_law.map_or(String::new(), |l| format!("; along it h_s = {} eta^{} MPa (seed 000's sweep: 0.068(4) eta^-9.88(3))", l.a.concise(), l.b.concise()));
+            let _ = writeln!(s, "  e0 profile: e0 {:.4} -> {:.4} moves h_s {:.3e} -> {:.3e} MPa and eta {:.3} -> {:.3}{law}", a.e0, b.e0, a.h_s / 1e6, b.h_s / 1e6, a.eta, b.eta);
         }
         let pf = self.final_state.packing_fraction.map_or("n/a".to_string(), |p| format!("{p:.4}"));
         let _ = writeln!(s, "  final: KE = {:.4e} J, packing fraction = {pf}, coordination = {:.3}", self.final_state.kinetic_energy, self.final_state.coordination_number);
@@ -153,6 +187,14 @@ impl Summary {
 /// Points below which no Bauer fit is tried.
 pub const MIN_BAUER_POINTS: usize = 4;
 
+/// Fits in the e0 profile of a run.
+pub const PROFILE_POINTS: usize = 16;
+
+/// The (pressure, void ratio) points Bauer's law is fitted to.
+fn compression_data(points: &[CompressionPoint]) -> Vec<(f64, f64)> {
+    points.iter().map(|c| (c.pressure, c.void_ratio)).collect()
+}
+
 /// Bauer's law through the measured pressures and void ratios, with e0 the void ratio
 /// measured before loading (as the experiment measures it) when known, else fitted:
 /// `Ok(None)` with too few points to try.
@@ -160,8 +202,7 @@ fn fit_compression(points: &[CompressionPoint], e0: Option<f64>) -> Result<Optio
     if points.len() < MIN_BAUER_POINTS {
         return Ok(None);
     }
-    let data: Vec<(f64, f64)> = points.iter().map(|c| (c.pressure, c.void_ratio)).collect();
-    fit_bauer(&data, e0, 1.0).map(Some).map_err(|e| e.to_string())
+    fit_bauer(&compression_data(points), e0, 1.0).map(Some).map_err(|e| e.to_string())
 }
 
 /// Pairs per grain assumed by the memory estimate (a dense packing with a 10% skin).

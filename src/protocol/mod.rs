@@ -42,8 +42,9 @@ pub struct StageResult {
     pub stats: Stats,
     /// The compression point of an oedometer step.
     pub compression: Option<CompressionPoint>,
-    /// The void ratio of the sample when the piston was lowered onto it (Bauer's e0,
-    /// measured before any pressure acts), for the stage that lowered it.
+    /// The void ratio of the sample when the piston was lowered onto it, up to the top of the
+    /// highest grain (before any pressure acts; it counts the rough surface's hollows as
+    /// voids), for the stage that lowered it.
     pub initial_void_ratio: Option<f64>,
 }
 
@@ -68,6 +69,9 @@ pub struct CompressionPoint {
     pub stress_zz: f64,
     /// Whether the step met its settle criteria.
     pub settled: bool,
+    /// The seating load's point: its void ratio is Bauer's e0, and it is not fitted.
+    #[serde(default)]
+    pub seating: bool,
 }
 
 impl CompressionPoint {
@@ -190,11 +194,14 @@ fn run_stage(
         };
         // Translational energy: a rattler spinning in its cage (nothing to brake it on a
         // frictionless wall) says nothing about whether the packing stands.
-        let still = match stage.ke_ratio {
-            Some(r) => stats.ke_translational < r * stats.elastic_energy,
-            None => stats.ke_translational / n < stage.ke_per_grain,
+        // A loaded packing (ke_ratio) is judged on its loaded grains: a rattler bouncing in its
+        // cage does not move the piston. A deposit is judged on every grain: one in flight is
+        // not settled.
+        let (still, unbalanced) = match stage.ke_ratio {
+            Some(r) => (stats.ke_translational - stats.ke_rattlers < r * stats.elastic_energy, stats.unbalanced_force_loaded),
+            None => (stats.ke_translational / n < stage.ke_per_grain, stats.unbalanced_force),
         };
-        if settles && still && stats.unbalanced_force < stage.unbalanced_force && pressure_reached {
+        if settles && still && unbalanced < stage.unbalanced_force && pressure_reached {
             settled = true;
             break;
         }
@@ -202,7 +209,7 @@ fn run_stage(
     if next_frame.is_none() {
         rec.frame(&engine.frame(scene.output.contact_forces))?;
     }
-    let compression = if stage.records_compression { Some(compression_point(scene, engine, &stats, settled)) } else { None };
+    let compression = if stage.records_compression { Some(CompressionPoint { seating: stage.seating, ..compression_point(scene, engine, &stats, settled) }) } else { None };
     let result = StageResult {
         name: stage.name.clone(),
         kind: match stage.kind {
@@ -247,6 +254,7 @@ fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, sett
         stress_zz: stress[2][2],
         stress,
         settled,
+        seating: false,
     }
 }
 

@@ -180,8 +180,9 @@ pub struct Stage {
     pub duration: f64,
     /// Settled when the kinetic energy per grain (J) is below this ...
     pub ke_per_grain: f64,
-    /// ... or, when set, when the translational kinetic energy over the elastic energy of
-    /// the contacts is below this (-), in place of `ke_per_grain` ...
+    /// ... or, when set, when the translational kinetic energy of the loaded grains (rattlers
+    /// left out) over the elastic energy of the contacts is below this (-), in place of
+    /// `ke_per_grain`; the unbalanced force is then that of the loaded grains too ...
     pub ke_ratio: Option<f64>,
     /// ... and the unbalanced-force ratio is below this (-).
     pub unbalanced_force: f64,
@@ -194,6 +195,8 @@ pub struct Stage {
     pub lower_piston: bool,
     /// Record a compression point (pressure, void ratio, macroscopic stress) at the end.
     pub records_compression: bool,
+    /// The oedometer's seating load: its compression point gives Bauer's e0.
+    pub seating: bool,
     /// Wet the sample at the start with this liquid volume (m^3).
     pub wet_volume: Option<f64>,
     /// Servo walls' target pressure during the stage (Pa), if it changes.
@@ -965,7 +968,7 @@ fn validate_stages(
             }
         }
         if !oedometer {
-            for (k, set) in [("p0", s.p0.is_some()), ("p_max", s.p_max.is_some()), ("factor", s.factor.is_some())] {
+            for (k, set) in [("p0", s.p0.is_some()), ("p_max", s.p_max.is_some()), ("factor", s.factor.is_some()), ("seating_pressure", s.seating_pressure.is_some())] {
                 if set {
                     return Err(c.invalid(key(k), "(set)", "belongs to kind = \"oedometer\"", format!("remove `{k}` or use kind = \"oedometer\"")));
                 }
@@ -1004,6 +1007,7 @@ fn validate_stages(
             pressure_tolerance,
             lower_piston: false,
             records_compression: false,
+            seating: false,
             servo_pressure: match s.servo_pressure {
                 Some(_) if !has_servo => return Err(c.invalid(key("servo_pressure"), "(set)", "the scene has no servo box", "add a [[wall]] with type = \"servo_box\" or remove the key")),
                 Some(p) => Some(non_negative(c, &key("servo_pressure"), p, "give the pressure in Pa")?),
@@ -1038,8 +1042,23 @@ fn validate_stages(
         if !(factor > 1.0 && factor.is_finite()) {
             return Err(c.invalid(key("factor"), factor, "must exceed 1", "give a multiplier such as 2"));
         }
-        let mut p = p0;
         let mut first = true;
+        if let Some(seat) = s.seating_pressure {
+            let seat = positive(c, &key("seating_pressure"), seat, "give a small pressure in Pa, below p0")?;
+            if seat >= p0 {
+                return Err(c.invalid(key("seating_pressure"), seat, format!("is not below p0 = {p0}"), "give a seating load below the first pressure, e.g. p0 / 10"));
+            }
+            out.push(Stage {
+                name: format!("{}@seat {}", base.name, pressure_label(seat)),
+                piston_pressure: Some(seat),
+                lower_piston: true,
+                records_compression: true,
+                seating: true,
+                ..base.clone()
+            });
+            first = false;
+        }
+        let mut p = p0;
         while p <= p_max * (1.0 + 1e-12) {
             out.push(Stage {
                 name: format!("{}@{}", base.name, pressure_label(p)),

@@ -399,6 +399,10 @@ pub struct StageSpec {
     pub p_max: Option<f64>,
     /// "oedometer": pressure multiplier between steps. Default 2 (seed 000).
     pub factor: Option<f64>,
+    /// "oedometer": a seating load (Pa, below p0) put on the sample before p0, as an
+    /// experimenter seats the cap: its void ratio is Bauer's e0 and it is not fitted.
+    /// Default: none (e0 is then the void ratio up to the top of the highest grain).
+    pub seating_pressure: Option<f64>,
     /// Target pressure (Pa) of the servo walls during this stage. Default: unchanged.
     pub servo_pressure: Option<f64>,
     /// Triaxial compression: the servo box's z walls close at this strain rate (1/s) while
