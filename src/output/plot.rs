@@ -126,8 +126,9 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
         root.fill(&WHITE).map_err(err)?;
         let published: Vec<(Estimate, Estimate)> = if paper { seed000::TABLES.iter().map(|r| (r.eta, r.h_s)).collect() } else { Vec::new() };
         let all: Vec<&(Estimate, Estimate)> = points.iter().chain(&published).chain(std::iter::once(&GUAMO)).collect();
-        let x_lo = all.iter().map(|p| (p.0.value - p.0.error).max(p.0.value * 0.5)).fold(f64::INFINITY, f64::min) * 0.8;
-        let x_hi = all.iter().map(|p| p.0.value + p.0.error).fold(0.0, f64::max) * 1.25;
+        // The x range reaches a decade's bounds, so that the log axis has labelled ticks.
+        let x_lo = (all.iter().map(|p| (p.0.value - p.0.error).max(p.0.value * 0.5)).fold(f64::INFINITY, f64::min) * 0.8).min(0.1);
+        let x_hi = (all.iter().map(|p| p.0.value + p.0.error).fold(0.0, f64::max) * 1.25).max(1.0);
         let y_lo = all.iter().map(|p| (p.1.value - p.1.error).max(p.1.value * 0.2)).fold(f64::INFINITY, f64::min) * 0.5;
         let y_hi = all.iter().map(|p| p.1.value + p.1.error).fold(0.0, f64::max) * 2.0;
         let mut chart = ChartBuilder::on(root)
@@ -135,11 +136,19 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
             .margin(12)
             .x_label_area_size(40)
             .y_label_area_size(64)
-            .build_cartesian_2d((x_lo..x_hi).log_scale(), (y_lo..y_hi).log_scale())
+            .build_cartesian_2d((x_lo..x_hi).log_scale().with_key_points(vec![0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 1.0]), (y_lo..y_hi).log_scale())
             .map_err(err)?;
-        chart.configure_mesh().x_desc("eta").y_desc("h_s (MPa)").draw().map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("eta")
+            .y_desc("h_s (MPa)")
+            .x_labels(12)
+            .x_label_formatter(&|x| format!("{x:.2}"))
+            .y_label_formatter(&|y| format!("{y:.0e}"))
+            .draw()
+            .map_err(err)?;
         if let Some(l) = law {
-            let line: Vec<(f64, f64)> = (0..=100).map(|k| x_lo * (x_hi / x_lo).powf(k as f64 / 100.0)).map(|x| (x, l.a.value * x.powf(l.b.value))).collect();
+            let line: Vec<(f64, f64)> = (0..=100).map(|k| x_lo * (x_hi / x_lo).powf(k as f64 / 100.0)).map(|x| (x, l.a.value * x.powf(l.b.value))).filter(|p| p.1 >= y_lo && p.1 <= y_hi).collect();
             chart
                 .draw_series(LineSeries::new(line, &BLUE))
                 .map_err(err)?
@@ -149,7 +158,7 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
         if paper {
             let grey = RGBColor(150, 150, 150);
             let l = seed000::POWER_LAW;
-            let line: Vec<(f64, f64)> = (0..=100).map(|k| x_lo * (x_hi / x_lo).powf(k as f64 / 100.0)).map(|x| (x, l.a.value * x.powf(l.b.value))).collect();
+            let line: Vec<(f64, f64)> = (0..=100).map(|k| x_lo * (x_hi / x_lo).powf(k as f64 / 100.0)).map(|x| (x, l.a.value * x.powf(l.b.value))).filter(|p| p.1 >= y_lo && p.1 <= y_hi).collect();
             chart
                 .draw_series(DashedLineSeries::new(line, 6, 4, grey.stroke_width(2)))
                 .map_err(err)?
@@ -173,7 +182,7 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
             .map_err(err)?
             .label("Guamo sand (experiment): h_s = 19.1(1.1) MPa, eta = 0.57(1)")
             .legend(|(x, y)| TriangleMarker::new((x + 8, y), 6, RED.filled()));
-        chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
+        chart.configure_series_labels().position(SeriesLabelPosition::LowerLeft).background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
         Ok(())
     }
     both(stem, (900, 640), |r| draw(r, title, points, law, paper), |r| draw(r, title, points, law, paper))
