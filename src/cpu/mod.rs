@@ -37,7 +37,7 @@ use grid::{hash_cells, CellGrid};
 use pair_force::pair_block;
 use profile::{Phase, PhaseClock};
 use rayon::prelude::*;
-use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS};
+use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS, PAR_MIN_PAIRS};
 use wall_contacts::wall_block;
 
 /// Fraction of the largest stable servo gain used where a wall's contacts are stiff.
@@ -351,7 +351,7 @@ impl<T: Real> CpuEngine<T> {
         self.since_eval = T::ZERO;
         let (pairs, body, prop) = (&self.pairs, &self.body, &self.prop);
         let stride = self.slots.stride;
-        let min_blocks = PAR_MIN_ITEMS / pair_force::BLOCK;
+        let min_blocks = PAR_MIN_PAIRS / pair_force::BLOCK;
         if stride == 0 {
             self.out.par_chunks_mut(pair_force::BLOCK).with_min_len(min_blocks).enumerate().for_each(|(b, o)| pair_block(b * pair_force::BLOCK, o, &mut [], pairs, body, prop, &ctx));
         } else {
