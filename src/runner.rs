@@ -53,7 +53,7 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
         if !summary.compression.is_empty() {
             let path = dir.join("compression.csv");
             std::fs::write(&path, summary.compression_csv()).with_context(|| format!("cannot write {}", path.display()))?;
-            let fits: Vec<(&str, &BauerFit)> = [("e0 levelled", summary.bauer.as_ref()), ("e0 fitted", summary.bauer_free.as_ref())].into_iter().filter_map(|(n, f)| f.map(|f| (n, f))).collect();
+            let fits: Vec<(&str, &BauerFit)> = [("e0 held", summary.bauer.as_ref()), ("e0 fitted", summary.bauer_free.as_ref())].into_iter().filter_map(|(n, f)| f.map(|f| (n, f))).collect();
             if let Err(e) = crate::output::plot::compression(&dir.join("compression"), &scene.name, &summary.compression, &fits) {
                 eprintln!("warning: {e:#}");
             }

@@ -134,6 +134,10 @@ fn refused(name: &str, text: &str) -> String {
     stderr(&o)
 }
 
+fn oedometer() -> String {
+    std::fs::read_to_string(common::scene_path("oedometer.toml")).unwrap()
+}
+
 fn two_spheres() -> String {
     std::fs::read_to_string(common::scene_path("two_spheres.toml")).unwrap()
 }
@@ -153,6 +157,9 @@ fn malformed_scenes_get_one_line_naming_the_key_and_the_fix() {
         ),
         ("wrong_type.toml", base.replace("duration = 2.5e-3", "duration = \"long\""), "duration"),
         ("unused_parameter.toml", base.replace("damping = \"none\"", "damping = \"none\"\nc_n = 1.0"), "model.c_n"),
+        ("speed_threshold.toml", base.replace("[model]", "[model]\nv_slip = 1.0e-3"), "model.v_slip = 0.001: is no longer used"),
+        ("seating_above_p0.toml", oedometer().replace("seating_pressure = 1.0e3", "seating_pressure = 2.0e4"), "seating_pressure = 20000: is not below p0"),
+        ("two_ke_criteria.toml", oedometer().replace("ke_ratio = 1.0e-3", "ke_ratio = 1.0e-3\nke_per_grain = 1.0e-12"), "ke_ratio"),
     ];
     for (name, text, key) in cases {
         let err = refused(name, &text);

@@ -45,10 +45,11 @@ pub fn contact_tangential_velocity<T: Real>(g: &Geometry<T>, k: &Kinematics<T>) 
 ///
 /// - **static**: an elastic spring `xi` (history, m), rotated into the tangent plane and grown
 ///   by `v_t elapsed`, gives `F_t = -k_t xi - eta_t v_t`; it cancels the applied tangential
-///   force (eq. 10) as long as `|F_t| <= mu_s |F_n|` (`max(mu_s, mu_k)`: see below). Its dashpot `eta_t = 2 zeta sqrt(k_t m_t)`
-///   is the fraction `zeta` (`static_damping`) of the critical damping of the contact's
-///   tangential mass `1/m_t = 1/m_i + R'_i^2/I_i + 1/m_j + R'_j^2/I_j`, so that the spring, a
-///   stand-in for the paper's rigid constraint, does not ring.
+///   force (eq. 10) as long as `|F_t| <= mu_s |F_n|` (`max(mu_s, mu_k)`: see below). Its
+///   dashpot `eta_t = 2 zeta sqrt(k_t m_t)` is the fraction `zeta` (`static_damping`) of the
+///   critical damping of the contact's tangential mass `1/m_t = 1/m_i + R'_i^2/I_i + 1/m_j +
+///   R'_j^2/I_j`, so that the spring, a stand-in for the paper's rigid constraint, does not
+///   ring.
 /// - **sliding**: once the spring's own Coulomb test fails, the contact slides: `F_t` is
 ///   capped at `mu_k |F_n|` (eq. 5) along the spring and the spring is rescaled to the cap.
 ///   The `sliding` flag (history) keeps the cap at `mu_k` until the spring unloads below it,

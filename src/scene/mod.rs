@@ -273,7 +273,7 @@ pub struct BridgeLimits {
     pub reach: f64,
 }
 
-/// Default damping of seed 000's static spring, as a fraction of critical (-).
+/// Default damping of seed 000's static and rolling springs, as a fraction of critical (-).
 pub const DEFAULT_STATIC_DAMPING: f64 = 0.3;
 /// Default tangential-to-normal stiffness ratio for the linear law (the classic 2/7).
 pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
