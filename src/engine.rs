@@ -20,7 +20,7 @@ pub enum SimError {
         capacity: usize,
     },
     /// The state became non-finite, overlaps ran away, or energy grew with no input.
-    #[error("unstable at step {step} (t = {time:.6e} s): {what} (grain {grain}); fix: lower simulation.dt to {suggested_dt:.3e} s or less")]
+    #[error("unstable at step {step} (t = {time:.6e} s): {what} (grain {grain}); fix: lower simulation.dt to {suggested_dt:.3e} s or less{also}")]
     Unstable {
         /// Step at which it was seen.
         step: u64,
@@ -32,6 +32,8 @@ pub enum SimError {
         grain: u32,
         /// A step that should be stable (s).
         suggested_dt: f64,
+        /// A second fix, when the step may not be the cause ("" otherwise), starting with ", ".
+        also: &'static str,
     },
 }
 

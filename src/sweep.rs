@@ -206,7 +206,13 @@ pub fn gather(sweep: &Sweep, out: &Path) -> anyhow::Result<Table> {
     for p in &sweep.points {
         let path = Sweep::point_dir(out, p).join("summary.json");
         let row = match std::fs::read_to_string(&path) {
-            Err(_) => Row { point: p.clone(), e0: None, h_s: None, eta: None, note: Some("not run yet".into()) },
+            Err(_) => {
+                let note = match std::fs::read_to_string(Sweep::point_dir(out, p).join(ERROR_FILE)) {
+                    Ok(e) => format!("failed: {}", e.lines().next().unwrap_or("")),
+                    Err(_) => "not run yet".into(),
+                };
+                Row { point: p.clone(), e0: None, h_s: None, eta: None, note: Some(note) }
+            }
             Ok(text) => {
                 let v: serde_json::Value = serde_json::from_str(&text).with_context(|| format!("{}: unreadable summary", path.display()))?;
                 let est = |key: &str, scale: f64| -> Option<Estimate> {
@@ -230,22 +236,35 @@ pub fn done(out: &Path, p: &Point) -> bool {
     Sweep::point_dir(out, p).join("summary.json").exists()
 }
 
-/// Runs one point into its directory: the point's scene is written there as `scene.toml`; a
-/// point with a checkpoint and no summary resumes; a finished point is left alone.
+/// The file in a point's directory that holds why its last run failed (removed when it runs
+/// again), so that the gathered table can say so.
+pub const ERROR_FILE: &str = "error.txt";
+
+/// Runs one point into its directory, recording a failure in [`ERROR_FILE`] there.
 pub fn run_point(sweep: &Sweep, out: &Path, p: &Point, precision: &str) -> anyhow::Result<()> {
     if done(out, p) {
         return Ok(());
     }
     let dir = Sweep::point_dir(out, p);
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let error = dir.join(ERROR_FILE);
+    let _ = std::fs::remove_file(&error);
+    run_point_in(sweep, &dir, p, precision).inspect_err(|e| {
+        let _ = std::fs::write(&error, format!("{e:#}\n"));
+    })
+}
+
+/// [`run_point`] in its created directory: the point's scene is written there as
+/// `scene.toml`; a point with a checkpoint and no summary resumes.
+fn run_point_in(sweep: &Sweep, dir: &Path, p: &Point, precision: &str) -> anyhow::Result<()> {
     let scene_file = dir.join("scene.toml");
     let text = sweep.scene_for(p)?;
     let checkpoint = dir.join(crate::checkpoint::FILE);
     if checkpoint.exists() && std::fs::read_to_string(&scene_file).ok().as_deref() == Some(text.as_str()) {
-        crate::runner::resume(&dir, Some(&scene_file), Some(precision), false)?;
+        crate::runner::resume(dir, Some(&scene_file), Some(precision), false)?;
     } else {
         std::fs::write(&scene_file, &text).with_context(|| format!("cannot write {}", scene_file.display()))?;
-        crate::runner::run_cpu(&scene_file, precision, Some(&dir), false)?;
+        crate::runner::run_cpu(&scene_file, precision, Some(dir), false)?;
     }
     Ok(())
 }

@@ -78,3 +78,20 @@ fn a_bad_parameter_path_is_refused_before_anything_runs() {
     assert!(err.contains("material.clay.mu_s") && err.contains("fix:"), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
+
+#[test]
+fn a_failed_point_is_gathered_with_its_error() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(common::scene_path("two_spheres.toml"), dir.path().join("two.toml")).unwrap();
+    let sweep = dir.path().join("dt.toml");
+    // The second point stops as unstable once the spheres touch (any overlap is too much).
+    std::fs::write(&sweep, "scene = \"two.toml\"\n[parameters]\n\"simulation.max_overlap\" = [0.2, 1.0e-9]\n").unwrap();
+    let out = dir.path().join("runs");
+    let g = grains(&["sweep", sweep.to_str().unwrap(), "--out", out.to_str().unwrap(), "--json"]);
+    assert_eq!(g.status.code(), Some(1), "a failed point fails the sweep");
+    let table: serde_json::Value = serde_json::from_slice(&g.stdout).unwrap();
+    let note = table["rows"][1]["note"].as_str().unwrap();
+    println!("point 1: {note}");
+    assert!(note.starts_with("failed:") && note.contains("simulation.max_overlap"), "{note}");
+    assert_ne!(table["rows"][0]["note"].as_str(), Some("not run yet"), "point 0 ran");
+}

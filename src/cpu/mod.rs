@@ -266,6 +266,7 @@ impl<T: Real> CpuEngine<T> {
             what: "non-finite position or velocity".into(),
             grain: self.id[grain],
             suggested_dt: self.suggested_dt,
+            also: "",
         }
     }
 

@@ -274,14 +274,16 @@ impl Guard {
     }
 
     fn check(&self, s: &Stats) -> Result<(), SimError> {
-        let unstable = |what: String, grain: u32| SimError::Unstable { step: s.step, time: s.time, what, grain, suggested_dt: self.suggested_dt };
+        let unstable = |what: String, grain: u32, also: &'static str| SimError::Unstable { step: s.step, time: s.time, what, grain, suggested_dt: self.suggested_dt, also };
         if let Some(g) = s.non_finite_grain {
-            return Err(unstable("non-finite position or velocity".into(), g));
+            return Err(unstable("non-finite position or velocity".into(), g, ""));
         }
         if s.max_overlap > self.max_overlap {
+            // A large overlap can be a load the contacts cannot carry as well as too long a step.
             return Err(unstable(
                 format!("overlap {:.3} of the radius exceeds simulation.max_overlap = {}", s.max_overlap, self.max_overlap),
                 s.max_overlap_grain,
+                ", or, if the grains carry more load than their stiffness allows, stiffen them (youngs_modulus) or lower the pressure",
             ));
         }
         let in_play = self.kinetic_elastic0 + (s.gravity_energy - self.gravity0).abs() + s.external_work.abs() + s.kinetic_energy() * 1e-6;
@@ -290,6 +292,7 @@ impl Guard {
             return Err(unstable(
                 format!("mechanical energy grew by {growth:.3e} J with {in_play:.3e} J in play and no input"),
                 s.max_overlap_grain,
+                "",
             ));
         }
         Ok(())
