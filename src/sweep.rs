@@ -194,7 +194,7 @@ impl Table {
             }
         }
         if let Some(l) = &self.power_law {
-            s.push_str(&format!("power law across the points: h_s = {} eta^{} MPa (seed 000: a = 0.068(4), b = -9.88(3))\n", l.a.concise(), l.b.concise()));
+            s.push_str(&format!("power law across the points: {} (seed 000: {})\n", l.line(), crate::analysis::seed000::POWER_LAW.line()));
         }
         s
     }

@@ -310,6 +310,13 @@ pub struct PowerLaw {
     pub b: Estimate,
 }
 
+impl PowerLaw {
+    /// `h_s = 0.068(4) eta^-9.88(3) MPa`, for a law fitted to h_s in MPa.
+    pub fn line(&self) -> String {
+        format!("h_s = {} eta^{} MPa", self.a.concise(), self.b.concise())
+    }
+}
+
 /// Fits `y = a x^b` to positive points by least squares on `ln y = ln a + b ln x`.
 pub fn fit_power_law(points: &[(f64, f64)]) -> Result<PowerLaw, FitError> {
     if points.len() < 3 {

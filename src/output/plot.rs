@@ -152,7 +152,7 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
             chart
                 .draw_series(LineSeries::new(line, &BLUE))
                 .map_err(err)?
-                .label(format!("h_s = {} eta^{} MPa", l.a.concise(), l.b.concise()))
+                .label(l.line())
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE));
         }
         if paper {
@@ -162,7 +162,7 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
             chart
                 .draw_series(DashedLineSeries::new(line, 6, 4, grey.stroke_width(2)))
                 .map_err(err)?
-                .label("seed 000: h_s = 0.068(4) eta^-9.88(3) MPa")
+                .label(format!("seed 000: {}", l.line()))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey));
             chart
                 .draw_series(published.iter().map(|(eta, h)| ErrorBar::new_vertical(eta.value, (h.value - h.error).max(y_lo), h.value, h.value + h.error, grey.filled(), 6)))

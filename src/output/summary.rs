@@ -175,7 +175,7 @@ impl Summary {
             let _ = writeln!(s, "  Bauer's law, e0 fitted: {}; correlations ln h_s-eta {:.3}, ln h_s-e0 {}, eta-e0 {}", b.line(), c.ln_h_s_eta, r(c.ln_h_s_e0), r(c.eta_e0));
         }
         if let Some((p, a, b)) = self.bauer_profile.as_ref().and_then(|p| Some((p, p.points.first()?, p.points.last()?))) {
-            let law = p.power_law.map_or(String::new(), |l| format!("; along it h_s = {} eta^{} MPa (seed 000's sweep: 0.068(4) eta^-9.88(3))", l.a.concise(), l.b.concise()));
+            let law = p.power_law.map_or(String::new(), |l| format!("; along it {} (seed 000's sweep: {})", l.line(), crate::analysis::seed000::POWER_LAW.line()));
             let _ = writeln!(s, "  e0 profile: e0 {:.4} -> {:.4} moves h_s {:.3e} -> {:.3e} MPa and eta {:.3} -> {:.3}{law}", a.e0, b.e0, a.h_s / 1e6, b.h_s / 1e6, a.eta, b.eta);
         }
         let pf = self.final_state.packing_fraction.map_or("n/a".to_string(), |p| format!("{p:.4}"));
