@@ -1,6 +1,11 @@
 // One invocation computes one grain's contacts with every wall (the grain-grain laws with an
-// infinite partner), and each workgroup sums the forces its grains put on each wall. The w of
-// wall_force and wall_torque count the grain's wall contacts sliding and rolling.
+// infinite partner), and each workgroup sums the forces its grains put on each wall (row
+// entries 0..MAX_WALLS: xyz force, w contacts) and, for servo walls (WALL_RESPONSE), their
+// contacts' normal tangent stiffness and damping coefficient (entries MAX_WALLS..: x N/m,
+// y N s/m). The w of wall_force and wall_torque count the grain's wall contacts sliding and
+// rolling.
+override WALL_RESPONSE: bool = false;
+
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
 @group(0) @binding(2) var<storage, read> pos: array<vec4<f32>>;
@@ -24,7 +29,9 @@ fn wall_contacts(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
     var torque = vec3<f32>(0.0);
     var sliding = 0.0;
     var rolling = 0.0;
+    var response: array<vec2<f32>, MAX_WALLS>;
     for (var w = 0u; w < MAX_WALLS; w++) {
+        response[w] = vec2<f32>(0.0);
         reaction[lid * MAX_WALLS + w] = vec4<f32>(0.0);
     }
     if (live) {
@@ -59,12 +66,26 @@ fn wall_contacts(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
             reaction[lid * MAX_WALLS + w] = vec4<f32>(-f.f_i, 1.0);
             sliding += select(0.0, 1.0, f.regime == REGIME_SLIDING);
             rolling += select(0.0, 1.0, f.regime == REGIME_ROLLING);
+            if (WALL_RESPONSE) {
+                response[w] = vec2<f32>(normal_stiffness(c, g), normal_damping(c, g));
+            }
         }
         wall_force[i] = vec4<f32>(force, sliding);
         wall_torque[i] = vec4<f32>(torque, rolling);
     }
+    let row = (wid.y * nwg.x + wid.x) * 2u * MAX_WALLS;
+    reduce_walls(lid, row);
+    if (WALL_RESPONSE) {
+        for (var w = 0u; w < MAX_WALLS; w++) {
+            reaction[lid * MAX_WALLS + w] = vec4<f32>(response[w], 0.0, 0.0);
+        }
+        reduce_walls(lid, row + MAX_WALLS);
+    }
+}
+
+// Sums `reaction` over the workgroup's lanes by a fixed-order tree into wall_partials[at..].
+fn reduce_walls(lid: u32, at: u32) {
     workgroupBarrier();
-    // Fixed-order tree over the workgroup's lanes.
     for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
         if (lid < stride) {
             for (var w = 0u; w < MAX_WALLS; w++) {
@@ -74,9 +95,9 @@ fn wall_contacts(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         workgroupBarrier();
     }
     if (lid == 0u) {
-        let row = (wid.y * nwg.x + wid.x) * MAX_WALLS;
         for (var w = 0u; w < MAX_WALLS; w++) {
-            wall_partials[row + w] = reaction[w];
+            wall_partials[at + w] = reaction[w];
         }
     }
+    workgroupBarrier();
 }

@@ -1,5 +1,6 @@
-// One workgroup sums the per-workgroup wall forces in a fixed order into each wall's total
-// (xyz: force the grains exert, w: contacts).
+// One workgroup sums the per-workgroup wall rows in a fixed order into each wall's totals:
+// entries 0..MAX_WALLS (xyz: force the grains exert, w: contacts), then MAX_WALLS.. (the
+// contacts' summed stiffness and damping, for servo walls; zero otherwise).
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> wall_partials: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> wall_reaction: array<vec4<f32>>;
@@ -8,11 +9,18 @@ var<workgroup> acc: array<vec4<f32>, 512>;
 
 @compute @workgroup_size(64)
 fn wall_reduce(@builtin(local_invocation_index) lid: u32) {
-    let rows = arrayLength(&wall_partials) / MAX_WALLS;
+    for (var half = 0u; half < 2u; half++) {
+        reduce_half(lid, half * MAX_WALLS);
+    }
+}
+
+fn reduce_half(lid: u32, first: u32) {
+    let row = 2u * MAX_WALLS;
+    let rows = arrayLength(&wall_partials) / row;
     for (var w = 0u; w < MAX_WALLS; w++) {
         var s = vec4<f32>(0.0);
         for (var r = lid; r < rows; r += WG) {
-            s += wall_partials[r * MAX_WALLS + w];
+            s += wall_partials[r * row + first + w];
         }
         acc[lid * MAX_WALLS + w] = s;
     }
@@ -27,7 +35,8 @@ fn wall_reduce(@builtin(local_invocation_index) lid: u32) {
     }
     if (lid == 0u) {
         for (var w = 0u; w < MAX_WALLS; w++) {
-            wall_reaction[w] = acc[w];
+            wall_reaction[first + w] = acc[w];
         }
     }
+    workgroupBarrier();
 }

@@ -39,6 +39,10 @@ pub struct CheckpointHeader {
     pub identity: RunIdentity,
     /// Where the run stands.
     pub progress: crate::protocol::Progress,
+    /// The output files a resumed run continues, by name in the run directory, with their
+    /// length in bytes at the checkpoint: what was written after it is cut off on resuming.
+    #[serde(default)]
+    pub files: Vec<(String, u64)>,
 }
 
 /// An engine's state as named arrays.

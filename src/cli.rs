@@ -50,7 +50,9 @@ pub enum BenchPart {
     Throughput,
     /// Wall time against error over a ladder of time steps.
     Ladder,
-    /// Both.
+    /// Steps per second of small scenes (280, 1200 and 10^4 grains), dispatch-bound on a GPU.
+    Small,
+    /// Throughput and ladder (not the small scenes).
     All,
 }
 

@@ -21,7 +21,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             match resume {
                 Some(dir) => {
                     let precision = precision.map(|p| if p == Precision::F32 { "f32" } else { "f64" });
-                    report(&pool.install(|| grains::runner::resume(&dir, scene.as_deref(), precision, progress_bar(json)))?, json)
+                    report(&pool.install(|| grains::runner::resume(&dir, scene.as_deref(), precision, adapter.as_deref(), progress_bar(json)))?, json)
                 }
                 None => {
                     let path = scene.expect("clap requires a scene without --resume");
@@ -35,7 +35,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                         let mut engine = engine_for(&scene, backend, adapter.as_deref(), precision, json)?;
                         let start = Progress::start(&scene, engine.as_mut());
                         let identity = grains::runner::identity(&path, engine.as_ref())?;
-                        grains::runner::execute(&scene, engine.as_mut(), out.as_deref(), start, identity, false, progress_bar(json))
+                        grains::runner::execute(&scene, engine.as_mut(), out.as_deref(), start, identity, None, progress_bar(json))
                     })?;
                     report(&summary, json)
                 }
@@ -158,8 +158,9 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 threads,
                 work,
                 repeats: repeats as usize,
-                throughput: part != BenchPart::Ladder,
-                ladder: part != BenchPart::Throughput,
+                throughput: matches!(part, BenchPart::Throughput | BenchPart::All),
+                ladder: matches!(part, BenchPart::Ladder | BenchPart::All),
+                small: part == BenchPart::Small,
                 cache: cache.unwrap_or_else(grains::bench::bed::default_cache),
                 adapter,
                 progress: !json,

@@ -302,6 +302,11 @@ pub trait Engine {
     fn memory_bytes(&self) -> u64;
     /// Starts or stops timing each phase of the step; a no-op where the backend cannot.
     fn set_profiling(&mut self, _on: bool) {}
+    /// Kernel dispatches recorded since the engine was made, where the backend records them
+    /// (the GPU); `None` otherwise.
+    fn dispatches(&self) -> Option<u64> {
+        None
+    }
     /// Seconds spent in each phase while profiling, by phase name; empty where the backend
     /// does not time its phases.
     fn phase_seconds(&self) -> Vec<(&'static str, f64)> {

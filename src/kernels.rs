@@ -77,6 +77,7 @@ macro_rules! kernel {
 /// Every kernel, in the order a rebuilding step runs them.
 pub const KERNELS: &[Kernel] = &[
     kernel!("drift", BASE, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "vel": Read, "omega": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "control": ReadWrite]),
+    kernel!("servo_move", BASE, ["params": Uniform, "phase": Phase, "walls": ReadWrite, "wall_reaction": Read, "servo": ReadWrite]),
     kernel!("decide_rebuild", BASE, ["params": Uniform, "control": ReadWrite, "args": ReadWrite]),
     kernel!("save_starts", BASE, ["params": Uniform, "pair_start": Read, "old_start": ReadWrite]),
     kernel!("save_pairs", BASE, ["params": Uniform, "pair_j": Read, "hist": Read, "old_j": ReadWrite, "old_hist": ReadWrite, "control": Read]),

@@ -18,6 +18,7 @@ pub mod periodic;
 pub mod protocol;
 pub mod real;
 pub mod runner;
+pub mod schedule;
 pub mod scene;
 pub mod sweep;
 pub mod timestep;

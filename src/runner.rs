@@ -26,15 +26,26 @@ pub fn identity(scene_file: &Path, engine: &dyn Engine) -> anyhow::Result<RunIde
 pub fn cpu_engine(scene: &Scene, precision: &str) -> anyhow::Result<Box<dyn Engine>> {
     Ok(match precision {
         "f32" => Box::new(CpuEngine::<f32>::new(scene)?),
-        _ => Box::new(CpuEngine::<f64>::new(scene)?),
+        "f64" => Box::new(CpuEngine::<f64>::new(scene)?),
+        other => anyhow::bail!("precision `{other}`: the CPU engine computes in f32 or f64; fix: give --precision f32 or f64"),
     })
+}
+
+/// The engine a checkpoint was written by: its backend ("cpu" or "gpu", on the adapter whose
+/// name contains `adapter`, or the best one) and precision.
+fn engine_of(scene: &Scene, id: &RunIdentity, adapter: Option<&str>) -> anyhow::Result<Box<dyn Engine>> {
+    match id.backend.as_str() {
+        "cpu" => cpu_engine(scene, &id.precision),
+        "gpu" => Ok(Box::new(crate::gpu::GpuEngine::new(crate::gpu::open(adapter)?, scene)?)),
+        other => anyhow::bail!("the checkpoint was written by a `{other}` backend, which this grains lacks; fix: resume with the grains that wrote it"),
+    }
 }
 
 /// Runs the stages from `start` on, recording into `out` (with checkpoints at every stage
 /// end), and writes `summary.json` last: a directory with a summary holds a finished run.
-pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start: Progress, identity: RunIdentity, resumed: bool, progress_bar: bool) -> anyhow::Result<Summary> {
-    let rec = match (out, resumed) {
-        (Some(dir), true) => RunRecorder::resume(dir, start.next_stage, progress_bar)?,
+pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start: Progress, identity: RunIdentity, resumed_from: Option<&CheckpointHeader>, progress_bar: bool) -> anyhow::Result<Summary> {
+    let rec = match (out, resumed_from) {
+        (Some(dir), Some(header)) => RunRecorder::resume(dir, header, progress_bar)?,
         _ => RunRecorder::new(out, progress_bar)?,
     };
     let mut rec = match out {
@@ -84,12 +95,13 @@ pub fn run_cpu(scene_file: &Path, precision: &str, out: Option<&Path>, progress_
     let mut engine = cpu_engine(&scene, precision)?;
     let start = Progress::start(&scene, engine.as_mut());
     let id = identity(scene_file, engine.as_ref())?;
-    execute(&scene, engine.as_mut(), out, start, id, false, progress_bar)
+    execute(&scene, engine.as_mut(), out, start, id, None, progress_bar)
 }
 
-/// Continues the run of `dir` from its checkpoint (CPU), into `dir`. The scene is the one the
-/// checkpoint names unless `scene_file` is given; it must be unchanged.
-pub fn resume(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, progress_bar: bool) -> anyhow::Result<Summary> {
+/// Continues the run of `dir` from its checkpoint, into `dir`, on the backend and precision
+/// that wrote it (a GPU checkpoint on the adapter `adapter` names, or the best one). The scene
+/// is the one the checkpoint names unless `scene_file` is given; it must be unchanged.
+pub fn resume(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, adapter: Option<&str>, progress_bar: bool) -> anyhow::Result<Summary> {
     let (header, state): (CheckpointHeader, EngineState) = crate::checkpoint::read(&dir.join(crate::checkpoint::FILE))?;
     let id = &header.identity;
     let path = scene_file.map(Path::to_path_buf).unwrap_or_else(|| id.scene_file.clone().into());
@@ -101,8 +113,8 @@ pub fn resume(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, pr
     if precision.is_some_and(|p| p != id.precision) {
         anyhow::bail!("the checkpoint was written in {}; fix: drop --precision or give --precision {}", id.precision, id.precision);
     }
-    let mut engine = cpu_engine(&scene, &id.precision)?;
+    let mut engine = engine_of(&scene, id, adapter)?;
     engine.restore(&state).with_context(|| format!("cannot resume from {}", dir.display()))?;
     let identity = identity(&path, engine.as_ref())?;
-    execute(&scene, engine.as_mut(), Some(dir), header.progress, identity, true, progress_bar)
+    execute(&scene, engine.as_mut(), Some(dir), header.progress.clone(), identity, Some(&header), progress_bar)
 }

@@ -261,7 +261,7 @@ fn run_point_in(sweep: &Sweep, dir: &Path, p: &Point, precision: &str) -> anyhow
     let text = sweep.scene_for(p)?;
     let checkpoint = dir.join(crate::checkpoint::FILE);
     if checkpoint.exists() && std::fs::read_to_string(&scene_file).ok().as_deref() == Some(text.as_str()) {
-        crate::runner::resume(dir, Some(&scene_file), Some(precision), false)?;
+        crate::runner::resume(dir, Some(&scene_file), Some(precision), None, false)?;
     } else {
         std::fs::write(&scene_file, &text).with_context(|| format!("cannot write {}", scene_file.display()))?;
         crate::runner::run_cpu(&scene_file, precision, Some(dir), false)?;

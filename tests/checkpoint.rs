@@ -1,6 +1,6 @@
 //! Checkpoint and resume: a run stopped after a stage and resumed from its checkpoint ends
-//! bitwise where the uninterrupted run ends (CPU backend), from the library and from the
-//! command line.
+//! bitwise where the uninterrupted run ends, on the CPU and the GPU, from the library and from
+//! the command line.
 
 mod common;
 
@@ -61,13 +61,27 @@ kind = "run"
 duration = 2.0e-3
 "#;
 
-/// Keeps the first checkpoint in memory and stops the run there.
-struct StopAfterFirst {
+/// SCENE with a checkpoint at every statistics read inside a stage.
+fn checkpointing_within_stages() -> String {
+    format!("{SCENE}[output]\ncheckpoint_interval = 1.0e-9\n")
+}
+
+/// Keeps checkpoint number `at` (1 = the first offered) in memory, passing every one to the
+/// inner recorder, and stops the run there.
+struct StopAt {
     inner: RunRecorder,
+    at: usize,
+    seen: usize,
     saved: Option<(Progress, EngineState)>,
 }
 
-impl Recorder for StopAfterFirst {
+impl StopAt {
+    fn new(inner: RunRecorder, at: usize) -> Self {
+        StopAt { inner, at, seen: 0, saved: None }
+    }
+}
+
+impl Recorder for StopAt {
     fn stats(&mut self, stage: &str, s: &Stats) -> anyhow::Result<()> {
         self.inner.stats(stage, s)
     }
@@ -79,12 +93,17 @@ impl Recorder for StopAfterFirst {
     }
     fn progress(&mut self, _: &str, _: u64, _: u64) {}
     fn checkpoint(&mut self, progress: &Progress, engine: &dyn Engine) -> anyhow::Result<()> {
+        self.inner.checkpoint(progress, engine)?;
+        self.seen += 1;
+        if self.seen < self.at {
+            return Ok(());
+        }
         self.saved = Some((progress.clone(), engine.save().unwrap()));
-        anyhow::bail!("interrupted after stage {}", progress.next_stage)
+        anyhow::bail!("interrupted at checkpoint {} (stage {}, inside it: {})", self.seen, progress.next_stage, progress.in_stage.is_some())
     }
 }
 
-fn bits(e: &CpuEngine<f64>) -> Vec<u64> {
+fn bits(e: &dyn Engine) -> Vec<u64> {
     let f = e.frame(true);
     let mut v: Vec<u64> = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|x| x.map(f64::to_bits)).collect();
     v.extend(f.orientation.unwrap().iter().flat_map(|q| q.map(f64::to_bits)));
@@ -92,60 +111,85 @@ fn bits(e: &CpuEngine<f64>) -> Vec<u64> {
     v
 }
 
-#[test]
-fn a_resumed_run_ends_bitwise_where_the_uninterrupted_one_does() {
-    let scene = common::parse(SCENE);
-    let mut whole: CpuEngine<f64> = common::engine(&scene);
-    let full = protocol::run(&scene, &mut whole, &mut RunRecorder::new(None, false).unwrap()).unwrap();
+/// Runs `text` whole on one engine, and stopped at checkpoint `at` on another whose checkpoint
+/// goes through the file format into a third that never ran; the third must end bitwise where
+/// the first did, with the same stage results. Returns whether the stop was inside a stage.
+fn resume_ends_bitwise(text: &str, at: usize, make: &dyn Fn(&grains::scene::Scene) -> Box<dyn Engine>) -> bool {
+    let scene = common::parse(text);
+    let mut whole = make(&scene);
+    let full = protocol::run(&scene, whole.as_mut(), &mut RunRecorder::new(None, false).unwrap()).unwrap();
 
-    let mut first: CpuEngine<f64> = common::engine(&scene);
-    let mut stopper = StopAfterFirst { inner: RunRecorder::new(None, false).unwrap(), saved: None };
-    let err = protocol::run(&scene, &mut first, &mut stopper).unwrap_err();
-    assert!(err.to_string().contains("interrupted after stage 1"));
+    let mut first = make(&scene);
+    let mut stopper = StopAt::new(RunRecorder::new(None, false).unwrap(), at);
+    let err = protocol::run(&scene, first.as_mut(), &mut stopper).unwrap_err();
+    assert!(err.to_string().contains(&format!("interrupted at checkpoint {at}")), "{err}");
     let (progress, state) = stopper.saved.unwrap();
+    let inside = progress.in_stage.is_some();
 
-    // Through the file format, into an engine that never ran.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join(grains::checkpoint::FILE);
-    let id = RunIdentity { scene_file: "test.toml".into(), scene_hash: 0, backend: "cpu".into(), precision: "f64".into() };
-    grains::checkpoint::write(&path, &CheckpointHeader { identity: id, progress }, &state).unwrap();
+    let id = RunIdentity { scene_file: "test.toml".into(), scene_hash: 0, backend: whole.backend().into(), precision: whole.precision().into() };
+    grains::checkpoint::write(&path, &CheckpointHeader { identity: id, progress, files: Vec::new() }, &state).unwrap();
     let (header, state): (CheckpointHeader, EngineState) = grains::checkpoint::read(&path).unwrap();
-    let mut resumed: CpuEngine<f64> = common::engine(&scene);
+    let mut resumed = make(&scene);
     resumed.restore(&state).unwrap();
-    let results = protocol::run_from(&scene, &mut resumed, &mut RunRecorder::new(None, false).unwrap(), header.progress).unwrap();
+    let results = protocol::run_from(&scene, resumed.as_mut(), &mut RunRecorder::new(None, false).unwrap(), header.progress).unwrap();
 
-    let (a, b) = (bits(&whole), bits(&resumed));
-    println!("{} values compared after {} steps; {} stage results", a.len(), resumed.steps(), results.len());
+    let (a, b) = (bits(whole.as_ref()), bits(resumed.as_ref()));
+    println!("{}, stopped at checkpoint {at} (inside a stage: {inside}): {} values compared after {} steps; {} stage results", whole.backend(), a.len(), resumed.steps(), results.len());
     assert_eq!(results.len(), full.len());
     assert_eq!(whole.steps(), resumed.steps());
     assert_eq!(a, b);
     let (x, y) = (serde_json::to_string(&full).unwrap(), serde_json::to_string(&results).unwrap());
-    let at = x.chars().zip(y.chars()).position(|(a, b)| a != b).unwrap_or(0);
-    assert_eq!(x, y, "first difference at {at}: {} / {}", &x[at.saturating_sub(80)..(at + 40).min(x.len())], &y[at.saturating_sub(80)..(at + 40).min(y.len())]);
+    let d = x.chars().zip(y.chars()).position(|(a, b)| a != b).unwrap_or(0);
+    assert_eq!(x, y, "first difference at {d}: {} / {}", &x[d.saturating_sub(80)..(d + 40).min(x.len())], &y[d.saturating_sub(80)..(d + 40).min(y.len())]);
+    inside
 }
 
 #[test]
+fn a_resumed_run_ends_bitwise_where_the_uninterrupted_one_does() {
+    let cpu = |scene: &grains::scene::Scene| -> Box<dyn Engine> { Box::new(common::engine::<f64>(scene)) };
+    assert!(!resume_ends_bitwise(SCENE, 1, &cpu), "the first checkpoint is the first stage's end");
+    assert!(resume_ends_bitwise(&checkpointing_within_stages(), 5, &cpu), "checkpoint 5 is inside a stage");
+}
+
+#[test]
+fn a_resumed_gpu_run_ends_bitwise_where_the_uninterrupted_one_does() {
+    if common::gpu().is_none() {
+        return;
+    }
+    let gpu = |scene: &grains::scene::Scene| -> Box<dyn Engine> { Box::new(common::gpu_engine(scene).expect("the adapter opened above")) };
+    assert!(!resume_ends_bitwise(SCENE, 1, &gpu));
+    assert!(resume_ends_bitwise(&checkpointing_within_stages(), 5, &gpu));
+}
+
+/// A run stopped inside a stage, with a statistics row written after its checkpoint (as a run
+/// killed between two checkpoints leaves), resumed from the command line: the same summary as
+/// the uninterrupted run, and the same `stats.csv` row for row.
+#[test]
 fn grains_run_resume_continues_a_stopped_run_to_the_same_summary() {
+    let text = checkpointing_within_stages();
     let dir = tempfile::tempdir().unwrap();
     let scene_path = dir.path().join("scene.toml");
-    std::fs::write(&scene_path, SCENE).unwrap();
+    std::fs::write(&scene_path, &text).unwrap();
     let grains = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_grains")).args(args).env("RUST_BACKTRACE", "0").output().unwrap();
     let whole = dir.path().join("whole");
     let o = grains(&["run", scene_path.to_str().unwrap(), "--out", whole.to_str().unwrap(), "--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let full: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
 
-    // A run stopped after its first stage: the library run above, written where the command
-    // line expects it.
+    // The library run, recording where the command line expects it, stopped at a checkpoint
+    // inside the second stage.
     let cut = dir.path().join("cut");
     let scene = grains::scene::load(&scene_path).unwrap();
     let mut e: CpuEngine<f64> = CpuEngine::new(&scene).unwrap();
-    let mut stopper = StopAfterFirst { inner: RunRecorder::new(Some(&cut), false).unwrap(), saved: None };
-    let _ = protocol::run(&scene, &mut e, &mut stopper);
+    let id = RunIdentity { scene_file: scene_path.display().to_string(), scene_hash: grains::checkpoint::fnv1a(text.as_bytes()), backend: "cpu".into(), precision: "f64".into() };
+    let mut stopper = StopAt::new(RunRecorder::new(Some(&cut), false).unwrap().with_checkpoints(&cut, id), 28);
+    let err = protocol::run(&scene, &mut e, &mut stopper).unwrap_err();
+    assert!(err.to_string().contains("stage 1, inside it: true"), "{err}");
     stopper.inner.finish().unwrap();
-    let (progress, state) = stopper.saved.unwrap();
-    let id = RunIdentity { scene_file: scene_path.display().to_string(), scene_hash: grains::checkpoint::fnv1a(SCENE.as_bytes()), backend: "cpu".into(), precision: "f64".into() };
-    grains::checkpoint::write(&cut.join(grains::checkpoint::FILE), &CheckpointHeader { identity: id, progress }, &state).unwrap();
+    let mut csv = std::fs::OpenOptions::new().append(true).open(cut.join("stats.csv")).unwrap();
+    std::io::Write::write_all(&mut csv, b"a row written after the checkpoint\n").unwrap();
 
     let o = grains(&["run", "--resume", cut.to_str().unwrap(), "--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -156,9 +200,10 @@ fn grains_run_resume_continues_a_stopped_run_to_the_same_summary() {
     assert_eq!(full["stages"], resumed["stages"]);
     let rows = |d: &std::path::Path| std::fs::read_to_string(d.join("stats.csv")).unwrap();
     assert_eq!(rows(&whole), rows(&cut), "the resumed CSV continues the stopped one row for row");
+    assert!(cut.join(format!("frames-from-stage1-step{}.mcap", e.steps())).exists(), "frames after the resume go to their own file");
 
     // A changed scene is refused.
-    std::fs::write(&scene_path, SCENE.replace("seed = 21", "seed = 22")).unwrap();
+    std::fs::write(&scene_path, text.replace("seed = 21", "seed = 22")).unwrap();
     let o = grains(&["run", "--resume", cut.to_str().unwrap()]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1));

@@ -7,7 +7,8 @@ mod common;
 
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
-use grains::scene::Scene;
+use grains::schedule::{Op, Schedule};
+use grains::scene::{Integrator, Scene};
 
 /// GPU and CPU f32 loads: the largest difference over the mean contact force. Both compute in
 /// f32 from the same inputs; the GPU may fuse multiply-adds, so they differ by a few ulps of
@@ -65,6 +66,61 @@ fn mean_contact_force(e: &mut CpuEngine<f32>) -> f64 {
     let frame = e.frame(true);
     let c = frame.contacts.unwrap();
     c.iter().map(|r| r.normal_force).sum::<f64>() / c.len().max(1) as f64
+}
+
+/// Checks that the springs of every evaluation in `ops` advance by the drifts since the one
+/// before it (or since the start), as the CPU once counted them in the engine.
+fn assert_elapsed_is_the_drifted_time(ops: &[Op], what: &str) {
+    let mut since = 0.0;
+    for op in ops {
+        match *op {
+            Op::Drift { tau } => since += tau,
+            Op::Forces { elapsed } => {
+                assert!((elapsed - since).abs() <= 1e-12 * since.max(1e-30), "{what}: an evaluation advances the springs by {elapsed:e} s after {since:e} s of drift");
+                since = 0.0;
+            }
+            _ => {}
+        }
+    }
+}
+
+/// The CPU engine runs, and the GPU engine encodes, the operations of one schedule: for each
+/// integrator, with and without statistics read before the first step, both walk the
+/// schedule's prologue (where loads are needed), first step and later steps, and the springs
+/// advance by exactly the time drifted between evaluations.
+#[test]
+fn both_engines_walk_the_schedule_of_each_integrator() {
+    for integrator in [Integrator::VelocityVerlet, Integrator::OptimizedVerlet] {
+        for stats_first in [false, true] {
+            let mut scene = gas(false);
+            scene.integrator = integrator;
+            let schedule = Schedule::new(integrator, scene.time_step.dt);
+            let mut expected = Vec::new();
+            if stats_first || schedule.needs_loads {
+                expected.extend(&schedule.prologue);
+            }
+            expected.extend(&schedule.first);
+            expected.extend(&schedule.step);
+            expected.extend(&schedule.step);
+            let what = format!("{integrator:?}, statistics first: {stats_first}");
+            let walk = |e: &mut dyn Engine| {
+                if stats_first {
+                    e.stats();
+                }
+                e.advance(3).unwrap();
+            };
+            let mut c: CpuEngine<f32> = common::engine(&scene);
+            c.trace_schedule();
+            walk(&mut c);
+            assert_eq!(c.traced(), &expected[..], "{what}: the CPU's operations");
+            assert_elapsed_is_the_drifted_time(c.traced(), &what);
+            let Some(mut g) = common::gpu_engine(&scene) else { return };
+            g.trace_schedule();
+            walk(&mut g);
+            println!("{what}: {} operations walked by both engines", g.traced().len());
+            assert_eq!(g.traced(), c.traced(), "{what}: the GPU's operations");
+        }
+    }
 }
 
 #[test]
@@ -150,7 +206,18 @@ fn integrate_and_the_reductions_match_the_cpu_twins() {
 
 #[test]
 fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
-    for name in ["quickstart.toml", "two_spheres.toml", "sphere_on_plane.toml", "elastic_gas.toml", "pour.toml"] {
+    for name in [
+        "quickstart.toml",
+        "two_spheres.toml",
+        "sphere_on_plane.toml",
+        "elastic_gas.toml",
+        "pour.toml",
+        "oedometer.toml",
+        "oedometer_1200.toml",
+        "oedometer_5000.toml",
+        "dry_iso_100pa.toml",
+        "dry_triaxial.toml",
+    ] {
         let scene = common::shipped(name);
         let Some(mut g) = common::gpu_engine(&scene) else { return };
         let mut c: CpuEngine<f32> = common::engine(&scene);
@@ -164,6 +231,58 @@ fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
         assert!(worst / d_mean < F32_POSITION_TOLERANCE, "{name}");
         assert!((sg.kinetic_energy() - sc.kinetic_energy()).abs() <= F32_STATS_TOLERANCE * sc.kinetic_energy(), "{name}");
     }
+}
+
+/// Servo wall pressures, GPU against CPU f32, relative. The two sum each wall's reaction and
+/// contact stiffness in different orders, so a pressure-controlled wall's speed differs by
+/// ulps and its position by about 1e-6 of a diameter after a thousand steps; at the lightly
+/// loaded start of a compaction a wall's few contacts overlap by about 1e-4 of a diameter, and
+/// Hertz forces grow as h^1.5, so that moves the pressure by some 0.1-1%.
+const SERVO_PRESSURE_TOLERANCE: f64 = 1e-2;
+
+/// Servo walls on the GPU against the CPU f32 twin: 300 grains compacted by six servo planes
+/// (the walls first close at full speed, then feel the grains), then a triaxial leg with the
+/// z planes at a fixed strain rate. While the walls close at full speed the two are bitwise
+/// equal; once they follow their pressures, positions agree to f32 round-off of the sums they
+/// follow, the walls' work and the kinetic energy to the statistics tolerance.
+#[test]
+fn servo_walls_on_the_gpu_follow_the_cpu_twin() {
+    let scene = common::parse(&common::edit(
+        &std::fs::read_to_string(common::scene_path("dry_iso_100pa.toml")).unwrap(),
+        // Seed 001's isotropic compaction with its density of grains, 300 of them.
+        &[("count = 8000", "count = 300"), ("max = [28.0e-3, 28.0e-3, 28.0e-3]", "max = [9.4e-3, 9.4e-3, 9.4e-3]")],
+    ));
+    let Some(mut g) = common::gpu_engine(&scene) else { return };
+    let mut c: CpuEngine<f32> = common::engine(&scene);
+    let d_mean = 2.0 * scene.grains.radius.iter().sum::<f64>() / scene.grains.len() as f64;
+    let compare = |g: &mut grains::gpu::GpuEngine, c: &mut CpuEngine<f32>, leg: &str| {
+        let (sg, sc) = (g.stats(), c.stats());
+        let (mut worst, mut worst_p): (f64, f64) = (0.0, 0.0);
+        for (a, b) in sg.walls.iter().zip(&sc.walls).filter(|(a, _)| a.position.is_some()) {
+            worst = worst.max((a.position.unwrap() - b.position.unwrap()).abs());
+            let (pa, pb) = (a.pressure.unwrap(), b.pressure.unwrap());
+            worst_p = worst_p.max((pa - pb).abs() / pb.abs().max(1.0));
+        }
+        println!(
+            "{leg}: walls differ by {:.2e} of a diameter, their pressures by {worst_p:.2e}; {} / {} contacts; work gpu {:.6e} cpu {:.6e} J; KE gpu {:.6e} cpu {:.6e}",
+            worst / d_mean, sg.wall_contacts, sc.wall_contacts, sg.external_work, sc.external_work, sg.kinetic_energy(), sc.kinetic_energy()
+        );
+        assert!(sc.wall_contacts > 0, "{leg}: the walls reached the grains");
+        assert!(worst / d_mean < F32_POSITION_TOLERANCE, "{leg}: wall positions");
+        assert!(worst_p < SERVO_PRESSURE_TOLERANCE, "{leg}: wall pressures");
+        assert!((sg.external_work - sc.external_work).abs() <= F32_STATS_TOLERANCE * sc.external_work.abs(), "{leg}: the walls' work");
+        assert!((sg.kinetic_energy() - sc.kinetic_energy()).abs() <= F32_STATS_TOLERANCE * sc.kinetic_energy(), "{leg}: kinetic energy");
+    };
+    for e in [&mut g as &mut dyn Engine, &mut c] {
+        e.set_servo(Some(100.0), None);
+        e.advance(3000).unwrap();
+    }
+    compare(&mut g, &mut c, "isotropic");
+    for e in [&mut g as &mut dyn Engine, &mut c] {
+        e.set_servo(None, Some(0.5));
+        e.advance(1000).unwrap();
+    }
+    compare(&mut g, &mut c, "triaxial");
 }
 
 #[test]

@@ -84,6 +84,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     check_struct!(&m, layout::Wall, "Wall", [kind, material, _pad0, _pad1, point, normal, velocity, piston]);
     check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite]);
     check_struct!(&m, layout::DispatchArgs, "DispatchArgs", [x, y, z]);
+    check_struct!(&m, layout::Servo, "Servo", [walls_lo, walls_hi, pressure, gain, max_speed, strain_rate, relaxation, work, work_lo, strain]);
     // Constants the host relies on.
     let constant = |name: &str| -> u32 {
         let (_, c) = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("no const {name}"));

@@ -90,6 +90,14 @@ fn normal_elastic(c: PairCoeffs, g: Geometry) -> vec2<f32> {
     return vec2<f32>(params.k_n * g.h, params.k_n);
 }
 
+// Normal tangent stiffness dF_el/dh (N/m): 2 V_eff sqrt(R_eff h) (Hertz), k_n (linear).
+fn normal_stiffness(c: PairCoeffs, g: Geometry) -> f32 {
+    if (NORMAL_LAW == 1u) {
+        return params.k_n;
+    }
+    return 2.0 * c.v_eff * sqrt(g.r_eff * g.h);
+}
+
 // Damping coefficient eta (kg/s): the damping force on i is -eta v_n n.
 fn normal_damping(c: PairCoeffs, g: Geometry) -> f32 {
     if (DAMPING_LAW == 1u) {

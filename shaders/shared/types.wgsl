@@ -62,6 +62,20 @@ struct Wall {
     piston: vec4<f32>,   // mass (kg), area (m^2), target pressure (Pa), external work (J)
 }
 
+// The servo box's control state.
+struct Servo {
+    walls_lo: vec4<u32>, // wall indices of the x_min, x_max, y_min, y_max planes
+    walls_hi: vec4<u32>, // z_min, z_max (z, w unused)
+    pressure: f32,       // target pressure (Pa)
+    gain: f32,           // wall speed per pressure error (m/(s Pa))
+    max_speed: f32,      // m/s
+    strain_rate: f32,    // z planes' strain rate (1/s, closing positive) when strain != 0
+    relaxation: f32,     // fraction of the largest stable gain kept where contacts are stiff
+    work: f32,           // work the planes did on the grains (J), and its rounding error
+    work_lo: f32,
+    strain: u32,         // 1: the z planes are strain-controlled
+}
+
 // Flags and counters the host reads back with the statistics.
 struct Control {
     max_disp2: atomic<u32>,    // bits of the largest squared displacement since the build (f32 >= 0)

@@ -5,6 +5,7 @@
 pub mod bed;
 pub mod ladder;
 pub mod memory;
+pub mod small;
 pub mod throughput;
 
 use crate::engine::Engine;
@@ -34,6 +35,8 @@ pub struct BenchOptions {
     pub throughput: bool,
     /// Run the speed-against-error part.
     pub ladder: bool,
+    /// Run the small-scene part (steps per second at 280, 1200 and 10^4 grains).
+    pub small: bool,
     /// Where the poured bed is cached.
     pub cache: PathBuf,
     /// GPU adapter name (substring); the best one when absent.
@@ -68,6 +71,8 @@ pub struct BenchReport {
     pub throughput: Vec<Throughput>,
     /// Speed against error.
     pub ladder: Option<Ladder>,
+    /// Small scenes.
+    pub small: Vec<small::SmallScene>,
 }
 
 /// This machine.
@@ -137,7 +142,33 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
         }
     }
     let ladder = if opts.ladder { Some(all.install(|| ladder::ladder(&base, &say))?) } else { None };
-    Ok(BenchReport { machine, bed, throughput: rows, ladder })
+    let mut small_rows = Vec::new();
+    if opts.small {
+        let mut scenes: Vec<(String, crate::scene::Scene)> = small::oedometer_scenes()?.into_iter().map(|s| (s.path.display().to_string(), s)).collect();
+        scenes.push(("bench_bed.toml".into(), base.clone()));
+        for (name, scene) in &scenes {
+            for backend in &opts.backends {
+                let precisions: Vec<String> = if backend == "gpu" { vec!["f32".into()] } else { opts.precisions.clone() };
+                for precision in precisions {
+                    let steps = ((2e7 / scene.grains.len() as f64) as u64).clamp(200, 2000);
+                    say(&format!("small scenes: {name} on {backend} {precision}, {} x {steps} steps", opts.repeats));
+                    let row = if backend == "gpu" {
+                        let mut engine = crate::gpu::GpuEngine::new(crate::gpu::open(opts.adapter.as_deref())?, scene)?;
+                        let count = |e: &dyn Engine| e.dispatches();
+                        small::measure(&mut engine, name, steps / 10, steps, opts.repeats, &count)?
+                    } else {
+                        all.install(|| -> anyhow::Result<small::SmallScene> {
+                            let mut engine = crate::runner::cpu_engine(scene, &precision)?;
+                            small::measure(engine.as_mut(), name, steps / 10, steps, opts.repeats, &|e: &dyn Engine| e.dispatches())
+                        })?
+                    };
+                    say(&format!("  {:.0} steps/s", row.steps_per_second));
+                    small_rows.push(row);
+                }
+            }
+        }
+    }
+    Ok(BenchReport { machine, bed, throughput: rows, ladder, small: small_rows })
 }
 
 impl BenchReport {
@@ -173,6 +204,23 @@ impl BenchReport {
                     r.bytes_per_grain,
                     r.peak_rss_bytes.map_or("-".to_string(), |b| format!("{:.0}", b as f64 / (1 << 20) as f64)),
                     shares.join(", ")
+                ));
+            }
+        }
+        if !self.small.is_empty() {
+            s.push_str("\nsmall scenes (from their initial state; the GPU's dispatches per step include the rebuild kernels, empty on steps that keep the list)\n");
+            s.push_str("scene                grains backend prec  steps/s  spread  dispatches/step\n");
+            for r in &self.small {
+                let (lo, hi) = r.repeats.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &x| (lo.min(x), hi.max(x)));
+                s.push_str(&format!(
+                    "{:<20} {:>6} {:<7} {:<4} {:>8.0} {:>6.1}% {:>16}\n",
+                    r.scene,
+                    r.grains,
+                    r.backend,
+                    r.precision,
+                    r.steps_per_second,
+                    50.0 * (hi - lo) / r.steps_per_second,
+                    r.dispatches_per_step.map_or("-".to_string(), |d| format!("{d:.1}"))
                 ));
             }
         }

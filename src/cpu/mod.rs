@@ -30,7 +30,8 @@ use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, Sim
 use crate::model::{normal_potential, rupture_distance, CohesionLaw, ContactForce, ContactModel, PairCoeffs, Regime};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
-use crate::scene::{Integrator, Scene, WallShape};
+use crate::schedule::{Op, Schedule, Trace};
+use crate::scene::{Scene, WallShape};
 use crate::walls::WallGeom;
 use gather::gather_block;
 use grid::{hash_cells, CellGrid};
@@ -42,9 +43,6 @@ use wall_contacts::wall_block;
 
 /// Fraction of the largest stable servo gain used where a wall's contacts are stiff.
 pub const SERVO_RELAXATION: f64 = 0.5;
-
-/// Seed 000's optimised velocity Verlet parameter (eqs. 11-15).
-pub const OVV_XI: f64 = 0.1931833275037836;
 
 /// The piston's dynamic state.
 #[derive(Clone, Copy, Debug)]
@@ -82,7 +80,9 @@ pub struct CpuEngine<T: Real> {
     dt: T,
     /// Step suggested when the state turns non-finite (s).
     suggested_dt: f64,
-    integrator: Integrator,
+    schedule: Schedule,
+    /// The operations run, when tracing.
+    trace: Trace,
     skin: T,
     /// Distance beyond contact that pair detection reaches: the skin plus, for capillary
     /// scenes, the rupture distance of the largest bridge (m).
@@ -124,7 +124,8 @@ pub struct CpuEngine<T: Real> {
     hist: Vec<T>,
     out: Vec<ContactForce<T>>,
     // Clocks.
-    since_eval: T,
+    /// Largest squared displacement of a grain since the last build (m^2), as of the last drift.
+    max_moved2: T,
     forces_valid: bool,
     step: u64,
     time: f64,
@@ -180,7 +181,8 @@ impl<T: Real> CpuEngine<T> {
             gravity: Vec3::of(scene.gravity),
             dt: T::of(scene.time_step.dt),
             suggested_dt: crate::protocol::suggested_dt(scene),
-            integrator: scene.integrator,
+            schedule: Schedule::new(scene.integrator, scene.time_step.dt),
+            trace: Trace::default(),
             skin: T::of(scene.skin),
             detect_reach: T::of(scene.skin + scene.bridges.reach),
             cutoff: T::of(2.0 * r_max + scene.skin + scene.bridges.reach),
@@ -209,7 +211,7 @@ impl<T: Real> CpuEngine<T> {
             pairs: PairList::default(),
             hist: Vec::new(),
             out: Vec::new(),
-            since_eval: T::ZERO,
+            max_moved2: T::ZERO,
             forces_valid: false,
             step: 0,
             time: 0.0,
@@ -253,6 +255,7 @@ impl<T: Real> CpuEngine<T> {
             *at = b.pos;
         }
         self.rebuilds += 1;
+        self.max_moved2 = T::ZERO;
         self.forces_valid = false;
         self.clock.stop(Phase::Remap, t);
         Ok(())
@@ -335,8 +338,8 @@ impl<T: Real> CpuEngine<T> {
     }
 
     /// Runs the force passes: `update_bridges` (capillary scenes), `pair_force`,
-    /// `wall_contacts`, `gather`.
-    fn evaluate_forces(&mut self) {
+    /// `wall_contacts`, `gather`; the springs advance by `elapsed` (s).
+    fn evaluate_forces(&mut self, elapsed: T) {
         let t = self.clock.start();
         if self.slots.layout.bridge {
             self.update_bridges();
@@ -346,10 +349,9 @@ impl<T: Real> CpuEngine<T> {
             coeffs: &self.coeffs,
             n_materials: self.n_materials,
             slots: self.slots,
-            elapsed: self.since_eval,
+            elapsed,
             periodic: self.periodic,
         };
-        self.since_eval = T::ZERO;
         let (pairs, body, prop) = (&self.pairs, &self.body, &self.prop);
         let stride = self.slots.stride;
         let min_blocks = PAR_MIN_PAIRS / pair_force::BLOCK;
@@ -392,9 +394,9 @@ impl<T: Real> CpuEngine<T> {
         self.clock.stop(Phase::Integrate, t);
     }
 
-    /// Drift of every grain (and orientation, and piston) by `tau` (s); rebuilds the
-    /// neighbour list when a grain has moved half the skin since the last build.
-    fn drift(&mut self, tau: T) -> Result<(), SimError> {
+    /// Drift of every grain (and orientation, piston and servo walls) by `tau` (s); notes
+    /// how far the grains have moved since the last build.
+    fn drift(&mut self, tau: T) {
         let t = self.clock.start();
         let moved: Vec<T> = self
             .body
@@ -416,14 +418,50 @@ impl<T: Real> CpuEngine<T> {
             self.external_work -= (p.pressure * p.area * dz).f64();
         }
         self.servo_drift(tau);
-        self.since_eval += tau;
-        let max_moved = moved.into_iter().fold(T::ZERO, T::max);
-        let half = self.skin * T::of(0.5);
+        self.max_moved2 = moved.into_iter().fold(T::ZERO, T::max);
         self.clock.stop(Phase::Integrate, t);
-        if !(max_moved < half * half) {
+    }
+
+    /// Rebuilds the neighbour list when a grain has moved half the skin since the last build
+    /// (a non-finite displacement rebuilds too, and the rebuild reports it).
+    fn rebuild_if_needed(&mut self) -> Result<(), SimError> {
+        let half = self.skin * T::of(0.5);
+        if !(self.max_moved2 < half * half) {
             self.rebuild()?;
         }
         Ok(())
+    }
+
+    /// Runs one operation of the schedule.
+    fn run(&mut self, op: Op) -> Result<(), SimError> {
+        self.trace.record(op);
+        match op {
+            Op::Kick { tau } => self.kick(T::of(tau)),
+            Op::Drift { tau } => self.drift(T::of(tau)),
+            Op::RebuildIfNeeded => self.rebuild_if_needed()?,
+            Op::Forces { elapsed } => self.evaluate_forces(T::of(elapsed)),
+        }
+        Ok(())
+    }
+
+    /// Makes the loads valid by the schedule's prologue, if nothing has evaluated them yet.
+    fn ensure_loads(&mut self) -> Result<(), SimError> {
+        if !self.forces_valid {
+            for k in 0..self.schedule.prologue.len() {
+                self.run(self.schedule.prologue[k])?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Starts recording the operations run (see [`Trace`]).
+    pub fn trace_schedule(&mut self) {
+        self.trace.start();
+    }
+
+    /// The operations run since [`Self::trace_schedule`].
+    pub fn traced(&self) -> &[Op] {
+        self.trace.ops()
     }
 
     /// Plane point and unit normal of wall `w` (a plane).
@@ -485,28 +523,12 @@ impl<T: Real> CpuEngine<T> {
 
     /// One time step of the scene's integrator.
     pub fn step(&mut self) -> Result<(), SimError> {
-        let dt = self.dt;
-        let half = dt * T::of(0.5);
-        match self.integrator {
-            Integrator::VelocityVerlet => {
-                if !self.forces_valid {
-                    self.evaluate_forces();
-                }
-                self.kick(half);
-                self.drift(dt)?;
-                self.evaluate_forces();
-                self.kick(half);
-            }
-            Integrator::OptimizedVerlet => {
-                let xi = T::of(OVV_XI);
-                self.drift(xi * dt)?;
-                self.evaluate_forces();
-                self.kick(half);
-                self.drift((T::ONE - T::of(2.0) * xi) * dt)?;
-                self.evaluate_forces();
-                self.kick(half);
-                self.drift(xi * dt)?;
-            }
+        if self.schedule.needs_loads {
+            self.ensure_loads()?;
+        }
+        let ops = self.schedule.ops(self.step).len();
+        for k in 0..ops {
+            self.run(self.schedule.ops(self.step)[k])?;
         }
         self.step += 1;
         self.time += self.dt.f64();
@@ -637,9 +659,9 @@ impl<T: Real> Engine for CpuEngine<T> {
     }
 
     fn stats(&mut self) -> Stats {
-        if !self.forces_valid {
-            self.evaluate_forces();
-        }
+        // A rebuild that fails here (a non-finite grain) leaves the loads as they were: the
+        // statistics name the grain and the next step returns the error.
+        self.ensure_loads().ok();
         let g = self.gravity;
         let grain_sums = chunked(self.body.len(), |r| {
             let mut s = GrainSums::default();
@@ -964,7 +986,7 @@ impl<T: Real> Engine for CpuEngine<T> {
                 r
             }),
         );
-        s.put_reals("clock", [self.since_eval.f64(), self.time, self.external_work]);
+        s.put_reals("clock", [self.max_moved2.f64(), self.time, self.external_work]);
         s.put_ints("counters", [self.step, self.rebuilds, self.forces_valid as u64]);
         Some(s)
     }
@@ -1031,7 +1053,7 @@ impl<T: Real> Engine for CpuEngine<T> {
             .map(|c| ContactForce { f_i: v3(&c[0..3]), f_j: v3(&c[3..6]), t_i: v3(&c[6..9]), t_j: v3(&c[9..12]), f_n: T::of(c[12]), clamped: c[13] != 0.0, f_c: T::of(c[14]), regime: Regime::from_code(c[15] as u8) })
             .collect();
         let clock = s.reals("clock", 3)?;
-        (self.since_eval, self.time, self.external_work) = (T::of(clock[0]), clock[1], clock[2]);
+        (self.max_moved2, self.time, self.external_work) = (T::of(clock[0]), clock[1], clock[2]);
         let counters = s.ints("counters", Some(3))?;
         (self.step, self.rebuilds, self.forces_valid) = (counters[0], counters[1], counters[2] != 0);
         Ok(())

@@ -6,11 +6,11 @@
 
 use super::device::Gpu;
 use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, STAT_ROW, WG};
-use crate::cpu::OVV_XI;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::kernels::{Access, KERNELS};
 use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
-use crate::scene::{Integrator, Scene, WallShape};
+use crate::schedule::{Op, Schedule, Trace};
+use crate::scene::{Scene, WallShape};
 use std::collections::HashMap;
 use wgpu::util::DeviceExt;
 
@@ -22,6 +22,15 @@ pub const INITIAL_PAIRS_PER_GRAIN: u64 = 6;
 pub const PAIR_GROWTH_THRESHOLD: f64 = 0.75;
 /// Steps recorded per queue submission.
 pub const STEPS_PER_SUBMIT: u64 = 16;
+
+/// Buffers a checkpoint leaves out: the scene's constants (set up again from the scene) and
+/// scratch space every step or statistics read rewrites before reading it.
+const NOT_STATE: [&str; 19] = [
+    "params", "phase", "material", "coeffs", // constants
+    "cell_of", "cell_grains", "cell_count", "cell_fill", "hash_sums", "grain_sums", "spare_sum", // the hash grid
+    "old_start", "old_j", "old_hist", "rev_fill", // rebuild scratch
+    "wall_partials", "grain_rows", "pair_rows", "stats", // reductions
+];
 
 /// Why the GPU engine refused a scene.
 #[derive(Debug, thiserror::Error)]
@@ -42,21 +51,6 @@ pub enum GpuSetupError {
     },
 }
 
-/// Uniform slots of the step phases (kick and drift durations, spring elapsed times).
-#[derive(Clone, Copy, Debug)]
-enum Slot {
-    KickHalf,
-    DriftDt,
-    DriftXi,
-    DriftMid,
-    ForceZero,
-    ForceDt,
-    ForceXi,
-    ForceTwoXi,
-    ForceMid,
-}
-const SLOTS: usize = 9;
-
 /// How a kernel is dispatched.
 #[derive(Clone, Copy, Debug)]
 enum Size {
@@ -73,7 +67,11 @@ pub struct GpuEngine {
     gpu: Gpu,
     n: u32,
     params: Params,
-    integrator: Integrator,
+    schedule: Schedule,
+    /// The schedule's operations in the order of their uniform slots in `phase`.
+    phase_ops: Vec<Op>,
+    /// The operations encoded, when tracing.
+    trace: Trace,
     dt: f64,
     layouts: HashMap<&'static str, wgpu::BindGroupLayout>,
     pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
@@ -85,6 +83,8 @@ pub struct GpuEngine {
     track_orientation: bool,
     wall_names: Vec<String>,
     piston: Option<usize>,
+    /// The servo box's planes (x_min, x_max, y_min, y_max, z_min, z_max), if any.
+    servo: Option<[usize; 6]>,
     /// The contact model and coefficients in f32, for re-evaluating wall contacts on the host.
     model: crate::model::ContactModel<f32>,
     coeffs: Vec<PairCoeffs<f32>>,
@@ -93,6 +93,19 @@ pub struct GpuEngine {
     time: f64,
     forces_valid: bool,
     control: Control,
+    /// Dispatches recorded so far.
+    dispatches: std::cell::Cell<u64>,
+}
+
+/// The pressure the grains exert on plane `k` (0..6) of the servo box whose walls are
+/// `planes` (Pa): the CPU's `servo_pressure`, from the GPU's walls and reactions.
+fn servo_pressure(walls: &[layout::Wall], reaction: &[[f32; 4]], planes: [usize; 6], k: usize) -> f64 {
+    let coord = |k: usize| walls[planes[k]].point[k / 2] as f64;
+    let extents = [0, 1, 2].map(|a| coord(2 * a + 1) - coord(2 * a));
+    let a = k / 2;
+    let area = extents[(a + 1) % 3] * extents[(a + 2) % 3];
+    let (r, n) = (reaction[planes[k]], walls[planes[k]].normal);
+    -(0..3).map(|c| r[c] as f64 * n[c] as f64).sum::<f64>() / area
 }
 
 fn groups_for(n: u64) -> (u32, u32) {
@@ -114,9 +127,6 @@ impl GpuEngine {
             if need > have { Err(GpuSetupError::Limit { adapter: adapter.clone(), what, need, have, fix }) } else { Ok(()) }
         };
         let binding = gpu.limits.max_storage_buffer_binding_size;
-        if scene.servo.is_some() {
-            anyhow::bail!("{}: a servo_box wall: the GPU backend has no servo walls yet; fix: run with --backend cpu", scene.path.display());
-        }
         if !matches!(scene.model.cohesion, crate::model::CohesionLaw::None) {
             anyhow::bail!("{}: model.cohesion: the GPU backend has no capillary cohesion yet; fix: run with --backend cpu", scene.path.display());
         }
@@ -255,25 +265,33 @@ impl GpuEngine {
         let quat: Vec<[f32; 4]> = if scene.track_orientation { vec![[1.0, 0.0, 0.0, 0.0]; g.len()] } else { vec![[0.0; 4]] };
         init("quat", bytemuck::cast_slice(&quat), wgpu::BufferUsages::empty());
         init("params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+        let servo = scene.servo.map_or(layout::Servo::default(), |s| {
+            let w = s.walls.map(|w| w as u32);
+            layout::Servo {
+                walls_lo: [w[0], w[1], w[2], w[3]],
+                walls_hi: [w[4], w[5], 0, 0],
+                pressure: s.pressure as f32,
+                gain: s.gain as f32,
+                max_speed: s.max_speed as f32,
+                relaxation: crate::cpu::SERVO_RELAXATION as f32,
+                ..Default::default()
+            }
+        });
+        init("servo", bytemuck::bytes_of(&servo), wgpu::BufferUsages::empty());
 
         let phase_stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<Phase>() as u64);
         let dt = scene.time_step.dt;
-        let xi = OVV_XI;
-        let phases: [(Slot, f64, f64); SLOTS] = [
-            (Slot::KickHalf, 0.5 * dt, 0.0),
-            (Slot::DriftDt, dt, 0.0),
-            (Slot::DriftXi, xi * dt, 0.0),
-            (Slot::DriftMid, (1.0 - 2.0 * xi) * dt, 0.0),
-            (Slot::ForceZero, 0.0, 0.0),
-            (Slot::ForceDt, 0.0, dt),
-            (Slot::ForceXi, 0.0, xi * dt),
-            (Slot::ForceTwoXi, 0.0, 2.0 * xi * dt),
-            (Slot::ForceMid, 0.0, (1.0 - 2.0 * xi) * dt),
-        ];
-        let mut phase_bytes = vec![0u8; phase_stride as usize * SLOTS];
-        for (slot, tau, elapsed) in phases {
+        let schedule = Schedule::new(scene.integrator, dt);
+        let phase_ops = schedule.distinct();
+        let mut phase_bytes = vec![0u8; phase_stride as usize * phase_ops.len()];
+        for (slot, op) in phase_ops.iter().enumerate() {
+            let (tau, elapsed) = match *op {
+                Op::Kick { tau } | Op::Drift { tau } => (tau, 0.0),
+                Op::Forces { elapsed } => (0.0, elapsed),
+                Op::RebuildIfNeeded => (0.0, 0.0),
+            };
             let p = Phase { tau: tau as f32, elapsed: elapsed as f32, ..Default::default() };
-            let at = slot as usize * phase_stride as usize;
+            let at = slot * phase_stride as usize;
             phase_bytes[at..at + std::mem::size_of::<Phase>()].copy_from_slice(bytemuck::bytes_of(&p));
         }
         init("phase", &phase_bytes, wgpu::BufferUsages::UNIFORM);
@@ -300,8 +318,9 @@ impl GpuEngine {
         zeroed("rev_fill", 4 * n);
         let wall_hist = if hist_blocks > 0 { 16 * n * scene.walls.len() as u64 * hist_blocks } else { 16 };
         zeroed("wall_hist", wall_hist);
-        zeroed("wall_partials", rows_for(n) * MAX_WALLS as u64 * 16);
-        zeroed("wall_reaction", MAX_WALLS as u64 * 16);
+        // Per wall: the reaction, then the contacts' stiffness and damping (servo walls).
+        zeroed("wall_partials", rows_for(n) * 2 * MAX_WALLS as u64 * 16);
+        zeroed("wall_reaction", 2 * MAX_WALLS as u64 * 16);
         zeroed("grain_rows", rows_for(n) * STAT_ROW as u64 * 4);
         zeroed("stats", 2 * STAT_ROW as u64 * 4);
 
@@ -309,7 +328,9 @@ impl GpuEngine {
             gpu,
             n: n as u32,
             params,
-            integrator: scene.integrator,
+            schedule,
+            phase_ops,
+            trace: Trace::default(),
             dt,
             layouts: HashMap::new(),
             pipelines: HashMap::new(),
@@ -321,6 +342,7 @@ impl GpuEngine {
             track_orientation: scene.track_orientation,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
             piston,
+            servo: scene.servo.map(|s| s.walls),
             model: scene.model.cast::<f32>(),
             coeffs: scene.materials.iter().flat_map(|a| scene.materials.iter().map(move |b| PairCoeffs::mix(&a.constants, &b.constants))).collect(),
             n_materials: scene.materials.len(),
@@ -328,6 +350,7 @@ impl GpuEngine {
             time: 0.0,
             forces_valid: false,
             control,
+            dispatches: std::cell::Cell::new(0),
         };
         engine.allocate_pairs(pair_capacity);
         engine.build_pipelines(scene);
@@ -335,23 +358,28 @@ impl GpuEngine {
         Ok(engine)
     }
 
+    /// The per-pair buffers and their bytes per pair.
+    fn pair_buffers(&self) -> [(&'static str, u64); 10] {
+        let blocks = self.params.hist_blocks as u64;
+        [
+            ("pair_i", 4),
+            ("pair_j", 4),
+            ("old_j", 4),
+            ("rev_pair", 4),
+            ("hist", 16 * blocks),
+            ("old_hist", 16 * blocks),
+            ("out_fi", 16),
+            ("out_fj", 16),
+            ("out_ti", 16),
+            ("out_tj", 16),
+        ]
+    }
+
     /// (Re)allocates the per-pair buffers for `capacity` pairs.
     fn allocate_pairs(&mut self, capacity: u64) {
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let blocks = self.params.hist_blocks as u64;
-        let sizes: [(&'static str, u64); 11] = [
-            ("pair_i", 4 * capacity),
-            ("pair_j", 4 * capacity),
-            ("old_j", 4 * capacity),
-            ("rev_pair", 4 * capacity),
-            ("hist", 16 * capacity * blocks),
-            ("old_hist", 16 * capacity * blocks),
-            ("out_fi", 16 * capacity),
-            ("out_fj", 16 * capacity),
-            ("out_ti", 16 * capacity),
-            ("out_tj", 16 * capacity),
-            ("pair_rows", rows_for(capacity) * STAT_ROW as u64 * 4),
-        ];
+        let mut sizes: Vec<(&'static str, u64)> = self.pair_buffers().iter().map(|&(name, per_pair)| (name, per_pair * capacity)).collect();
+        sizes.push(("pair_rows", rows_for(capacity) * STAT_ROW as u64 * 4));
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         for (name, size) in sizes {
             let b = self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size: size.max(16), usage: storage, mapped_at_creation: false });
@@ -394,7 +422,8 @@ impl GpuEngine {
             ("HAS_TANGENTIAL_HISTORY", self.history.tangential as u8 as f64),
             ("HAS_ROLLING_HISTORY", self.history.rolling as u8 as f64),
         ];
-        let orientation = [("TRACK_ORIENTATION", self.track_orientation as u8 as f64)];
+        let orientation = ("TRACK_ORIENTATION", self.track_orientation as u8 as f64);
+        let wall_response = ("WALL_RESPONSE", self.servo.is_some() as u8 as f64);
         for k in KERNELS {
             let entries: Vec<wgpu::BindGroupLayoutEntry> = k
                 .bindings
@@ -419,19 +448,18 @@ impl GpuEngine {
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &entries });
             let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(k.name), bind_group_layouts: &[Some(&layout)], ..Default::default() });
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(k.name), source: wgpu::ShaderSource::Wgsl(k.wgsl().into()) });
-            let constants: &[(&str, f64)] = if k.includes.contains(&"model") {
-                &model_constants
-            } else if k.name == "drift" {
-                &orientation
-            } else {
-                &[]
-            };
+            let mut constants: Vec<(&str, f64)> = if k.includes.contains(&"model") { model_constants.to_vec() } else { Vec::new() };
+            match k.name {
+                "drift" => constants.push(orientation),
+                "wall_contacts" => constants.push(wall_response),
+                _ => {}
+            }
             let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(k.name),
                 layout: Some(&pipeline_layout),
                 module: &module,
                 entry_point: Some(k.name),
-                compilation_options: wgpu::PipelineCompilationOptions { constants, zero_initialize_workgroup_memory: true },
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, zero_initialize_workgroup_memory: true },
                 cache: None,
             });
             self.layouts.insert(k.name, layout);
@@ -479,10 +507,12 @@ impl GpuEngine {
         }
     }
 
-    fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, group: &str, size: Size, phase: Option<Slot>) {
+    fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, group: &str, size: Size, phase: Option<Op>) {
         pass.set_pipeline(&self.pipelines[name]);
-        let offsets: Vec<u32> = phase.map(|s| (s as u64 * self.phase_stride) as u32).into_iter().collect();
+        let slot = |op: Op| self.phase_ops.iter().position(|o| *o == op).expect("every operation of the schedule has a uniform slot");
+        let offsets: Vec<u32> = phase.map(|op| (slot(op) as u64 * self.phase_stride) as u32).into_iter().collect();
         pass.set_bind_group(0, &self.bind_groups[group], &offsets);
+        self.dispatches.set(self.dispatches.get() + 1);
         match size {
             Size::Grains => {
                 let (x, y) = groups_for(self.n as u64);
@@ -493,7 +523,7 @@ impl GpuEngine {
         }
     }
 
-    fn run(&self, pass: &mut wgpu::ComputePass, name: &str, size: Size, phase: Option<Slot>) {
+    fn run(&self, pass: &mut wgpu::ComputePass, name: &str, size: Size, phase: Option<Op>) {
         self.dispatch(pass, name, name, size, phase);
     }
 
@@ -530,41 +560,48 @@ impl GpuEngine {
         self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
     }
 
-    /// `pair_force`, `wall_contacts` (+ `wall_reduce`), `gather`.
-    fn encode_forces(&self, pass: &mut wgpu::ComputePass, elapsed: Slot) {
-        self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(elapsed));
+    /// `pair_force`, `wall_contacts` (+ `wall_reduce`), `gather`, the springs advancing by the
+    /// elapsed time of `op` (a [`Op::Forces`]).
+    fn encode_forces(&self, pass: &mut wgpu::ComputePass, op: Op) {
+        self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(op));
         if self.has_walls {
-            self.run(pass, "wall_contacts", Size::Grains, Some(elapsed));
+            self.run(pass, "wall_contacts", Size::Grains, Some(op));
             self.run(pass, "wall_reduce", Size::One, None);
         }
         self.run(pass, "gather", Size::Grains, None);
     }
 
-    fn encode_step(&self, pass: &mut wgpu::ComputePass, first: bool) {
-        match self.integrator {
-            Integrator::VelocityVerlet => {
-                if first {
-                    self.encode_rebuild_if_needed(pass);
-                    self.encode_forces(pass, Slot::ForceZero);
+    /// Encodes one operation of the schedule.
+    fn encode(&self, pass: &mut wgpu::ComputePass, op: Op) {
+        match op {
+            Op::Kick { .. } => self.run(pass, "kick", Size::Grains, Some(op)),
+            Op::Drift { .. } => {
+                self.run(pass, "drift", Size::Grains, Some(op));
+                if self.servo.is_some() {
+                    self.run(pass, "servo_move", Size::One, Some(op));
                 }
-                self.run(pass, "kick", Size::Grains, Some(Slot::KickHalf));
-                self.run(pass, "drift", Size::Grains, Some(Slot::DriftDt));
-                self.encode_rebuild_if_needed(pass);
-                self.encode_forces(pass, Slot::ForceDt);
-                self.run(pass, "kick", Size::Grains, Some(Slot::KickHalf));
             }
-            Integrator::OptimizedVerlet => {
-                self.run(pass, "drift", Size::Grains, Some(Slot::DriftXi));
-                self.encode_rebuild_if_needed(pass);
-                self.encode_forces(pass, if first { Slot::ForceXi } else { Slot::ForceTwoXi });
-                self.run(pass, "kick", Size::Grains, Some(Slot::KickHalf));
-                self.run(pass, "drift", Size::Grains, Some(Slot::DriftMid));
-                self.encode_rebuild_if_needed(pass);
-                self.encode_forces(pass, Slot::ForceMid);
-                self.run(pass, "kick", Size::Grains, Some(Slot::KickHalf));
-                self.run(pass, "drift", Size::Grains, Some(Slot::DriftXi));
-            }
+            Op::RebuildIfNeeded => self.encode_rebuild_if_needed(pass),
+            Op::Forces { .. } => self.encode_forces(pass, op),
         }
+    }
+
+    /// Encodes `ops` in order and traces them.
+    fn encode_all(&mut self, pass: &mut wgpu::ComputePass, ops: &[Op]) {
+        for &op in ops {
+            self.encode(pass, op);
+            self.trace.record(op);
+        }
+    }
+
+    /// Starts recording the operations encoded (see [`Trace`]).
+    pub fn trace_schedule(&mut self) {
+        self.trace.start();
+    }
+
+    /// The operations encoded since [`Self::trace_schedule`].
+    pub fn traced(&self) -> &[Op] {
+        self.trace.ops()
     }
 
     /// Copies buffers out: `(buffer, offset, bytes)` each, returned in order as 4-byte words
@@ -730,9 +767,13 @@ impl Engine for GpuEngine {
             let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
+                if self.schedule.needs_loads && !self.forces_valid {
+                    let prologue = self.schedule.prologue.clone();
+                    self.encode_all(&mut pass, &prologue);
+                }
                 for s in 0..chunk {
-                    let first = self.step + s == 0;
-                    self.encode_step(&mut pass, first && !self.forces_valid);
+                    let ops = self.schedule.ops(self.step + s).to_vec();
+                    self.encode_all(&mut pass, &ops);
                 }
             }
             self.gpu.queue.submit([encoder.finish()]);
@@ -750,13 +791,11 @@ impl Engine for GpuEngine {
             let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
-                self.encode_rebuild_if_needed(&mut pass);
-                self.encode_forces(&mut pass, Slot::ForceZero);
+                let prologue = self.schedule.prologue.clone();
+                self.encode_all(&mut pass, &prologue);
             }
             self.gpu.queue.submit([encoder.finish()]);
-            if self.integrator == Integrator::VelocityVerlet {
-                self.forces_valid = true;
-            }
+            self.forces_valid = true;
         }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
@@ -772,8 +811,10 @@ impl Engine for GpuEngine {
             ("stats", 0, 2 * STAT_ROW as u64 * 4),
             ("wall_reaction", 0, MAX_WALLS as u64 * 16),
             ("walls", 0, (n_walls.max(1) * std::mem::size_of::<layout::Wall>()) as u64),
+            ("servo", 0, std::mem::size_of::<layout::Servo>() as u64),
         ]);
         let control: Control = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[0]));
+        let servo: layout::Servo = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[4]));
         self.control = control;
         let s: &[f32] = bytemuck::cast_slice(&parts[1]);
         let reaction: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
@@ -809,7 +850,7 @@ impl Engine for GpuEngine {
             elastic_energy: p(2) + g(12),
             gravity_energy: g(2),
             piston_ke: self.piston.map_or(0.0, |w| 0.5 * walls[w].piston[0] as f64 * (walls[w].velocity[2] as f64).powi(2)),
-            external_work: self.piston.map_or(0.0, |w| walls[w].piston[3] as f64),
+            external_work: self.piston.map_or(0.0, |w| walls[w].piston[3] as f64) + servo.work as f64 + servo.work_lo as f64,
             momentum: [g(3), g(4), g(5)],
             angular_momentum: [g(6), g(7), g(8)],
             pairs: control.n_pairs as u64,
@@ -831,12 +872,15 @@ impl Engine for GpuEngine {
             liquid_in_bridges: 0.0,
             liquid_on_grains: 0.0,
             walls: (0..n_walls)
-                .map(|w| WallStats {
-                    name: self.wall_names[w].clone(),
-                    force: [reaction[w][0] as f64, reaction[w][1] as f64, reaction[w][2] as f64],
-                    contacts: reaction[w][3].round() as u64,
-                    position: None,
-                    pressure: None,
+                .map(|w| {
+                    let servo_plane = self.servo.and_then(|planes| planes.iter().position(|&p| p == w));
+                    WallStats {
+                        name: self.wall_names[w].clone(),
+                        force: [reaction[w][0] as f64, reaction[w][1] as f64, reaction[w][2] as f64],
+                        contacts: reaction[w][3].round() as u64,
+                        position: servo_plane.map(|k| walls[w].point[k / 2] as f64),
+                        pressure: servo_plane.map(|k| servo_pressure(walls, reaction, self.servo.expect("a servo plane"), k)),
+                    }
                 })
                 .collect(),
             piston,
@@ -897,22 +941,68 @@ impl Engine for GpuEngine {
         }
     }
 
-    fn set_servo(&mut self, _: Option<f64>, _: Option<f64>) {}
+    fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
+        if self.servo.is_none() {
+            return;
+        }
+        let buffer = &self.buffers["servo"];
+        let at = |offset: usize| offset as u64;
+        if let Some(p) = pressure {
+            self.gpu.queue.write_buffer(buffer, at(std::mem::offset_of!(layout::Servo, pressure)), bytemuck::bytes_of(&(p as f32)));
+        }
+        let (strain, rate) = axial_strain_rate.map_or((0u32, 0.0f32), |r| (1, r as f32));
+        self.gpu.queue.write_buffer(buffer, at(std::mem::offset_of!(layout::Servo, strain_rate)), bytemuck::bytes_of(&rate));
+        self.gpu.queue.write_buffer(buffer, at(std::mem::offset_of!(layout::Servo, strain)), bytemuck::bytes_of(&strain));
+    }
 
     fn wet(&mut self, _: f64) -> anyhow::Result<()> {
         anyhow::bail!("the GPU backend has no capillary cohesion yet; fix: run with --backend cpu")
     }
 
     fn save(&self) -> Option<crate::checkpoint::EngineState> {
-        None
+        let mut s = crate::checkpoint::EngineState::default();
+        let n_pairs = self.control.n_pairs as u64;
+        let per_pair: HashMap<&str, u64> = self.pair_buffers().into_iter().collect();
+        let mut names: Vec<&'static str> = self.buffers.keys().copied().filter(|name| !NOT_STATE.contains(name)).collect();
+        names.sort_unstable();
+        let parts: Vec<(&str, u64, u64)> = names.iter().map(|&name| (name, 0, per_pair.get(name).map_or(self.buffers[name].size(), |b| b * n_pairs))).collect();
+        for (name, words) in names.iter().zip(self.read(&parts)) {
+            // Two 4-byte words per stored integer, the first in the low half.
+            s.put_ints(&format!("gpu:{name}"), words.chunks(2).map(|c| c[0] as u64 | (c.get(1).copied().unwrap_or(0) as u64) << 32));
+        }
+        s.put_ints("counters", [self.step, self.forces_valid as u64, self.params.pair_capacity as u64]);
+        s.put_reals("time", [self.time]);
+        Some(s)
     }
 
-    fn restore(&mut self, _: &crate::checkpoint::EngineState) -> anyhow::Result<()> {
-        anyhow::bail!("the GPU backend does not resume from checkpoints yet; fix: resume with --backend cpu")
+    fn restore(&mut self, s: &crate::checkpoint::EngineState) -> anyhow::Result<()> {
+        let counters = s.ints("counters", Some(3))?;
+        if counters[2] != self.params.pair_capacity as u64 {
+            self.allocate_pairs(counters[2]);
+            self.build_bind_groups();
+        }
+        for (key, words) in &s.ints {
+            let Some(name) = key.strip_prefix("gpu:") else { continue };
+            let buffer = self.buffers.get(name).ok_or_else(|| anyhow::anyhow!("the checkpoint holds a GPU buffer `{name}` this engine lacks; fix: resume with the grains version that wrote it"))?;
+            let bytes: Vec<u8> = words.iter().flat_map(|&w| w.to_le_bytes()).collect();
+            // A list of an odd number of words was padded with one (beyond the live pairs).
+            if bytes.len() as u64 > buffer.size() + 4 {
+                anyhow::bail!("the checkpoint's GPU buffer `{name}` holds {} bytes, this scene's {}; fix: resume with the scene the checkpoint was written for", bytes.len(), buffer.size());
+            }
+            self.gpu.queue.write_buffer(buffer, 0, &bytes[..bytes.len().min(buffer.size() as usize)]);
+        }
+        (self.step, self.forces_valid) = (counters[0], counters[1] != 0);
+        self.time = s.reals("time", 1)?[0];
+        self.read_control();
+        Ok(())
     }
 
     fn memory_bytes(&self) -> u64 {
         self.buffers.values().map(wgpu::Buffer::size).sum()
+    }
+
+    fn dispatches(&self) -> Option<u64> {
+        Some(self.dispatches.get())
     }
 
     fn place_piston(&mut self, z: f64) {

@@ -118,6 +118,32 @@ pub struct Wall {
     pub piston: [f32; 4],
 }
 
+/// The servo box's control state (WGSL `Servo`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Servo {
+    /// Wall indices of the x_min, x_max, y_min, y_max planes.
+    pub walls_lo: [u32; 4],
+    /// Wall indices of the z_min, z_max planes (z, w unused).
+    pub walls_hi: [u32; 4],
+    /// Target pressure (Pa).
+    pub pressure: f32,
+    /// Wall speed per pressure error (m/(s Pa)).
+    pub gain: f32,
+    /// Largest wall speed (m/s).
+    pub max_speed: f32,
+    /// Strain rate of the z planes (1/s, closing positive) when `strain` is 1.
+    pub strain_rate: f32,
+    /// Fraction of the largest stable gain kept where the contacts are stiff.
+    pub relaxation: f32,
+    /// Work the planes did on the grains (J).
+    pub work: f32,
+    /// Its rounding error (J).
+    pub work_lo: f32,
+    /// 1 when the z planes are strain-controlled.
+    pub strain: u32,
+}
+
 /// Flags and counters (WGSL `Control`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Pod, Zeroable)]

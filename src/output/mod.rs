@@ -86,6 +86,13 @@ impl Csv {
     fn flush(&mut self) -> anyhow::Result<()> {
         self.out.flush().with_context(|| format!("cannot write {}", self.path.display()))
     }
+    /// Flushes and returns the file's name and length (bytes).
+    fn flushed_length(&mut self) -> anyhow::Result<(String, u64)> {
+        self.flush()?;
+        let len = self.out.get_ref().metadata().with_context(|| format!("cannot read {}", self.path.display()))?.len();
+        let name = self.path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        Ok((name, len))
+    }
 }
 
 /// Records a run: files under `--out DIR` when given, a progress bar when asked for.
@@ -119,18 +126,30 @@ impl RunRecorder {
         Ok(RunRecorder { stats, stages, frames, bar, bar_stage: String::new(), checkpoint: None })
     }
 
-    /// Continues the files of a run resumed at stage `next_stage`: rows are appended to the
-    /// CSV files, frames go to `frames-from-stage<next_stage>.mcap` (the earlier recording is
-    /// complete and kept).
-    pub fn resume(dir: &Path, next_stage: usize, progress: bool) -> anyhow::Result<Self> {
+    /// Continues the files of a run resumed from the checkpoint `header`: the CSV files are cut
+    /// back to their length at the checkpoint and rows are appended; frames go to
+    /// `frames-from-stage<S>.mcap` (resumed at the start of stage S) or
+    /// `frames-from-stage<S>-step<N>.mcap` (inside it, at step N); the earlier recording is
+    /// kept as it is.
+    pub fn resume(dir: &Path, header: &CheckpointHeader, progress: bool) -> anyhow::Result<Self> {
+        for (name, len) in &header.files {
+            let path = dir.join(name);
+            let file = std::fs::OpenOptions::new().write(true).open(&path).with_context(|| format!("cannot open {} to continue it", path.display()))?;
+            file.set_len(*len).with_context(|| format!("cannot cut {} back to its length at the checkpoint", path.display()))?;
+        }
+        let p = &header.progress;
+        let from = match &p.in_stage {
+            Some(s) => format!("stage{}-step{}", p.next_stage, s.step0 + s.done),
+            None => format!("stage{}", p.next_stage),
+        };
         let mut r = RunRecorder::new(None, progress)?;
         r.stats = Some(Csv::append(dir.join("stats.csv"))?);
         r.stages = Some(Csv::append(dir.join("stages.csv"))?);
-        r.frames = Some(mcap::McapRecorder::create(&dir.join(format!("frames-from-stage{next_stage}.mcap")))?);
+        r.frames = Some(mcap::McapRecorder::create(&dir.join(format!("frames-from-{from}.mcap")))?);
         Ok(r)
     }
 
-    /// Writes a checkpoint into `dir` at every stage boundary (CPU engines).
+    /// Writes a checkpoint into `dir` whenever the host loop offers one.
     pub fn with_checkpoints(mut self, dir: &Path, identity: RunIdentity) -> Self {
         self.checkpoint = Some((dir.join(crate::checkpoint::FILE), identity));
         self
@@ -174,7 +193,8 @@ impl Recorder for RunRecorder {
     }
     fn checkpoint(&mut self, progress: &Progress, engine: &dyn Engine) -> anyhow::Result<()> {
         let (Some((path, identity)), Some(state)) = (&self.checkpoint, engine.save()) else { return Ok(()) };
-        let header = CheckpointHeader { identity: identity.clone(), progress: progress.clone() };
+        let files = [&mut self.stats, &mut self.stages].into_iter().flatten().map(Csv::flushed_length).collect::<anyhow::Result<_>>()?;
+        let header = CheckpointHeader { identity: identity.clone(), progress: progress.clone(), files };
         crate::checkpoint::write(path, &header, &state)
     }
 

@@ -95,7 +95,8 @@ pub trait Recorder {
     fn stage_end(&mut self, r: &StageResult) -> anyhow::Result<()>;
     /// Progress within a stage: steps done out of at most `total`.
     fn progress(&mut self, stage: &str, done: u64, total: u64);
-    /// A stage boundary: the moment to write a checkpoint of `engine` and `progress`.
+    /// A stage boundary, or a statistics read inside a stage when a checkpoint is due: the
+    /// moment to write a checkpoint of `engine` and `progress`.
     fn checkpoint(&mut self, progress: &Progress, engine: &dyn Engine) -> anyhow::Result<()>;
 }
 
@@ -110,6 +111,41 @@ pub struct Progress {
     guard: Guard,
     /// Simulated time of the next frame, when frames are taken at an interval.
     next_frame: Option<f64>,
+    /// Where stage `next_stage` stands, when the checkpoint was taken inside it.
+    #[serde(default)]
+    pub in_stage: Option<StageProgress>,
+}
+
+/// Where a stage stands at a checkpoint taken inside it (at a statistics read).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StageProgress {
+    /// Steps done in the stage.
+    pub done: u64,
+    /// The engine's step count at the stage's start.
+    pub step0: u64,
+    /// Simulated time at the stage's start (s).
+    pub time0: f64,
+    /// The void ratio when the stage lowered the piston, if it did.
+    pub initial_void_ratio: Option<f64>,
+}
+
+/// When a checkpoint is due inside a stage: every `interval` seconds of wall-clock time since
+/// the last one (never with an interval of 0).
+struct CheckpointClock {
+    interval: f64,
+    last: std::time::Instant,
+}
+
+impl CheckpointClock {
+    fn new(interval: f64) -> Self {
+        CheckpointClock { interval, last: std::time::Instant::now() }
+    }
+    fn due(&self) -> bool {
+        self.interval > 0.0 && self.last.elapsed().as_secs_f64() >= self.interval
+    }
+    fn reset(&mut self) {
+        self.last = std::time::Instant::now();
+    }
 }
 
 impl Progress {
@@ -121,6 +157,7 @@ impl Progress {
             results: Vec::new(),
             guard: Guard::new(scene, &stats),
             next_frame: (scene.output.frame_interval > 0.0).then(|| engine.time()),
+            in_stage: None,
         }
     }
 }
@@ -132,25 +169,24 @@ pub fn run(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn Recorder) -> an
 }
 
 /// Runs the stages from `progress` on (a fresh start, or a resumed checkpoint), offering a
-/// checkpoint to the recorder after each.
+/// checkpoint to the recorder after each, and inside a stage every
+/// `output.checkpoint_interval` seconds of wall-clock time.
 pub fn run_from(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn Recorder, mut progress: Progress) -> anyhow::Result<Vec<StageResult>> {
+    let mut clock = CheckpointClock::new(scene.output.checkpoint_interval);
     while let Some(stage) = scene.stages.get(progress.next_stage) {
-        let result = run_stage(scene, stage, engine, rec, &progress.guard, &mut progress.next_frame)?;
+        let result = run_stage(scene, stage, engine, rec, &mut progress, &mut clock)?;
         progress.results.push(result);
         progress.next_stage += 1;
+        progress.in_stage = None;
         rec.checkpoint(&progress, engine)?;
+        clock.reset();
     }
     Ok(progress.results)
 }
 
-fn run_stage(
-    scene: &Scene,
-    stage: &Stage,
-    engine: &mut dyn Engine,
-    rec: &mut dyn Recorder,
-    guard: &Guard,
-    next_frame: &mut Option<f64>,
-) -> anyhow::Result<StageResult> {
+/// Sets stage `stage` up on the engine (pressures, liquid, the piston lowered), returning
+/// where it starts.
+fn start_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine) -> anyhow::Result<StageProgress> {
     if let Some(p) = stage.piston_pressure {
         engine.set_piston_pressure(p);
     }
@@ -167,13 +203,23 @@ fn run_stage(
         engine.place_piston(top);
         initial_void_ratio = container_volume(scene, top).map(|v| void_ratio(solid_volume(&f), v));
     }
+    Ok(StageProgress { done: 0, step0: engine.steps(), time0: engine.time(), initial_void_ratio })
+}
+
+/// Runs a stage from its start, or from where a checkpoint inside it left it (the engine
+/// restored from that checkpoint already holds what the stage set up).
+fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dyn Recorder, progress: &mut Progress, clock: &mut CheckpointClock) -> anyhow::Result<StageResult> {
+    let start = match progress.in_stage.take() {
+        Some(resumed) => resumed,
+        None => start_stage(scene, stage, engine)?,
+    };
+    let StageProgress { mut done, step0, time0, initial_void_ratio } = start;
+    let guard = progress.guard.clone();
     let dt = scene.time_step.dt;
     let total = (stage.duration / dt).round().max(1.0) as u64;
     let k = scene.stats_interval;
     let n = engine.grain_count() as f64;
-    let (step0, time0) = (engine.steps(), engine.time());
     let settles = stage.kind != StageKind::Run;
-    let mut done = 0;
     let mut settled = false;
     let mut stats = engine.stats();
     while done < total {
@@ -184,7 +230,7 @@ fn run_stage(
         guard.check(&stats)?;
         rec.stats(&stage.name, &stats)?;
         rec.progress(&stage.name, done, total);
-        if let Some(t) = next_frame.as_mut().filter(|t| engine.time() >= **t) {
+        if let Some(t) = progress.next_frame.as_mut().filter(|t| engine.time() >= **t) {
             rec.frame(&engine.frame(scene.output.contact_forces))?;
             *t += scene.output.frame_interval;
         }
@@ -205,8 +251,14 @@ fn run_stage(
             settled = true;
             break;
         }
+        if done < total && clock.due() {
+            progress.in_stage = Some(StageProgress { done, step0, time0, initial_void_ratio });
+            rec.checkpoint(progress, engine)?;
+            progress.in_stage = None;
+            clock.reset();
+        }
     }
-    if next_frame.is_none() {
+    if progress.next_frame.is_none() {
         rec.frame(&engine.frame(scene.output.contact_forces))?;
     }
     let compression = if stage.records_compression { Some(CompressionPoint { seating: stage.seating, ..compression_point(scene, engine, &stats, settled) }) } else { None };

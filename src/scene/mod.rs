@@ -214,7 +214,13 @@ pub struct Output {
     pub contact_forces: bool,
     /// Analyse the force transmission at the end of the run.
     pub analysis: bool,
+    /// Wall-clock seconds between checkpoints inside a stage; 0 for stage ends only.
+    pub checkpoint_interval: f64,
 }
+
+/// Wall-clock seconds between checkpoints inside a stage by default: a run killed mid-stage
+/// loses at most about this much work.
+pub const DEFAULT_CHECKPOINT_INTERVAL: f64 = 600.0;
 
 /// A validated scene, in SI units and `f64`; engines convert to their precision.
 #[derive(Clone, Debug)]
@@ -410,6 +416,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         frame_interval: non_negative(&c, "output.frame_interval", f.output.frame_interval, "give seconds, or 0 for a frame per stage")?,
         contact_forces: f.output.contact_forces,
         analysis: f.output.analysis,
+        checkpoint_interval: non_negative(&c, "output.checkpoint_interval", f.output.checkpoint_interval.unwrap_or(DEFAULT_CHECKPOINT_INTERVAL), "give wall-clock seconds, or 0 for checkpoints at stage ends only")?,
     };
     let name = f.name.clone().unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());
     Ok(Scene {

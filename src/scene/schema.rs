@@ -431,4 +431,8 @@ pub struct OutputSpec {
     /// particle stresses, percolation, fabric) into `analysis.json` and pictures. Default false.
     #[serde(default)]
     pub analysis: bool,
+    /// Wall-clock seconds between checkpoints inside a stage (besides the one at every stage
+    /// end) when the run has `--out`; 0 checkpoints at stage ends only. Default
+    /// [`crate::scene::DEFAULT_CHECKPOINT_INTERVAL`].
+    pub checkpoint_interval: Option<f64>,
 }

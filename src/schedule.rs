@@ -1,0 +1,167 @@
+//! One time step as a list of operations, derived once from the integrator. The CPU engine
+//! executes the list and the GPU engine encodes it, so the kernel sequence, the kick and drift
+//! durations and the time the contact springs advance by at each force evaluation are written
+//! once, here.
+
+use crate::scene::Integrator;
+
+/// Seed 000's optimised velocity Verlet parameter (eqs. 11-15).
+pub const OVV_XI: f64 = 0.1931833275037836;
+
+/// One operation of a step. Durations are seconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Op {
+    /// Velocities (grains and piston) advance by `tau` under the last loads.
+    Kick {
+        /// s.
+        tau: f64,
+    },
+    /// Positions (grains, orientations, piston, servo walls) advance by `tau`.
+    Drift {
+        /// s.
+        tau: f64,
+    },
+    /// The neighbour list is rebuilt if a grain has moved half the skin since the last build.
+    RebuildIfNeeded,
+    /// Forces are evaluated; the contact springs advance by `elapsed`, the time since the
+    /// previous evaluation.
+    Forces {
+        /// s.
+        elapsed: f64,
+    },
+}
+
+/// The operations of the scene's integrator.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Schedule {
+    /// Makes the loads valid where nothing has evaluated them yet (before the first step, and
+    /// before statistics are read): the springs do not advance.
+    pub prologue: Vec<Op>,
+    /// Whether a step needs valid loads before its first operation (it starts with a kick).
+    pub needs_loads: bool,
+    /// The first step: its first evaluation counts the springs' time from the start.
+    pub first: Vec<Op>,
+    /// Every later step.
+    pub step: Vec<Op>,
+}
+
+impl Schedule {
+    /// The schedule of `integrator` at step `dt` (s).
+    pub fn new(integrator: Integrator, dt: f64) -> Self {
+        use Op::{Drift, Kick};
+        let forces = [Op::RebuildIfNeeded, Op::Forces { elapsed: f64::NAN }];
+        let mut step = Vec::new();
+        match integrator {
+            Integrator::VelocityVerlet => {
+                step.extend([Kick { tau: 0.5 * dt }, Drift { tau: dt }]);
+                step.extend(forces);
+                step.push(Kick { tau: 0.5 * dt });
+            }
+            Integrator::OptimizedVerlet => {
+                let xi = OVV_XI;
+                step.push(Drift { tau: xi * dt });
+                step.extend(forces);
+                step.extend([Kick { tau: 0.5 * dt }, Drift { tau: (1.0 - 2.0 * xi) * dt }]);
+                step.extend(forces);
+                step.extend([Kick { tau: 0.5 * dt }, Drift { tau: xi * dt }]);
+            }
+        }
+        // The springs advance by the drifts since the previous evaluation: in the first step
+        // counted from the start, in later ones across the end of the step before.
+        let drifts_after_last = step.iter().rev().take_while(|op| !matches!(op, Op::Forces { .. })).map(Op::drift).sum();
+        let first = with_elapsed(&step, 0.0);
+        let step = with_elapsed(&step, drifts_after_last);
+        Schedule { prologue: vec![Op::RebuildIfNeeded, Op::Forces { elapsed: 0.0 }], needs_loads: matches!(step[0], Kick { .. }), first, step }
+    }
+
+    /// The operations of step number `step` (0 = the first).
+    pub fn ops(&self, step: u64) -> &[Op] {
+        if step == 0 { &self.first } else { &self.step }
+    }
+
+    /// Every operation the schedule can run, without repeats in first-seen order (what the GPU
+    /// engine keeps a uniform slot for).
+    pub fn distinct(&self) -> Vec<Op> {
+        let mut out: Vec<Op> = Vec::new();
+        for op in self.prologue.iter().chain(&self.first).chain(&self.step) {
+            if !out.contains(op) {
+                out.push(*op);
+            }
+        }
+        out
+    }
+}
+
+impl Op {
+    /// The drift's duration (s); 0 for every other operation.
+    fn drift(&self) -> f64 {
+        if let Op::Drift { tau } = self { *tau } else { 0.0 }
+    }
+}
+
+/// `ops` with each evaluation's elapsed time set from the drifts before it, starting from
+/// `carried` (s) of drift before the list.
+fn with_elapsed(ops: &[Op], carried: f64) -> Vec<Op> {
+    let mut since = carried;
+    ops.iter()
+        .map(|op| match op {
+            Op::Forces { .. } => {
+                let elapsed = since;
+                since = 0.0;
+                Op::Forces { elapsed }
+            }
+            other => {
+                since += other.drift();
+                *other
+            }
+        })
+        .collect()
+}
+
+/// A record of the operations an engine ran, for checking both engines walk one schedule.
+#[derive(Clone, Debug, Default)]
+pub struct Trace(Option<Vec<Op>>);
+
+impl Trace {
+    /// Starts recording (and forgets what was recorded).
+    pub fn start(&mut self) {
+        self.0 = Some(Vec::new());
+    }
+    /// Records `op` while recording.
+    #[inline]
+    pub fn record(&mut self, op: Op) {
+        if let Some(v) = &mut self.0 {
+            v.push(op);
+        }
+    }
+    /// What was recorded.
+    pub fn ops(&self) -> &[Op] {
+        self.0.as_deref().unwrap_or(&[])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each step drifts `dt` in all and kicks `dt` in all; every evaluation but the first
+    /// step's advances the springs by the drift since the one before it, across step ends.
+    #[test]
+    fn durations_add_up_for_each_integrator() {
+        let dt = 1e-6;
+        for integrator in [Integrator::VelocityVerlet, Integrator::OptimizedVerlet] {
+            let s = Schedule::new(integrator, dt);
+            let total = |ops: &[Op], f: fn(&Op) -> f64| ops.iter().map(f).sum::<f64>();
+            let kick = |op: &Op| if let Op::Kick { tau } = op { *tau } else { 0.0 };
+            let elapsed = |op: &Op| if let Op::Forces { elapsed } = op { *elapsed } else { 0.0 };
+            for ops in [&s.first, &s.step] {
+                assert!((total(ops, Op::drift) - dt).abs() < 1e-18, "{integrator:?}: drifts sum to dt");
+                assert!((total(ops, kick) - dt).abs() < 1e-18, "{integrator:?}: kicks sum to dt");
+                assert!(ops.iter().zip(ops.iter().skip(1)).all(|(a, b)| !matches!(b, Op::Forces { .. }) || *a == Op::RebuildIfNeeded), "{integrator:?}: every evaluation follows a rebuild check");
+            }
+            // Springs advance by exactly the time that passed: in a steady step, dt.
+            assert!((total(&s.step, elapsed) - dt).abs() < 1e-18, "{integrator:?}: springs advance dt per step");
+            assert_eq!(s.needs_loads, integrator == Integrator::VelocityVerlet);
+        }
+    }
+}
