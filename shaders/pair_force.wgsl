@@ -1,7 +1,8 @@
 // One invocation computes the force of one listed pair, once, in canonical order (owner =
 // lower id = i), reading and writing its history (the tangential block's w is the sliding
-// flag); out_ti.w is its tangential regime. A pair that does not touch exerts nothing and
-// forgets its springs.
+// flag, the bridge block's x the liquid volume); out_ti.w is its tangential regime, out_tj.w
+// its capillary force. A pair that does not touch forgets its springs and exerts only the
+// capillary force of its bridge, if it has one within reach.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
 @group(0) @binding(2) var<storage, read> pos: array<vec4<f32>>;
@@ -19,20 +20,19 @@
 @group(0) @binding(14) var<storage, read> control: Control;
 
 fn load_history(k: u32) -> History {
-    var h: History;
-    h.tangential = vec3<f32>(0.0);
-    h.sliding = false;
-    h.rolling = vec3<f32>(0.0);
+    var h = empty_history();
     var b = k * params.hist_blocks;
     if (HAS_TANGENTIAL_HISTORY) { h.tangential = hist[b].xyz; h.sliding = hist[b].w != 0.0; b += 1u; }
-    if (HAS_ROLLING_HISTORY) { h.rolling = hist[b].xyz; }
+    if (HAS_ROLLING_HISTORY) { h.rolling = hist[b].xyz; b += 1u; }
+    if (COHESION_LAW == 1u) { h.bridge = hist[b].x; }
     return h;
 }
 
 fn store_history(k: u32, h: History) {
     var b = k * params.hist_blocks;
     if (HAS_TANGENTIAL_HISTORY) { hist[b] = vec4<f32>(h.tangential, select(0.0, 1.0, h.sliding)); b += 1u; }
-    if (HAS_ROLLING_HISTORY) { hist[b] = vec4<f32>(h.rolling, 0.0); }
+    if (HAS_ROLLING_HISTORY) { hist[b] = vec4<f32>(h.rolling, 0.0); b += 1u; }
+    if (COHESION_LAW == 1u) { hist[b] = vec4<f32>(h.bridge, 0.0, 0.0, 0.0); }
 }
 
 @compute @workgroup_size(64)
@@ -49,15 +49,21 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
     let dist2 = dot(d, d);
     let reach = pi.w + pj.w;
     if (dist2 >= reach * reach) {
-        var zero: History;
-        zero.tangential = vec3<f32>(0.0);
-        zero.sliding = false;
-        zero.rolling = vec3<f32>(0.0);
-        store_history(k, zero);
-        out_fi[k] = vec4<f32>(0.0);
-        out_fj[k] = vec4<f32>(0.0);
+        // The springs are forgotten, the bridge kept.
+        var open = empty_history();
+        var f_c = 0.0;
+        var n = vec3<f32>(0.0);
+        if (COHESION_LAW == 1u) {
+            open.bridge = load_history(k).bridge;
+            let dist = sqrt(dist2);
+            f_c = capillary_force(pi.w, pj.w, open.bridge, dist - reach);
+            n = d * (1.0 / dist);
+        }
+        store_history(k, open);
+        out_fi[k] = vec4<f32>(n * f_c, 0.0);
+        out_fj[k] = vec4<f32>(n * (-f_c), 0.0);
         out_ti[k] = vec4<f32>(0.0);
-        out_tj[k] = vec4<f32>(0.0);
+        out_tj[k] = vec4<f32>(0.0, 0.0, 0.0, f_c);
         return;
     }
     let vi = vel[i];
@@ -69,10 +75,16 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
     let bodies = Bodies(vi.w, wi.w, vj.w, wj.w, false);
     let c = coeffs[material[i] * params.n_materials + material[j]];
     var h = load_history(k);
-    let f = contact_force(c, g, kin, bodies, &h, phase.elapsed);
+    var f = contact_force(c, g, kin, bodies, &h, phase.elapsed);
     store_history(k, h);
+    var f_c = 0.0;
+    if (COHESION_LAW == 1u) {
+        f_c = capillary_force(pi.w, pj.w, h.bridge, -g.h);
+        f.f_i += g.n * f_c;
+        f.f_j -= g.n * f_c;
+    }
     out_fi[k] = vec4<f32>(f.f_i, f.f_n);
     out_fj[k] = vec4<f32>(f.f_j, select(0.0, 1.0, f.clamped));
     out_ti[k] = vec4<f32>(f.t_i, f32(f.regime));
-    out_tj[k] = vec4<f32>(f.t_j, 0.0);
+    out_tj[k] = vec4<f32>(f.t_j, f_c);
 }

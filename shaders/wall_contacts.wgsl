@@ -50,10 +50,8 @@ fn wall_contacts(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
             let kin = Kinematics(v.xyz, wall.velocity.xyz, om.xyz, vec3<f32>(0.0));
             let bodies = Bodies(v.w, om.w, 0.0, 0.0, true);
             let c = coeffs[wall.material * params.n_materials + material[i]];
-            var h: History;
-            h.tangential = vec3<f32>(0.0);
-            h.sliding = false;
-            h.rolling = vec3<f32>(0.0);
+            // Walls are not wetted: their contacts keep springs only.
+            var h = empty_history();
             var b = base;
             if (HAS_TANGENTIAL_HISTORY) { h.tangential = wall_hist[b].xyz; h.sliding = wall_hist[b].w != 0.0; b += 1u; }
             if (HAS_ROLLING_HISTORY) { h.rolling = wall_hist[b].xyz; }

@@ -93,6 +93,7 @@ pub const KERNELS: &[Kernel] = &[
     kernel!("reverse_count", BASE, ["params": Uniform, "pair_j": Read, "rev_start": ReadWrite, "control": Read]),
     kernel!("reverse_fill", BASE, ["params": Uniform, "pair_j": Read, "rev_start": Read, "rev_fill": ReadWrite, "rev_pair": ReadWrite, "control": Read]),
     kernel!("reverse_sort", BASE, ["params": Uniform, "rev_start": Read, "rev_pair": ReadWrite]),
+    kernel!("update_bridges", FORCES, ["params": Uniform, "pos": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "liquid": ReadWrite, "control": Read]),
     kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": ReadWrite, "out_fj": ReadWrite, "out_ti": ReadWrite, "out_tj": ReadWrite, "control": Read]),
     kernel!("wall_contacts", WALLS, ["params": Uniform, "phase": Phase, "pos": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_force": ReadWrite, "wall_torque": ReadWrite, "wall_partials": ReadWrite]),
     kernel!("wall_reduce", BASE, ["params": Uniform, "wall_partials": Read, "wall_reaction": ReadWrite]),

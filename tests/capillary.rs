@@ -122,15 +122,7 @@ fn a_bridge_holds_a_slow_pair_and_breaks_at_its_rupture_distance_for_a_fast_one(
 
 #[test]
 fn liquid_is_conserved_while_bridges_break_and_form() {
-    let text = std::fs::read_to_string(common::scene_path("elastic_gas.toml")).unwrap();
-    let text = text
-        .replace("count = 50", "count = 120")
-        .replace("max = [6.0e-3, 6.0e-3, 6.0e-3] }\nrandom_speed = 0.5", "max = [8.0e-3, 8.0e-3, 8.0e-3] }\nrandom_speed = 0.3")
-        .replace("max = [6.0e-3, 6.0e-3, 6.0e-3]\n", "max = [8.0e-3, 8.0e-3, 8.0e-3]\n")
-        .replace("poisson_ratio = 0.3", "poisson_ratio = 0.3\nmu_s = 0.4\nrestitution = 0.8")
-        .replace("damping = \"none\"\ntangential = \"none\"", "damping = \"restitution\"\ntangential = \"mindlin\"\ncohesion = \"capillary\"")
-        .replace("duration = 0.05", "duration = 0.05\nwater_content = 0.01");
-    let scene = common::parse(&text);
+    let scene = common::wet_gas();
     let mut e: CpuEngine<f64> = common::engine(&scene);
     let total = scene.stages[0].wet_volume.unwrap();
     e.wet(total).unwrap();

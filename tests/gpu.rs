@@ -217,6 +217,8 @@ fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
         "oedometer_5000.toml",
         "dry_iso_100pa.toml",
         "dry_triaxial.toml",
+        "wet_iso_0pa.toml",
+        "wet_iso_100pa.toml",
     ] {
         let scene = common::shipped(name);
         let Some(mut g) = common::gpu_engine(&scene) else { return };
@@ -283,6 +285,44 @@ fn servo_walls_on_the_gpu_follow_the_cpu_twin() {
         e.advance(1000).unwrap();
     }
     compare(&mut g, &mut c, "triaxial");
+}
+
+/// Liquid bridges on the GPU against the CPU f32 twin: the wet gas's bridges break and form
+/// as its grains collide; at every statistics read both engines hold the same number of
+/// bridges, and the liquid in bridges and on grains adds up to what was poured to f32
+/// round-off. (The capillary law's pow and exp are the GPU's own, so the two differ by ulps:
+/// positions are compared with the f32 tolerance.)
+#[test]
+fn liquid_bridges_on_the_gpu_form_and_break_as_on_the_cpu() {
+    /// Liquid conserved in f32: a bridge's volume and a grain's halves round (6e-8) at each
+    /// transfer, and transfers are few.
+    const LIQUID_F32_ROUNDOFF: f64 = 1e-7;
+    /// Positions after 2000 steps of a colliding gas whose capillary forces differ by ulps
+    /// (each backend's own pow and exp): collisions amplify the difference.
+    const CAPILLARY_POSITION_TOLERANCE: f64 = 1e-4;
+    let scene = common::wet_gas();
+    let Some(mut g) = common::gpu_engine(&scene) else { return };
+    let mut c: CpuEngine<f32> = common::engine(&scene);
+    let total = scene.stages[0].wet_volume.unwrap();
+    g.wet(total).unwrap();
+    c.wet(total).unwrap();
+    let d_mean = 2.0 * scene.grains.radius.iter().sum::<f64>() / scene.grains.len() as f64;
+    let (mut changes, mut last, mut worst_liquid, mut worst_x) = (0u64, g.stats().bridges, 0.0f64, 0.0f64);
+    for read in 0..20 {
+        g.advance(100).unwrap();
+        c.advance(100).unwrap();
+        let (sg, sc) = (g.stats(), c.stats());
+        assert_eq!(sg.bridges, sc.bridges, "bridges at read {read}");
+        changes += sg.bridges.abs_diff(last);
+        last = sg.bridges;
+        worst_liquid = worst_liquid.max(((sg.liquid_in_bridges + sg.liquid_on_grains) / total - 1.0).abs());
+        let (fg, fc) = (g.frame(false), c.frame(false));
+        worst_x = worst_x.max(fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max));
+    }
+    println!("{last} bridges at the end, {changes} net changes seen; liquid conserved to {worst_liquid:.2e}; positions differ by {:.2e} of a diameter", worst_x / d_mean);
+    assert!(changes > 5, "bridges must break and form");
+    assert!(worst_liquid < LIQUID_F32_ROUNDOFF);
+    assert!(worst_x / d_mean < CAPILLARY_POSITION_TOLERANCE);
 }
 
 #[test]

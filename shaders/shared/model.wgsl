@@ -9,6 +9,7 @@ override ROLLING_LAW: u32 = 0u;     // 0 none, 1 sds
 override TWISTING_LAW: u32 = 0u;    // 0 none, 1 oquendo
 override HAS_TANGENTIAL_HISTORY: bool = false;
 override HAS_ROLLING_HISTORY: bool = false;
+override COHESION_LAW: u32 = 0u;     // 0 none, 1 capillary (a bridge volume per pair)
 
 struct Geometry {
     n: vec3<f32>,
@@ -54,6 +55,43 @@ struct History {
     tangential: vec3<f32>,
     sliding: bool,
     rolling: vec3<f32>,
+    bridge: f32,          // liquid bridge volume (m^3)
+}
+
+// A history with no springs and no bridge.
+fn empty_history() -> History {
+    var h: History;
+    h.tangential = vec3<f32>(0.0);
+    h.sliding = false;
+    h.rolling = vec3<f32>(0.0);
+    h.bridge = 0.0;
+    return h;
+}
+
+// Capillary bridges (src/model/capillary.rs): rupture distance (1 + theta/2) V^(1/3) (m).
+fn rupture_distance(v_b: f32) -> f32 {
+    return (1.0 + params.theta * 0.5) * pow(v_b, 1.0 / 3.0);
+}
+
+// Decay length of the capillary force across the gap (m), seed 001 eq. 8.
+fn decay_length(r_i: f32, r_j: f32, v_b: f32) -> f32 {
+    let ratio = max(r_i / r_j, r_j / r_i);
+    return params.capillary_c * 0.70710678118654752 * sqrt((1.0 / r_i + 1.0 / r_j) / ratio * v_b);
+}
+
+// Capillary normal force (N, tensile negative) of a bridge of volume v_b at gap delta (m).
+fn capillary_force(r_i: f32, r_j: f32, v_b: f32, delta: f32) -> f32 {
+    if (v_b <= 0.0) {
+        return 0.0;
+    }
+    let f0 = -params.kappa * sqrt(r_i * r_j);
+    if (delta < 0.0) {
+        return f0;
+    }
+    if (delta <= rupture_distance(v_b)) {
+        return f0 * exp(-(delta / decay_length(r_i, r_j, v_b)));
+    }
+    return 0.0;
 }
 
 fn geometry_grain_grain(d: vec3<f32>, dist: f32, r_i: f32, r_j: f32, m_i: f32, m_j: f32) -> Geometry {

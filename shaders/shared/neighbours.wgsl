@@ -51,6 +51,6 @@ fn owns(i: u32, j: u32, pi: vec4<f32>) -> bool {
     }
     let pj = pos[j];
     let d = min_image(pi.xyz - pj.xyz);
-    let reach = pi.w + pj.w + params.skin;
+    let reach = pi.w + pj.w + params.reach;
     return dot(d, d) < reach * reach;
 }

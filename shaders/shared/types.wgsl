@@ -10,7 +10,7 @@ struct Params {
     hash_size: u32,
     max_neighbours: u32,
     piston: u32,          // wall index of the piston, or 0xffffffff
-    hist_blocks: u32,     // vec4 history blocks per contact (tangential with the sliding flag in w, then rolling)
+    hist_blocks: u32,     // vec4 history blocks per contact (tangential with the sliding flag in w, rolling, bridge volume in x)
     gravity: vec4<f32>,   // m/s^2 (xyz)
     cell: vec4<f32>,      // cell edge per axis (m)
     periodic_lo: vec4<f32>,
@@ -19,8 +19,8 @@ struct Params {
     skin: f32,            // m
     k_n: f32,             // linear normal stiffness (N/m)
     c_n: f32,             // viscous damping (N s/m)
-    _pad0: f32,
-    _pad1: f32,
+    reach: f32,           // distance beyond contact that pair detection reaches (m)
+    kappa: f32,           // capillary 2 pi gamma cos(theta) (N/m)
     kt_ratio: f32,        // k_t / (F_el / h); <= 0 selects Mindlin's k_t
     damping_ratio: f32,   // eta_t / eta_n (Hertz-Mindlin tangential dashpot)
     k_r: f32,             // rolling stiffness (N/m)
@@ -28,6 +28,10 @@ struct Params {
     mu_r: f32,            // rolling friction
     static_damping: f32,  // seed 000's static and rolling springs: fraction of critical damping
     rolling_as_written: u32, // seed 000's rolling friction: 0 torque pair, 1 eqs. 8-9 on each grain
+    theta: f32,           // capillary contact angle (rad)
+    capillary_c: f32,     // capillary decay-length coefficient (-)
+    bridge_cap: f32,      // largest bridge volume (m^3)
+    _pad0: f32,
 }
 
 // What changes between the dispatches of one step (uniform, dynamic offset).

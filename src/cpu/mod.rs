@@ -27,7 +27,7 @@ pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::checkpoint::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
-use crate::model::{normal_potential, rupture_distance, CohesionLaw, ContactForce, ContactModel, PairCoeffs, Regime};
+use crate::model::{normal_potential, rupture_distance, share_liquid, CohesionLaw, ContactForce, ContactModel, PairCoeffs, Regime};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 use crate::schedule::{Op, Schedule, Trace};
@@ -889,9 +889,6 @@ impl<T: Real> Engine for CpuEngine<T> {
         let CohesionLaw::Capillary { theta, .. } = self.model.cohesion else {
             anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
         };
-        // Pairs within their rupture distance share the liquid in proportion to 2 R_eff;
-        // dropping the pairs beyond the rupture distance of their share raises the others'
-        // shares, so repeat until no pair drops.
         let d: Vec<f64> = (0..self.pairs.len())
             .map(|k| {
                 let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
@@ -900,27 +897,13 @@ impl<T: Real> Engine for CpuEngine<T> {
             })
             .collect();
         let gaps: Vec<f64> = (0..self.pairs.len()).map(|k| self.gap(k).f64()).collect();
-        let cap = self.bridge_cap.f64();
-        let mut eligible: Vec<usize> = (0..self.pairs.len()).collect();
-        loop {
-            let total: f64 = eligible.iter().map(|&k| d[k]).sum();
-            let share = |k: usize| (volume * d[k] / total).min(cap);
-            let before = eligible.len();
-            eligible.retain(|&k| gaps[k] <= rupture_distance(theta.f64(), share(k)));
-            if eligible.len() == before || eligible.is_empty() {
-                break;
-            }
-        }
-        let total: f64 = eligible.iter().map(|&k| d[k]).sum();
+        let (shares, rest) = share_liquid(volume, &d, &gaps, self.bridge_cap.f64(), theta.f64());
         let (stride, b) = (self.slots.stride, self.slots.bridge);
-        let mut placed = 0.0;
-        for &k in &eligible {
-            let v = (volume * d[k] / total).min(cap);
+        for (k, v) in shares {
             self.hist[k * stride + b] += T::of(v);
-            placed += v;
         }
         // What the bridges could not hold waits on the grains.
-        let rest = T::of((volume - placed) / self.liquid.len() as f64);
+        let rest = T::of(rest / self.liquid.len() as f64);
         for l in &mut self.liquid {
             *l += rest;
         }

@@ -85,6 +85,8 @@ pub struct GpuEngine {
     piston: Option<usize>,
     /// The servo box's planes (x_min, x_max, y_min, y_max, z_min, z_max), if any.
     servo: Option<[usize; 6]>,
+    /// Wrapping axes, for the host's own geometry (wetting).
+    periodic: crate::periodic::Periodic<f32>,
     /// The contact model and coefficients in f32, for re-evaluating wall contacts on the host.
     model: crate::model::ContactModel<f32>,
     coeffs: Vec<PairCoeffs<f32>>,
@@ -95,6 +97,34 @@ pub struct GpuEngine {
     control: Control,
     /// Dispatches recorded so far.
     dispatches: std::cell::Cell<u64>,
+}
+
+/// The GPU's history (one vec4 per block and contact: tangential with the sliding flag in w,
+/// rolling, bridge volume in x) in the CPU engine's packed slots.
+fn cpu_history(blocks: &[[f32; 4]], slots: &crate::cpu::HistorySlots) -> Vec<f32> {
+    let layout = slots.layout;
+    let per_contact = [layout.tangential, layout.rolling, layout.bridge].into_iter().filter(|&b| b).count().max(1);
+    let mut out = Vec::with_capacity(blocks.len() / per_contact * slots.stride);
+    for contact in blocks.chunks_exact(per_contact) {
+        let mut s = vec![0.0f32; slots.stride];
+        let mut b = contact.iter();
+        if layout.tangential {
+            let t = b.next().expect("a tangential block");
+            s[slots.tangential..slots.tangential + 3].copy_from_slice(&t[..3]);
+            if layout.sliding {
+                s[slots.sliding] = t[3];
+            }
+        }
+        if layout.rolling {
+            let r = b.next().expect("a rolling block");
+            s[slots.rolling..slots.rolling + 3].copy_from_slice(&r[..3]);
+        }
+        if layout.bridge {
+            s[slots.bridge] = b.next().expect("a bridge block")[0];
+        }
+        out.extend(s);
+    }
+    out
 }
 
 /// The pressure the grains exert on plane `k` (0..6) of the servo box whose walls are
@@ -127,21 +157,20 @@ impl GpuEngine {
             if need > have { Err(GpuSetupError::Limit { adapter: adapter.clone(), what, need, have, fix }) } else { Ok(()) }
         };
         let binding = gpu.limits.max_storage_buffer_binding_size;
-        if !matches!(scene.model.cohesion, crate::model::CohesionLaw::None) {
-            anyhow::bail!("{}: model.cohesion: the GPU backend has no capillary cohesion yet; fix: run with --backend cpu", scene.path.display());
-        }
         limit("walls", scene.walls.len() as u64, MAX_WALLS as u64, "split the container into at most 8 walls or use --backend cpu")?;
         limit("bytes per grain array (16 per grain)", 16 * n, binding, "use fewer grains per run or a device with larger storage bindings")?;
         let hash_size = (n.max(64)).next_power_of_two();
         limit("scan elements (hash buckets)", hash_size, MAX_SCAN, "use fewer grains per run (the two-level scan holds 4,194,304)")?;
-        let hist_blocks = (scene.model.history_layout().tangential as u64) + (scene.model.history_layout().rolling as u64);
+        let layout_of_history = scene.model.history_layout();
+        let hist_blocks = [layout_of_history.tangential, layout_of_history.rolling, layout_of_history.bridge].into_iter().filter(|&b| b).count() as u64;
         let per_pair_bytes = 16 * hist_blocks.max(1);
         let pair_capacity = (INITIAL_PAIRS_PER_GRAIN * n).max(1024).min(binding / per_pair_bytes).min(binding / 16);
         limit("bytes of wall history", 16 * n * scene.walls.len() as u64 * hist_blocks, binding, "use fewer walls or grains")?;
 
         let model = &scene.model;
         let r_max = scene.grains.radius.iter().copied().fold(0.0, f64::max);
-        let cutoff = 2.0 * r_max + scene.skin;
+        let reach = scene.skin + scene.bridges.reach;
+        let cutoff = 2.0 * r_max + reach;
         let mut params = Params {
             n_grains: n as u32,
             n_walls: scene.walls.len() as u32,
@@ -154,8 +183,13 @@ impl GpuEngine {
             gravity: [scene.gravity[0] as f32, scene.gravity[1] as f32, scene.gravity[2] as f32, 0.0],
             cell: [cutoff as f32; 4],
             skin: scene.skin as f32,
+            reach: reach as f32,
+            bridge_cap: scene.bridges.volume_cap as f32,
             ..Default::default()
         };
+        if let crate::model::CohesionLaw::Capillary { kappa, theta, c } = model.cohesion {
+            (params.kappa, params.theta, params.capillary_c) = (kappa as f32, theta as f32, c as f32);
+        }
         for a in 0..3 {
             if let Some([lo, hi]) = scene.periodic[a] {
                 let dims = ((hi - lo) / cutoff).floor().max(1.0);
@@ -256,6 +290,8 @@ impl GpuEngine {
         init("vel", bytemuck::cast_slice(&vel), wgpu::BufferUsages::empty());
         init("omega", bytemuck::cast_slice(&omega), wgpu::BufferUsages::empty());
         init("material", bytemuck::cast_slice(&material), wgpu::BufferUsages::empty());
+        let liquid = vec![0.0f32; if layout_of_history.bridge { g.len() } else { 4 }];
+        init("liquid", bytemuck::cast_slice(&liquid), wgpu::BufferUsages::empty());
         init("coeffs", bytemuck::cast_slice(&coeffs), wgpu::BufferUsages::empty());
         let walls_bytes: Vec<layout::Wall> = if walls.is_empty() { vec![layout::Wall::default()] } else { walls };
         init("walls", bytemuck::cast_slice(&walls_bytes), wgpu::BufferUsages::empty());
@@ -343,6 +379,7 @@ impl GpuEngine {
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
             piston,
             servo: scene.servo.map(|s| s.walls),
+            periodic: crate::periodic::Periodic::of(&scene.periodic),
             model: scene.model.cast::<f32>(),
             coeffs: scene.materials.iter().flat_map(|a| scene.materials.iter().map(move |b| PairCoeffs::mix(&a.constants, &b.constants))).collect(),
             n_materials: scene.materials.len(),
@@ -413,12 +450,14 @@ impl GpuEngine {
         };
         let rolling = if let RollingLaw::Sds { .. } = m.rolling { 1.0 } else { 0.0 };
         let twisting = if let TwistingLaw::Oquendo = m.twisting { 1.0 } else { 0.0 };
+        let cohesion = if self.history.bridge { 1.0 } else { 0.0 };
         let model_constants = [
             ("NORMAL_LAW", normal),
             ("DAMPING_LAW", damping),
             ("TANGENTIAL_LAW", tangential),
             ("ROLLING_LAW", rolling),
             ("TWISTING_LAW", twisting),
+            ("COHESION_LAW", cohesion),
             ("HAS_TANGENTIAL_HISTORY", self.history.tangential as u8 as f64),
             ("HAS_ROLLING_HISTORY", self.history.rolling as u8 as f64),
         ];
@@ -560,9 +599,12 @@ impl GpuEngine {
         self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
     }
 
-    /// `pair_force`, `wall_contacts` (+ `wall_reduce`), `gather`, the springs advancing by the
-    /// elapsed time of `op` (a [`Op::Forces`]).
+    /// `update_bridges` (capillary scenes), `pair_force`, `wall_contacts` (+ `wall_reduce`),
+    /// `gather`, the springs advancing by the elapsed time of `op` (a [`Op::Forces`]).
     fn encode_forces(&self, pass: &mut wgpu::ComputePass, op: Op) {
+        if self.history.bridge {
+            self.run(pass, "update_bridges", Size::One, None);
+        }
         self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(op));
         if self.has_walls {
             self.run(pass, "wall_contacts", Size::Grains, Some(op));
@@ -592,6 +634,22 @@ impl GpuEngine {
             self.encode(pass, op);
             self.trace.record(op);
         }
+    }
+
+    /// Runs the schedule's prologue (the list built if need be, forces evaluated) where
+    /// nothing has evaluated the loads yet: before the first step, or after wetting.
+    fn ensure_loads(&mut self) {
+        if self.forces_valid {
+            return;
+        }
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            let prologue = self.schedule.prologue.clone();
+            self.encode_all(&mut pass, &prologue);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        self.forces_valid = true;
     }
 
     /// Starts recording the operations encoded (see [`Trace`]).
@@ -722,9 +780,8 @@ impl GpuEngine {
                 material: w.material,
             })
             .collect();
-        // The GPU keeps one vec4 per history block; the CPU layout packs three reals.
         let slots = HistorySlots::new(self.history);
-        let hist: Vec<f32> = gpu_hist.iter().flat_map(|b| [b[0], b[1], b[2]]).collect();
+        let hist = cpu_history(gpu_hist, &slots);
         let ctx = ForceContext {
             model: &self.model,
             coeffs: &self.coeffs,
@@ -734,6 +791,18 @@ impl GpuEngine {
             periodic: crate::periodic::Periodic::default(),
         };
         wall_contact_records(&body, &prop, &(0..self.n).collect::<Vec<u32>>(), &states, &ctx, &hist)
+    }
+
+    /// Liquid bridges among the first `n_pairs` pairs, the liquid they hold and the liquid
+    /// waiting on the grains (m^3), read back.
+    fn liquid_sums(&self, n_pairs: u64) -> (u64, f64, f64) {
+        let blocks = self.params.hist_blocks as usize;
+        let parts = self.read(&[("hist", 0, 16 * n_pairs * blocks as u64), ("liquid", 0, 4 * self.n as u64)]);
+        let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
+        let liquid: &[f32] = bytemuck::cast_slice(&parts[1]);
+        let volumes = hist.iter().skip(blocks - 1).step_by(blocks).map(|b| b[0]).filter(|&v| v > 0.0);
+        let (bridges, held) = volumes.fold((0, 0.0), |(n, s), v| (n + 1, s + v as f64));
+        (bridges, held, liquid.iter().map(|&l| l as f64).sum())
     }
 
     /// Reads grain arrays back (vec4 per grain).
@@ -786,17 +855,7 @@ impl Engine for GpuEngine {
     }
 
     fn stats(&mut self) -> Stats {
-        if !self.forces_valid {
-            // Statistics before the first step: build the list and evaluate forces once.
-            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                let prologue = self.schedule.prologue.clone();
-                self.encode_all(&mut pass, &prologue);
-            }
-            self.gpu.queue.submit([encoder.finish()]);
-            self.forces_valid = true;
-        }
+        self.ensure_loads();
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
@@ -833,6 +892,7 @@ impl Engine for GpuEngine {
             let (pv, pi) = (p(STAT_ROW - 2), s[2 * STAT_ROW - 1].to_bits());
             if gv > pv || (gv == pv && gi < pi) { (gv, gi) } else { (pv, pi) }
         };
+        let (bridges, liquid_in_bridges, liquid_on_grains) = if self.history.bridge { self.liquid_sums(control.n_pairs as u64) } else { (0, 0.0, 0.0) };
         let piston = self.piston.map(|w| {
             let wall = &walls[w];
             PistonStats {
@@ -868,9 +928,9 @@ impl Engine for GpuEngine {
             ke_rattlers: g(16),
             non_finite_grain: (control.non_finite != NONE).then_some(control.non_finite),
             rebuilds: control.rebuilds as u64,
-            bridges: 0,
-            liquid_in_bridges: 0.0,
-            liquid_on_grains: 0.0,
+            bridges,
+            liquid_in_bridges,
+            liquid_on_grains,
             walls: (0..n_walls)
                 .map(|w| {
                     let servo_plane = self.servo.and_then(|planes| planes.iter().position(|&p| p == w));
@@ -897,11 +957,13 @@ impl Engine for GpuEngine {
         let contact_records = contacts.then(|| {
             let np = self.control.n_pairs as u64;
             let blocks = self.params.hist_blocks as u64;
-            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, 16 * np), ("hist", 0, 16 * np * blocks)]);
+            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, 16 * np), ("hist", 0, 16 * np * blocks), ("out_tj", 0, 16 * np)]);
             let (pi, pj): (&[u32], &[u32]) = (&parts[0], &parts[1]);
             let fi: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
             let fj: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
             let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[4]);
+            // out_tj.w: the capillary force.
+            let f_c: Vec<f32> = bytemuck::cast_slice::<u32, [f32; 4]>(&parts[5]).iter().map(|t| t[3]).collect();
             let pos = &arrays[0];
             (0..np as usize)
                 .filter_map(|k| {
@@ -914,11 +976,11 @@ impl Engine for GpuEngine {
                         d2 += x * x;
                     }
                     let h = (a[3] + b[3]) as f64 - d2.sqrt();
-                    (h > 0.0).then(|| ContactRecord {
+                    (h > 0.0 || f_c[k] != 0.0).then(|| ContactRecord {
                         i: pi[k],
                         j: pj[k],
                         overlap: h,
-                        normal_force: fi[k][3] as f64,
+                        normal_force: (fi[k][3] + f_c[k]) as f64,
                         force: xyz(&fi[k]),
                         force_j: xyz(&fj[k]),
                         tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
@@ -955,8 +1017,42 @@ impl Engine for GpuEngine {
         self.gpu.queue.write_buffer(buffer, at(std::mem::offset_of!(layout::Servo, strain)), bytemuck::bytes_of(&strain));
     }
 
-    fn wet(&mut self, _: f64) -> anyhow::Result<()> {
-        anyhow::bail!("the GPU backend has no capillary cohesion yet; fix: run with --backend cpu")
+    fn wet(&mut self, volume: f64) -> anyhow::Result<()> {
+        use crate::real::Vec3;
+        let crate::model::CohesionLaw::Capillary { theta, .. } = self.model.cohesion else {
+            anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
+        };
+        // The liquid goes to the pairs of the current list.
+        self.ensure_loads();
+        let (n, np, blocks) = (self.n as u64, self.read_control().n_pairs as u64, self.params.hist_blocks as u64);
+        let parts = self.read(&[("pos", 0, 16 * n), ("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("hist", 0, 16 * np * blocks), ("liquid", 0, 4 * n)]);
+        let pos: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
+        let (pi, pj) = (&parts[1], &parts[2]);
+        let mut hist: Vec<[f32; 4]> = bytemuck::cast_slice(&parts[3]).to_vec();
+        let mut liquid: Vec<f32> = bytemuck::cast_slice(&parts[4]).to_vec();
+        // The CPU twin's reduced diameters and gaps (in f32, as its f32 engine has them).
+        let v3 = |p: &[f32; 4]| Vec3::new(p[0], p[1], p[2]);
+        let d: Vec<f64> = (0..np as usize).map(|k| {
+            let (ri, rj) = (pos[pi[k] as usize][3] as f64, pos[pj[k] as usize][3] as f64);
+            2.0 * ri * rj / (ri + rj)
+        }).collect();
+        let gaps: Vec<f64> = (0..np as usize).map(|k| {
+            let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
+            (self.periodic.min_image(v3(a) - v3(b)).norm() - a[3] - b[3]) as f64
+        }).collect();
+        let (shares, rest) = crate::model::share_liquid(volume, &d, &gaps, self.params.bridge_cap as f64, theta as f64);
+        let last = blocks as usize - 1;
+        for (k, v) in shares {
+            hist[k * blocks as usize + last][0] += v as f32;
+        }
+        let rest = (rest / n as f64) as f32;
+        for l in &mut liquid {
+            *l += rest;
+        }
+        self.gpu.queue.write_buffer(&self.buffers["hist"], 0, bytemuck::cast_slice(&hist));
+        self.gpu.queue.write_buffer(&self.buffers["liquid"], 0, bytemuck::cast_slice(&liquid));
+        self.forces_valid = false;
+        Ok(())
     }
 
     fn save(&self) -> Option<crate::checkpoint::EngineState> {

@@ -40,10 +40,11 @@ pub struct Params {
     pub k_n: f32,
     /// Viscous damping (N s/m).
     pub c_n: f32,
-    /// Padding.
-    pub _pad0: f32,
-    /// Padding.
-    pub _pad1: f32,
+    /// Distance beyond contact that pair detection reaches (m): the skin, plus the rupture
+    /// distance of the largest liquid bridge in capillary scenes.
+    pub reach: f32,
+    /// Capillary `kappa = 2 pi gamma cos(theta)` (N/m).
+    pub kappa: f32,
     /// k_t over the normal secant stiffness; <= 0 selects Mindlin.
     pub kt_ratio: f32,
     /// Hertz-Mindlin tangential damping ratio.
@@ -58,6 +59,14 @@ pub struct Params {
     pub static_damping: f32,
     /// Seed 000's rolling friction: 0 a torque pair, 1 eqs. 8-9 on each grain as written.
     pub rolling_as_written: u32,
+    /// Capillary contact angle (rad).
+    pub theta: f32,
+    /// Capillary decay-length coefficient `c` (-).
+    pub capillary_c: f32,
+    /// Largest bridge volume (m^3).
+    pub bridge_cap: f32,
+    /// Padding.
+    pub _pad0: f32,
 }
 
 /// What changes between dispatches of one step (WGSL `Phase`, uniform with dynamic offset).

@@ -37,3 +37,26 @@ pub fn capillary_force<T: Real>(kappa: T, theta: T, c: T, r_i: T, r_j: T, v_b: T
         T::ZERO
     }
 }
+
+/// How a volume of liquid (m^3) wets a sample: pairs within their rupture distance share it
+/// in proportion to their reduced diameter `d` (m), each share capped at `cap` (m^3); pairs
+/// beyond the rupture distance of their share drop out and raise the others' shares, until
+/// none drops. `gaps` (m) are the pairs' surface gaps, `theta` the contact angle (rad).
+/// Returns each wetted pair's `(index, volume)` and the volume left over, which waits on the
+/// grains (seed 001, PHYSICS.md).
+pub fn share_liquid(volume: f64, d: &[f64], gaps: &[f64], cap: f64, theta: f64) -> (Vec<(usize, f64)>, f64) {
+    let mut eligible: Vec<usize> = (0..d.len()).collect();
+    loop {
+        let total: f64 = eligible.iter().map(|&k| d[k]).sum();
+        let share = |k: usize| (volume * d[k] / total).min(cap);
+        let before = eligible.len();
+        eligible.retain(|&k| gaps[k] <= rupture_distance(theta, share(k)));
+        if eligible.len() == before || eligible.is_empty() {
+            break;
+        }
+    }
+    let total: f64 = eligible.iter().map(|&k| d[k]).sum();
+    let shares: Vec<(usize, f64)> = eligible.iter().map(|&k| (k, (volume * d[k] / total).min(cap))).collect();
+    let placed: f64 = shares.iter().map(|s| s.1).sum();
+    (shares, volume - placed)
+}

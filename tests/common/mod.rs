@@ -58,3 +58,20 @@ pub fn edit(text: &str, edits: &[(&str, &str)]) -> String {
         t.replace(from, to)
     })
 }
+
+/// Seed 000's elastic gas made frictional, damped and wet (w = 0.01): 120 grains whose
+/// liquid bridges break and form as they collide.
+pub fn wet_gas() -> Scene {
+    let text = std::fs::read_to_string(scene_path("elastic_gas.toml")).unwrap();
+    parse(&edit(
+        &text,
+        &[
+            ("count = 50", "count = 120"),
+            ("max = [6.0e-3, 6.0e-3, 6.0e-3] }\nrandom_speed = 0.5", "max = [8.0e-3, 8.0e-3, 8.0e-3] }\nrandom_speed = 0.3"),
+            ("max = [6.0e-3, 6.0e-3, 6.0e-3]\n", "max = [8.0e-3, 8.0e-3, 8.0e-3]\n"),
+            ("poisson_ratio = 0.3", "poisson_ratio = 0.3\nmu_s = 0.4\nrestitution = 0.8"),
+            ("damping = \"none\"\ntangential = \"none\"", "damping = \"restitution\"\ntangential = \"mindlin\"\ncohesion = \"capillary\""),
+            ("duration = 0.05", "duration = 0.05\nwater_content = 0.01"),
+        ],
+    ))
+}
