@@ -6,7 +6,7 @@
 @group(0) @binding(2) var<storage, read_write> args: array<DispatchArgs>;
 
 fn blocks(n: u32) -> DispatchArgs {
-    return DispatchArgs((n + 2047u) / 2048u, 1u, 1u);
+    return DispatchArgs((n + SCAN_BLOCK - 1u) / SCAN_BLOCK, 1u, 1u);
 }
 
 @compute @workgroup_size(1)

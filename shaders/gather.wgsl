@@ -1,8 +1,10 @@
 // One invocation sums the load on one grain in a fixed order: gravity, the pairs it owns,
 // the pairs where it is partner, its wall contacts. No float atomics. force.w counts the
-// grain's pairs that push (f_n > 0), for the statistics' rattlers.
+// grain's pairs that push (f_n > 0), for the statistics' rattlers. With phase.kick > 0 it
+// then kicks the grain (and invocation 0 the piston) under that load: the kick after an
+// evaluation, in the same dispatch.
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> vel: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read_write> vel: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> pair_start: array<u32>;
 @group(0) @binding(3) var<storage, read> rev_start: array<u32>;
 @group(0) @binding(4) var<storage, read> rev_pair: array<u32>;
@@ -14,10 +16,17 @@
 @group(0) @binding(10) var<storage, read> wall_torque: array<vec4<f32>>;
 @group(0) @binding(11) var<storage, read_write> force: array<vec4<f32>>;
 @group(0) @binding(12) var<storage, read_write> torque: array<vec4<f32>>;
+@group(0) @binding(13) var<uniform> phase: Phase;
+@group(0) @binding(14) var<storage, read_write> omega: array<vec4<f32>>;
+@group(0) @binding(15) var<storage, read_write> walls: array<Wall>;
+@group(0) @binding(16) var<storage, read> wall_reaction: array<vec4<f32>>;
 
 @compute @workgroup_size(64)
 fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat_index(wid, lid, nwg);
+    if (i == 0u && params.piston != NONE && phase.kick > 0.0) {
+        kick_piston(phase.kick);
+    }
     if (i >= params.n_grains) {
         return;
     }
@@ -36,6 +45,11 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index
         t += out_tj[k].xyz;
         pushing += select(0.0, 1.0, out_fi[k].w > 0.0);
     }
-    force[i] = vec4<f32>(f + wall_force[i].xyz, pushing);
-    torque[i] = vec4<f32>(t + wall_torque[i].xyz, 0.0);
+    let load = f + wall_force[i].xyz;
+    let moment = t + wall_torque[i].xyz;
+    force[i] = vec4<f32>(load, pushing);
+    torque[i] = vec4<f32>(moment, 0.0);
+    if (phase.kick > 0.0) {
+        kick_grain(i, load, moment, phase.kick);
+    }
 }

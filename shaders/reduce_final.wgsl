@@ -8,7 +8,7 @@
 
 var<workgroup> row: array<f32, WG * STAT_ROW>;
 
-fn fold(lid: u32, rows: u32, which: u32) {
+fn fold(lid: u32, rows: u32, which: u32, counts: u32) {
     clear_row(lid);
     let r = lid * STAT_ROW;
     for (var s = lid; s < rows; s += WG) {
@@ -16,7 +16,7 @@ fn fold(lid: u32, rows: u32, which: u32) {
         for (var f = 0u; f < STAT_MAX; f++) {
             var v = 0.0;
             if (which == 0u) { v = grain_rows[base + f]; } else { v = pair_rows[base + f]; }
-            row[r + f] += v;
+            row[r + f] = add_field(row[r + f], v, f, counts);
         }
         var vmax = 0.0;
         var arg = 0.0;
@@ -26,19 +26,19 @@ fn fold(lid: u32, rows: u32, which: u32) {
             row[r + STAT_ARG] = arg;
         }
     }
-    reduce_rows(lid);
+    reduce_rows(lid, counts);
 }
 
 @compute @workgroup_size(64)
 fn reduce_final(@builtin(local_invocation_index) lid: u32) {
     let grain_groups = (params.n_grains + WG - 1u) / WG;
-    fold(lid, grain_groups, 0u);
+    fold(lid, grain_groups, 0u, G_COUNTS);
     if (lid == 0u) {
         for (var f = 0u; f < STAT_ROW; f++) { stats[f] = row[f]; }
     }
     workgroupBarrier();
     let pair_groups = (control.n_pairs + WG - 1u) / WG;
-    fold(lid, pair_groups, 1u);
+    fold(lid, pair_groups, 1u, P_COUNTS);
     if (lid == 0u) {
         for (var f = 0u; f < STAT_ROW; f++) { stats[STAT_ROW + f] = row[f]; }
     }

@@ -32,27 +32,28 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         }
         let mv = v.xyz * v.w;
         let l = cross(x, mv) + w.xyz * w.w;
-        row[r + 0u] = 0.5 * v.w * dot(v.xyz, v.xyz);
-        row[r + 1u] = 0.5 * w.w * dot(w.xyz, w.xyz);
-        row[r + 2u] = -v.w * dot(params.gravity.xyz, x);
-        row[r + 3u] = mv.x;
-        row[r + 4u] = mv.y;
-        row[r + 5u] = mv.z;
-        row[r + 6u] = l.x;
-        row[r + 7u] = l.y;
-        row[r + 8u] = l.z;
-        row[r + 10u] = length(wall_force[i].xyz);
-        row[r + 13u] = wall_force[i].w;
-        row[r + 14u] = wall_torque[i].w;
+        row[r + G_KE_T] = 0.5 * v.w * dot(v.xyz, v.xyz);
+        row[r + G_KE_R] = 0.5 * w.w * dot(w.xyz, w.xyz);
+        row[r + G_PE_G] = -v.w * dot(params.gravity.xyz, x);
+        row[r + G_MOMENTUM] = mv.x;
+        row[r + G_MOMENTUM + 1u] = mv.y;
+        row[r + G_MOMENTUM + 2u] = mv.z;
+        row[r + G_ANGULAR] = l.x;
+        row[r + G_ANGULAR + 1u] = l.y;
+        row[r + G_ANGULAR + 2u] = l.z;
+        row[r + G_WALL_FORCE] = length(wall_force[i].xyz);
+        row[r + G_WALL_SLIDING] = count_field(u32(wall_force[i].w));
+        row[r + G_WALL_ROLLING] = count_field(u32(wall_torque[i].w));
         var contacts = force[i].w;
+        var wall_contacts = 0u;
         for (var k = 0u; k < params.n_walls; k++) {
             let frame = wall_frame(walls[k], p.xyz);
             let h = p.w - frame.w;
             if (h > 0.0) {
                 let c = coeffs[walls[k].material * params.n_materials + material[i]];
                 contacts += 1.0;
-                row[r + 11u] += 1.0;
-                row[r + 12u] += normal_potential(c, p.w, h);
+                wall_contacts += 1u;
+                row[r + G_WALL_ELASTIC] += normal_potential(c, p.w, h);
                 if (h / p.w > row[r + STAT_MAX]) {
                     row[r + STAT_MAX] = h / p.w;
                     row[r + STAT_ARG] = bitcast<f32>(i);
@@ -60,15 +61,16 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
             }
         }
         // A rattler (fewer than RATTLER_CONTACTS contacts) is counted apart.
-        row[r + 9u] = length(force[i].xyz);
+        row[r + G_WALL_CONTACTS] = count_field(wall_contacts);
+        row[r + G_NET_FORCE] = length(force[i].xyz);
         if (contacts < f32(RATTLER_CONTACTS)) {
-            row[r + 15u] = 1.0;
-            row[r + 16u] = row[r + 0u];
+            row[r + G_RATTLERS] = count_field(1u);
+            row[r + G_KE_RATTLERS] = row[r + G_KE_T];
         } else {
-            row[r + 17u] = row[r + 9u];
+            row[r + G_NET_LOADED] = row[r + G_NET_FORCE];
         }
     }
-    reduce_rows(lid);
+    reduce_rows(lid, G_COUNTS);
     if (lid == 0u) {
         let out = (wid.y * nwg.x + wid.x) * STAT_ROW;
         for (var f = 0u; f < STAT_ROW; f++) {

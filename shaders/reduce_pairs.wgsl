@@ -28,18 +28,18 @@ fn reduce_pairs(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
         let h = pi.w + pj.w - length(min_image(pi.xyz - pj.xyz));
         if (h > 0.0) {
             let c = coeffs[material[i] * params.n_materials + material[j]];
-            row[r + 0u] = 1.0;
-            row[r + 1u] = out_fj[k].w;
-            row[r + 2u] = normal_potential(c, pi.w * pj.w / (pi.w + pj.w), h);
-            row[r + 3u] = 2.0 * length(out_fi[k].xyz);
+            row[r + P_CONTACTS] = count_field(1u);
+            row[r + P_CLAMPED] = count_field(u32(out_fj[k].w));
+            row[r + P_ELASTIC] = normal_potential(c, pi.w * pj.w / (pi.w + pj.w), h);
+            row[r + P_FORCE] = 2.0 * length(out_fi[k].xyz);
             let regime = u32(out_ti[k].w);
-            row[r + 4u] = select(0.0, 1.0, regime == REGIME_SLIDING);
-            row[r + 5u] = select(0.0, 1.0, regime == REGIME_ROLLING);
+            row[r + P_SLIDING] = count_field(select(0u, 1u, regime == REGIME_SLIDING));
+            row[r + P_ROLLING] = count_field(select(0u, 1u, regime == REGIME_ROLLING));
             row[r + STAT_MAX] = h / min(pi.w, pj.w);
             row[r + STAT_ARG] = bitcast<f32>(i);
         }
     }
-    reduce_rows(lid);
+    reduce_rows(lid, P_COUNTS);
     if (lid == 0u) {
         let out = (wid.y * nwg.x + wid.x) * STAT_ROW;
         for (var f = 0u; f < STAT_ROW; f++) {

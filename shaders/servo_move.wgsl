@@ -1,4 +1,4 @@
-// One invocation moves the servo box's six planes by phase.tau (the CPU's servo_drift, in the
+// One invocation moves the servo box's six planes by phase.drift (the CPU's servo_drift, in the
 // same order): each along its normal at gain x (target - measured pressure), capped at the
 // largest speed, the gain lowered to `relaxation` of A / (k tau + c) where the wall's contacts
 // respond strongly; in triaxial mode the z planes close at the strain rate instead. The work
@@ -57,7 +57,7 @@ fn servo_move() {
         let w = servo_wall(k);
         let a = k / 2u;
         let area = e0[(a + 1u) % 3u] * e0[(a + 2u) % 3u];
-        let response = wall_reaction[MAX_WALLS + w].x * phase.tau + wall_reaction[MAX_WALLS + w].y;
+        let response = wall_reaction[MAX_WALLS + w].x * phase.drift + wall_reaction[MAX_WALLS + w].y;
         var gain = servo.gain;
         if (response > 0.0) {
             gain = min(servo.gain, servo.relaxation * area / response);
@@ -70,8 +70,8 @@ fn servo_move() {
         }
         let n = walls[w].normal.xyz;
         let v = n * speed;
-        walls[w].point = vec4<f32>(walls[w].point.xyz + v * phase.tau, walls[w].point.w);
+        walls[w].point = vec4<f32>(walls[w].point.xyz + v * phase.drift, walls[w].point.w);
         walls[w].velocity = vec4<f32>(v, 0.0);
-        book_work(-(dot_in_order(wall_reaction[w].xyz, v) * phase.tau));
+        book_work(-(dot_in_order(wall_reaction[w].xyz, v) * phase.drift));
     }
 }

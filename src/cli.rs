@@ -65,7 +65,7 @@ pub enum Command {
         #[arg(required_unless_present = "resume")]
         scene: Option<PathBuf>,
         /// Continue the run whose --out directory this is, from its last checkpoint (written
-        /// at every stage end by the CPU backend).
+        /// at every stage end and every output.checkpoint_interval inside a stage).
         #[arg(long, value_name = "DIR", conflicts_with = "out")]
         resume: Option<PathBuf>,
         /// Engine.
@@ -86,6 +86,9 @@ pub enum Command {
         /// Worker threads (default: all cores). Results do not depend on it.
         #[arg(long)]
         threads: Option<usize>,
+        /// Run even when the stages take more steps than a run can finish in practice.
+        #[arg(long)]
+        force: bool,
     },
     /// Validate a scene and print what a run would do.
     Check {

@@ -14,7 +14,7 @@ use std::path::Path;
 /// Runs one command.
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Run { scene, resume, backend, adapter, precision, out, json, threads } => {
+        Command::Run { scene, resume, backend, adapter, precision, out, json, threads, force } => {
             // The whole run happens on a worker of the pool, so that the CPU kernels' parallel
             // loops split work among workers instead of waking them from outside every time.
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start the worker threads")?;
@@ -26,6 +26,9 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 None => {
                     let path = scene.expect("clap requires a scene without --resume");
                     let scene = scene::load(&path)?;
+                    if !force {
+                        scene.check_practical()?;
+                    }
                     if !json {
                         for w in &scene.warnings {
                             eprintln!("warning: {w}");
@@ -44,7 +47,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Check { scene } => {
             let scene = scene::load(&scene)?;
             print!("{}", grains::output::check_report(&scene));
-            Ok(())
+            scene.check_practical()
         }
         Command::Fit { law: FitLaw::Bauer { file, p_column, e_column, mean_stress, trace_column, e0, profile, json } } => {
             use grains::analysis::fit::{e0_profile, fit_bauer, profile_e0s};

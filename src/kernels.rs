@@ -2,7 +2,8 @@
 //! includes, and its bindings in binding order. The GPU engine builds its pipelines and bind
 //! groups from it; `tests/shaders.rs` checks it against naga's reflection of each shader.
 //! The CPU engine's twins carry the same names (`src/cpu/`: `hash_cells`, `detect_pairs`,
-//! `remap_history`, `pair_force`, `wall_contacts`, `gather`, `integrate::{kick, drift}`);
+//! `remap_history`, `pair_force`, `wall_contacts`, `gather`, `integrate::{kick, drift}`, which the
+//! GPU's `integrate` runs as one dispatch when a kick is followed by a drift);
 //! the GPU-only kernels (scans, scatter, reverse list, reductions) are what a CPU does
 //! serially in a loop.
 
@@ -42,6 +43,7 @@ pub fn shared(name: &str) -> &'static str {
         "neighbours" => include_str!("../shaders/shared/neighbours.wgsl"),
         "walls" => include_str!("../shaders/shared/walls.wgsl"),
         "reduce" => include_str!("../shaders/shared/reduce.wgsl"),
+        "kick" => include_str!("../shaders/shared/kick.wgsl"),
         other => panic!("no shared WGSL file {other}"),
     }
 }
@@ -62,6 +64,7 @@ impl Kernel {
 use Access::{Phase, Read, ReadWrite, Uniform};
 
 const BASE: &[&str] = &["types", "dispatch"];
+const KICK: &[&str] = &["types", "dispatch", "kick"];
 const GRID: &[&str] = &["types", "dispatch", "grid"];
 const DETECT: &[&str] = &["types", "dispatch", "grid", "neighbours"];
 const FORCES: &[&str] = &["types", "dispatch", "grid", "model"];
@@ -76,7 +79,7 @@ macro_rules! kernel {
 
 /// Every kernel, in the order a rebuilding step runs them.
 pub const KERNELS: &[Kernel] = &[
-    kernel!("drift", BASE, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "vel": Read, "omega": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "control": ReadWrite]),
+    kernel!("integrate", KICK, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "force": Read, "torque": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "wall_reaction": Read, "control": ReadWrite]),
     kernel!("servo_move", BASE, ["params": Uniform, "phase": Phase, "walls": ReadWrite, "wall_reaction": Read, "servo": ReadWrite]),
     kernel!("decide_rebuild", BASE, ["params": Uniform, "control": ReadWrite, "args": ReadWrite]),
     kernel!("save_starts", BASE, ["params": Uniform, "pair_start": Read, "old_start": ReadWrite]),
@@ -97,8 +100,7 @@ pub const KERNELS: &[Kernel] = &[
     kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": ReadWrite, "out_fj": ReadWrite, "out_ti": ReadWrite, "out_tj": ReadWrite, "control": Read]),
     kernel!("wall_contacts", WALLS, ["params": Uniform, "phase": Phase, "pos": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_force": ReadWrite, "wall_torque": ReadWrite, "wall_partials": ReadWrite]),
     kernel!("wall_reduce", BASE, ["params": Uniform, "wall_partials": Read, "wall_reaction": ReadWrite]),
-    kernel!("gather", BASE, ["params": Uniform, "vel": Read, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "wall_force": Read, "wall_torque": Read, "force": ReadWrite, "torque": ReadWrite]),
-    kernel!("kick", BASE, ["params": Uniform, "phase": Phase, "vel": ReadWrite, "omega": ReadWrite, "force": Read, "torque": Read, "walls": ReadWrite, "wall_reaction": Read]),
+    kernel!("gather", KICK, ["params": Uniform, "vel": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "wall_force": Read, "wall_torque": Read, "force": ReadWrite, "torque": ReadWrite, "phase": Phase, "omega": ReadWrite, "walls": ReadWrite, "wall_reaction": Read]),
     kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "vel": Read, "omega": Read, "force": Read, "wall_force": Read, "wall_torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": ReadWrite]),
     kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "control": Read, "pair_rows": ReadWrite]),
     kernel!("reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": ReadWrite]),

@@ -228,3 +228,23 @@ fn gpu_run_and_compare_from_the_command_line() {
     assert_eq!(o.status.code(), Some(1));
     assert!(stderr(&o).contains("computes in f32"), "{}", stderr(&o));
 }
+
+/// A step that makes the run impossibly long is refused by `check` and `run`, naming the step
+/// count and the fix; `run --force` is the way past it.
+#[test]
+fn a_run_that_could_never_finish_is_refused_with_its_step_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string(common::scene_path("two_spheres.toml")).unwrap();
+    let path = dir.path().join("slow.toml");
+    std::fs::write(&path, common::edit(&text, &[("dt = \"auto\"", "dt = 1.0e-15")])).unwrap();
+    let path = path.to_str().unwrap();
+    for args in [vec!["check", path], vec!["run", path]] {
+        let o = grains(&args);
+        let err = stderr(&o);
+        println!("{}: {err}", args[0]);
+        assert_eq!(o.status.code(), Some(1), "{}", args[0]);
+        assert!(err.contains("simulation.dt = 1e-15") && err.contains("steps") && err.contains("--force") && err.contains("fix:"), "{err}");
+    }
+    let steps = grains::scene::load(std::path::Path::new(path)).unwrap().max_steps();
+    assert!(steps > grains::scene::PRACTICAL_STEPS, "{steps} steps");
+}

@@ -79,7 +79,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
         gravity, cell, periodic_lo, periodic_len, periodic_dims, skin, k_n, c_n, reach, kappa, kt_ratio,
         damping_ratio, k_r, gamma_r, mu_r, static_damping, rolling_as_written, theta, capillary_c, bridge_cap, _pad0
     ]);
-    check_struct!(&m, layout::Phase, "Phase", [tau, elapsed, _pad0, _pad1]);
+    check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, _pad0]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);
     check_struct!(&m, layout::Wall, "Wall", [kind, material, _pad0, _pad1, point, normal, velocity, piston]);
     check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite]);
@@ -97,6 +97,14 @@ fn rust_mirrors_match_the_wgsl_structures() {
     assert_eq!(constant("MAX_WALLS") as usize, layout::MAX_WALLS);
     assert_eq!(constant("STAT_ROW") as usize, layout::STAT_ROW);
     assert_eq!(constant("RATTLER_CONTACTS") as u64, grains::engine::RATTLER_CONTACTS);
+    assert_eq!(constant("SCAN_BLOCK") as u64, layout::SCAN_BLOCK);
+    use layout::stat::{grain, pair};
+    let grain_fields = [("G_KE_T", grain::KE_T), ("G_KE_R", grain::KE_R), ("G_PE_G", grain::PE_G), ("G_MOMENTUM", grain::MOMENTUM), ("G_ANGULAR", grain::ANGULAR), ("G_NET_FORCE", grain::NET_FORCE), ("G_WALL_FORCE", grain::WALL_FORCE), ("G_WALL_CONTACTS", grain::WALL_CONTACTS), ("G_WALL_ELASTIC", grain::WALL_ELASTIC), ("G_WALL_SLIDING", grain::WALL_SLIDING), ("G_WALL_ROLLING", grain::WALL_ROLLING), ("G_RATTLERS", grain::RATTLERS), ("G_KE_RATTLERS", grain::KE_RATTLERS), ("G_NET_LOADED", grain::NET_LOADED)];
+    let pair_fields = [("P_CONTACTS", pair::CONTACTS), ("P_CLAMPED", pair::CLAMPED), ("P_ELASTIC", pair::ELASTIC), ("P_FORCE", pair::FORCE), ("P_SLIDING", pair::SLIDING), ("P_ROLLING", pair::ROLLING)];
+    for (name, field) in grain_fields.iter().chain(&pair_fields) {
+        assert_eq!(constant(name) as usize, *field, "{name}");
+        assert!(*field < layout::STAT_ROW - 2, "{name} lies before the (largest, grain) pair");
+    }
     assert_eq!(constant("NONE"), layout::NONE);
     for (name, slot) in [("ARGS_GRAINS", layout::args::GRAINS), ("ARGS_HASH", layout::args::HASH), ("ARGS_HASH_BLOCKS", layout::args::HASH_BLOCKS), ("ARGS_GRAIN_BLOCKS", layout::args::GRAIN_BLOCKS), ("ARGS_ONE", layout::args::ONE), ("ARGS_OLD_PAIRS", layout::args::OLD_PAIRS), ("ARGS_PAIRS", layout::args::PAIRS), ("ARGS_NEW_PAIRS", layout::args::NEW_PAIRS), ("ARGS_GRAIN_STARTS", layout::args::GRAIN_STARTS), ("ARGS_SLOTS", layout::args::SLOTS)] {
         assert_eq!(constant(name) as u64, slot, "{name}");

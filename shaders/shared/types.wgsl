@@ -36,10 +36,10 @@ struct Params {
 
 // What changes between the dispatches of one step (uniform, dynamic offset).
 struct Phase {
-    tau: f32,      // kick or drift duration (s)
+    kick: f32,     // kick duration (s); 0: no kick
+    drift: f32,    // drift duration (s); 0: no drift
     elapsed: f32,  // time since the previous force evaluation (s), for the springs
     _pad0: f32,
-    _pad1: f32,
 }
 
 // Coefficients of a pair of materials, [material_i * n_materials + material_j].
@@ -115,9 +115,37 @@ const ARGS_GRAIN_STARTS: u32 = 8u;  // one per entry of n_grains + 1, if rebuild
 const ARGS_SLOTS: u32 = 9u;
 
 const MAX_WALLS: u32 = 8u;
+// Elements one workgroup of the scan handles (src/gpu/layout.rs SCAN_BLOCK).
+const SCAN_BLOCK: u32 = 2048u;
 // Grains with fewer contacts are rattlers (src/engine.rs RATTLER_CONTACTS).
 const RATTLER_CONTACTS: u32 = 2u;
 // Per-workgroup rows of the statistics reduction: sums, then (largest overlap, its grain).
 const STAT_ROW: u32 = 20u;
 const STAT_MAX: u32 = 18u;
 const STAT_ARG: u32 = 19u;
+// Fields of a grain row (src/gpu/layout.rs `stat::grain`).
+const G_KE_T: u32 = 0u;            // translational kinetic energy (J)
+const G_KE_R: u32 = 1u;            // rotational kinetic energy (J)
+const G_PE_G: u32 = 2u;            // gravitational energy (J)
+const G_MOMENTUM: u32 = 3u;        // 3 fields (kg m/s)
+const G_ANGULAR: u32 = 6u;         // 3 fields (kg m^2/s)
+const G_NET_FORCE: u32 = 9u;       // |net force| (N)
+const G_WALL_FORCE: u32 = 10u;     // |wall force| (N)
+const G_WALL_CONTACTS: u32 = 11u;  // count
+const G_WALL_ELASTIC: u32 = 12u;   // J
+const G_WALL_SLIDING: u32 = 13u;   // count
+const G_WALL_ROLLING: u32 = 14u;   // count
+const G_RATTLERS: u32 = 15u;       // count
+const G_KE_RATTLERS: u32 = 16u;    // J
+const G_NET_LOADED: u32 = 17u;     // |net force| of loaded grains (N)
+// Fields of a pair row (src/gpu/layout.rs `stat::pair`).
+const P_CONTACTS: u32 = 0u;        // count
+const P_CLAMPED: u32 = 1u;         // count
+const P_ELASTIC: u32 = 2u;         // J
+const P_FORCE: u32 = 3u;           // 2 |contact force| (N)
+const P_SLIDING: u32 = 4u;         // count
+const P_ROLLING: u32 = 5u;         // count
+// The fields of each row that hold u32 counts (bit f: field f), summed as integers so that
+// they stay exact past 2^24.
+const G_COUNTS: u32 = (1u << G_WALL_CONTACTS) | (1u << G_WALL_SLIDING) | (1u << G_WALL_ROLLING) | (1u << G_RATTLERS);
+const P_COUNTS: u32 = (1u << P_CONTACTS) | (1u << P_CLAMPED) | (1u << P_SLIDING) | (1u << P_ROLLING);

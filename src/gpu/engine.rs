@@ -5,10 +5,11 @@
 //! statistics back every `stats_interval` steps.
 
 use super::device::Gpu;
-use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, STAT_ROW, WG};
+use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, SCAN_BLOCK, STAT_ROW, WG};
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::kernels::{Access, KERNELS};
 use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+use super::plan::{plan, Dispatch, Entry};
 use crate::schedule::{Op, Schedule, Trace};
 use crate::scene::{Scene, WallShape};
 use std::collections::HashMap;
@@ -68,8 +69,10 @@ pub struct GpuEngine {
     n: u32,
     params: Params,
     schedule: Schedule,
-    /// The schedule's operations in the order of their uniform slots in `phase`.
-    phase_ops: Vec<Op>,
+    /// The plans of the schedule's prologue, first step and later steps.
+    plans: [Vec<Entry>; 3],
+    /// The phases of the plans, in the order of their uniform slots in `phase`.
+    phases: Vec<Phase>,
     /// The operations encoded, when tracing.
     trace: Trace,
     dt: f64,
@@ -318,17 +321,17 @@ impl GpuEngine {
         let phase_stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<Phase>() as u64);
         let dt = scene.time_step.dt;
         let schedule = Schedule::new(scene.integrator, dt);
-        let phase_ops = schedule.distinct();
-        let mut phase_bytes = vec![0u8; phase_stride as usize * phase_ops.len()];
-        for (slot, op) in phase_ops.iter().enumerate() {
-            let (tau, elapsed) = match *op {
-                Op::Kick { tau } | Op::Drift { tau } => (tau, 0.0),
-                Op::Forces { elapsed } => (0.0, elapsed),
-                Op::RebuildIfNeeded => (0.0, 0.0),
-            };
-            let p = Phase { tau: tau as f32, elapsed: elapsed as f32, ..Default::default() };
+        let plans = [plan(&schedule.prologue), plan(&schedule.first), plan(&schedule.step)];
+        let mut phases: Vec<Phase> = Vec::new();
+        for e in plans.iter().flatten() {
+            if !phases.contains(&e.phase) {
+                phases.push(e.phase);
+            }
+        }
+        let mut phase_bytes = vec![0u8; phase_stride as usize * phases.len()];
+        for (slot, p) in phases.iter().enumerate() {
             let at = slot * phase_stride as usize;
-            phase_bytes[at..at + std::mem::size_of::<Phase>()].copy_from_slice(bytemuck::bytes_of(&p));
+            phase_bytes[at..at + std::mem::size_of::<Phase>()].copy_from_slice(bytemuck::bytes_of(p));
         }
         init("phase", &phase_bytes, wgpu::BufferUsages::UNIFORM);
 
@@ -365,7 +368,8 @@ impl GpuEngine {
             n: n as u32,
             params,
             schedule,
-            phase_ops,
+            plans,
+            phases,
             trace: Trace::default(),
             dt,
             layouts: HashMap::new(),
@@ -489,7 +493,7 @@ impl GpuEngine {
             let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(k.name), source: wgpu::ShaderSource::Wgsl(k.wgsl().into()) });
             let mut constants: Vec<(&str, f64)> = if k.includes.contains(&"model") { model_constants.to_vec() } else { Vec::new() };
             match k.name {
-                "drift" => constants.push(orientation),
+                "integrate" => constants.push(orientation),
                 "wall_contacts" => constants.push(wall_response),
                 _ => {}
             }
@@ -546,10 +550,11 @@ impl GpuEngine {
         }
     }
 
-    fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, group: &str, size: Size, phase: Option<Op>) {
+    fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, group: &str, size: Size, phase: Option<Phase>) {
         pass.set_pipeline(&self.pipelines[name]);
-        let slot = |op: Op| self.phase_ops.iter().position(|o| *o == op).expect("every operation of the schedule has a uniform slot");
-        let offsets: Vec<u32> = phase.map(|op| (slot(op) as u64 * self.phase_stride) as u32).into_iter().collect();
+        // A kernel with a phase binding is given its phase; the others none.
+        let slot = |p: Phase| self.phases.iter().position(|q| *q == p).expect("every phase of the plans has a uniform slot");
+        let offsets: Vec<u32> = phase.map(|p| (slot(p) as u64 * self.phase_stride) as u32).into_iter().collect();
         pass.set_bind_group(0, &self.bind_groups[group], &offsets);
         self.dispatches.set(self.dispatches.get() + 1);
         match size {
@@ -562,13 +567,18 @@ impl GpuEngine {
         }
     }
 
-    fn run(&self, pass: &mut wgpu::ComputePass, name: &str, size: Size, phase: Option<Op>) {
+    fn run(&self, pass: &mut wgpu::ComputePass, name: &str, size: Size, phase: Option<Phase>) {
         self.dispatch(pass, name, name, size, phase);
     }
 
-    /// Exclusive scan of an array: blocks, the blocks' totals, then the offsets added back.
-    fn scan(&self, pass: &mut wgpu::ComputePass, tag: &str, sums_tag: &str, blocks: u64) {
+    /// Exclusive scan of an array of `elements`: blocks, the blocks' totals, then the offsets
+    /// added back (the last two only when there is more than one block).
+    fn scan(&self, pass: &mut wgpu::ComputePass, tag: &str, sums_tag: &str, blocks: u64, elements: u64) {
         self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{tag}"), Size::Indirect(blocks), None);
+        // An array of one block is scanned by then: its offset would be 0.
+        if elements <= SCAN_BLOCK {
+            return;
+        }
         self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{sums_tag}"), Size::Indirect(args::ONE), None);
         self.dispatch(pass, "scan_add", &format!("scan_add:{tag}"), Size::Indirect(blocks), None);
     }
@@ -584,55 +594,57 @@ impl GpuEngine {
         }
         self.run(pass, "clear_cells", Size::Indirect(args::HASH), None);
         self.run(pass, "hash_cells", Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "cell", "cell_sums", args::HASH_BLOCKS);
+        self.scan(pass, "cell", "cell_sums", args::HASH_BLOCKS, self.params.hash_size as u64);
         self.run(pass, "scatter_cells", Size::Indirect(args::GRAINS), None);
         self.run(pass, "detect_count", Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS);
+        self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
         self.run(pass, "pairs_ready", Size::One, None);
         self.run(pass, "detect_fill", Size::Indirect(args::GRAINS), None);
         if keeps_history {
             self.run(pass, "remap_history", Size::Indirect(args::NEW_PAIRS), None);
         }
         self.run(pass, "reverse_count", Size::Indirect(args::NEW_PAIRS), None);
-        self.scan(pass, "rev", "grain_sums", args::GRAIN_BLOCKS);
+        self.scan(pass, "rev", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
         self.run(pass, "reverse_fill", Size::Indirect(args::NEW_PAIRS), None);
         self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
     }
 
     /// `update_bridges` (capillary scenes), `pair_force`, `wall_contacts` (+ `wall_reduce`),
-    /// `gather`, the springs advancing by the elapsed time of `op` (a [`Op::Forces`]).
-    fn encode_forces(&self, pass: &mut wgpu::ComputePass, op: Op) {
+    /// `gather` (and the kick after it), with the durations of `phase`.
+    fn encode_forces(&self, pass: &mut wgpu::ComputePass, phase: Phase) {
         if self.history.bridge {
             self.run(pass, "update_bridges", Size::One, None);
         }
-        self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(op));
+        self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(phase));
         if self.has_walls {
-            self.run(pass, "wall_contacts", Size::Grains, Some(op));
+            self.run(pass, "wall_contacts", Size::Grains, Some(phase));
             self.run(pass, "wall_reduce", Size::One, None);
         }
-        self.run(pass, "gather", Size::Grains, None);
+        self.run(pass, "gather", Size::Grains, Some(phase));
     }
 
-    /// Encodes one operation of the schedule.
-    fn encode(&self, pass: &mut wgpu::ComputePass, op: Op) {
-        match op {
-            Op::Kick { .. } => self.run(pass, "kick", Size::Grains, Some(op)),
-            Op::Drift { .. } => {
-                self.run(pass, "drift", Size::Grains, Some(op));
-                if self.servo.is_some() {
-                    self.run(pass, "servo_move", Size::One, Some(op));
+    /// Encodes one entry of a plan.
+    fn encode(&self, pass: &mut wgpu::ComputePass, e: &Entry) {
+        match e.dispatch {
+            Dispatch::Integrate => {
+                self.run(pass, "integrate", Size::Grains, Some(e.phase));
+                if self.servo.is_some() && e.phase.drift > 0.0 {
+                    self.run(pass, "servo_move", Size::One, Some(e.phase));
                 }
             }
-            Op::RebuildIfNeeded => self.encode_rebuild_if_needed(pass),
-            Op::Forces { .. } => self.encode_forces(pass, op),
+            Dispatch::RebuildIfNeeded => self.encode_rebuild_if_needed(pass),
+            Dispatch::Forces => self.encode_forces(pass, e.phase),
         }
     }
 
-    /// Encodes `ops` in order and traces them.
-    fn encode_all(&mut self, pass: &mut wgpu::ComputePass, ops: &[Op]) {
-        for &op in ops {
-            self.encode(pass, op);
-            self.trace.record(op);
+    /// Encodes plan `which` (0 prologue, 1 first step, 2 later steps) and traces its
+    /// operations.
+    fn encode_plan(&mut self, pass: &mut wgpu::ComputePass, which: usize) {
+        for k in 0..self.plans[which].len() {
+            self.encode(pass, &self.plans[which][k]);
+            for op in self.plans[which][k].ops.clone() {
+                self.trace.record(op);
+            }
         }
     }
 
@@ -645,8 +657,7 @@ impl GpuEngine {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            let prologue = self.schedule.prologue.clone();
-            self.encode_all(&mut pass, &prologue);
+            self.encode_plan(&mut pass, 0);
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.forces_valid = true;
@@ -837,12 +848,10 @@ impl Engine for GpuEngine {
             {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
                 if self.schedule.needs_loads && !self.forces_valid {
-                    let prologue = self.schedule.prologue.clone();
-                    self.encode_all(&mut pass, &prologue);
+                    self.encode_plan(&mut pass, 0);
                 }
                 for s in 0..chunk {
-                    let ops = self.schedule.ops(self.step + s).to_vec();
-                    self.encode_all(&mut pass, &ops);
+                    self.encode_plan(&mut pass, if self.step + s == 0 { 1 } else { 2 });
                 }
             }
             self.gpu.queue.submit([encoder.finish()]);
@@ -878,15 +887,19 @@ impl Engine for GpuEngine {
         let s: &[f32] = bytemuck::cast_slice(&parts[1]);
         let reaction: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
         let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[3]);
+        use layout::stat::{grain as gr, pair as pr};
         let g = |f: usize| s[f] as f64;
         let p = |f: usize| s[STAT_ROW + f] as f64;
+        let g_count = |f: usize| s[f].to_bits() as u64;
+        let p_count = |f: usize| s[STAT_ROW + f].to_bits() as u64;
         let n = self.n as f64;
-        let contacts = p(0).round() as u64;
-        let wall_contacts = g(11).round() as u64;
+        let contacts = p_count(pr::CONTACTS);
+        let wall_contacts = g_count(gr::WALL_CONTACTS);
         let contact_ends = 2 * contacts + wall_contacts;
-        let rattlers = g(15).round() as u64;
-        let unbalanced_force = crate::engine::unbalanced(g(9), n, p(3) + g(10), contact_ends);
-        let unbalanced_force_loaded = crate::engine::unbalanced(g(17), n - rattlers as f64, p(3) + g(10), contact_ends);
+        let rattlers = g_count(gr::RATTLERS);
+        let contact_force = p(pr::FORCE) + g(gr::WALL_FORCE);
+        let unbalanced_force = crate::engine::unbalanced(g(gr::NET_FORCE), n, contact_force, contact_ends);
+        let unbalanced_force_loaded = crate::engine::unbalanced(g(gr::NET_LOADED), n - rattlers as f64, contact_force, contact_ends);
         let (max_overlap, max_overlap_grain) = {
             let (gv, gi) = (g(STAT_ROW - 2), s[STAT_ROW - 1].to_bits());
             let (pv, pi) = (p(STAT_ROW - 2), s[2 * STAT_ROW - 1].to_bits());
@@ -905,27 +918,27 @@ impl Engine for GpuEngine {
         Stats {
             step: self.step,
             time: self.time,
-            ke_translational: g(0),
-            ke_rotational: g(1),
-            elastic_energy: p(2) + g(12),
-            gravity_energy: g(2),
+            ke_translational: g(gr::KE_T),
+            ke_rotational: g(gr::KE_R),
+            elastic_energy: p(pr::ELASTIC) + g(gr::WALL_ELASTIC),
+            gravity_energy: g(gr::PE_G),
             piston_ke: self.piston.map_or(0.0, |w| 0.5 * walls[w].piston[0] as f64 * (walls[w].velocity[2] as f64).powi(2)),
             external_work: self.piston.map_or(0.0, |w| walls[w].piston[3] as f64) + servo.work as f64 + servo.work_lo as f64,
-            momentum: [g(3), g(4), g(5)],
-            angular_momentum: [g(6), g(7), g(8)],
+            momentum: [0, 1, 2].map(|a| g(gr::MOMENTUM + a)),
+            angular_momentum: [0, 1, 2].map(|a| g(gr::ANGULAR + a)),
             pairs: control.n_pairs as u64,
             contacts,
             wall_contacts,
-            clamped: p(1).round() as u64,
-            sliding: (p(4) + g(13)).round() as u64,
-            rolling: (p(5) + g(14)).round() as u64,
+            clamped: p_count(pr::CLAMPED),
+            sliding: p_count(pr::SLIDING) + g_count(gr::WALL_SLIDING),
+            rolling: p_count(pr::ROLLING) + g_count(gr::WALL_ROLLING),
             coordination: 2.0 * contacts as f64 / n,
             max_overlap,
             max_overlap_grain: if max_overlap_grain == NONE { 0 } else { max_overlap_grain },
             unbalanced_force,
             unbalanced_force_loaded,
             rattlers,
-            ke_rattlers: g(16),
+            ke_rattlers: g(gr::KE_RATTLERS),
             non_finite_grain: (control.non_finite != NONE).then_some(control.non_finite),
             rebuilds: control.rebuilds as u64,
             bridges,

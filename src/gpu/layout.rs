@@ -71,16 +71,16 @@ pub struct Params {
 
 /// What changes between dispatches of one step (WGSL `Phase`, uniform with dynamic offset).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Phase {
-    /// Kick or drift duration (s).
-    pub tau: f32,
+    /// Kick duration (s); 0: no kick.
+    pub kick: f32,
+    /// Drift duration (s); 0: no drift.
+    pub drift: f32,
     /// Time since the previous force evaluation (s).
     pub elapsed: f32,
     /// Padding.
     pub _pad0: f32,
-    /// Padding.
-    pub _pad1: f32,
 }
 
 /// Coefficients of a pair of materials (WGSL `PairCoeffs`).
@@ -195,8 +195,61 @@ pub const WG: u32 = 64;
 pub const MAX_WALLS: usize = 8;
 /// Reals per statistics row (WGSL `STAT_ROW`).
 pub const STAT_ROW: usize = 20;
-/// Largest element count the two-level scan handles: 2048 blocks of 2048.
-pub const MAX_SCAN: u64 = 2048 * 2048;
+/// Fields of the statistics rows (WGSL `G_*`, `P_*`): sums of f32, except the counts, whose
+/// u32 bits sit in their f32 slots and are summed as integers (WGSL `G_COUNTS`, `P_COUNTS`).
+pub mod stat {
+    /// A grain row.
+    pub mod grain {
+        /// Translational kinetic energy (J).
+        pub const KE_T: usize = 0;
+        /// Rotational kinetic energy (J).
+        pub const KE_R: usize = 1;
+        /// Gravitational energy (J).
+        pub const PE_G: usize = 2;
+        /// Momentum, 3 fields (kg m/s).
+        pub const MOMENTUM: usize = 3;
+        /// Angular momentum, 3 fields (kg m^2/s).
+        pub const ANGULAR: usize = 6;
+        /// |net force| (N).
+        pub const NET_FORCE: usize = 9;
+        /// |wall force| (N).
+        pub const WALL_FORCE: usize = 10;
+        /// Wall contacts (count).
+        pub const WALL_CONTACTS: usize = 11;
+        /// Elastic energy of the wall contacts (J).
+        pub const WALL_ELASTIC: usize = 12;
+        /// Wall contacts sliding (count).
+        pub const WALL_SLIDING: usize = 13;
+        /// Wall contacts rolling (count).
+        pub const WALL_ROLLING: usize = 14;
+        /// Rattlers (count).
+        pub const RATTLERS: usize = 15;
+        /// Kinetic energy of the rattlers (J).
+        pub const KE_RATTLERS: usize = 16;
+        /// |net force| of the loaded grains (N).
+        pub const NET_LOADED: usize = 17;
+    }
+    /// A pair row.
+    pub mod pair {
+        /// Touching pairs (count).
+        pub const CONTACTS: usize = 0;
+        /// Clamped contacts (count).
+        pub const CLAMPED: usize = 1;
+        /// Elastic energy (J).
+        pub const ELASTIC: usize = 2;
+        /// 2 |contact force| (N).
+        pub const FORCE: usize = 3;
+        /// Sliding contacts (count).
+        pub const SLIDING: usize = 4;
+        /// Rolling contacts (count).
+        pub const ROLLING: usize = 5;
+    }
+}
+
+/// Elements one workgroup of the scan handles (WGSL `SCAN_BLOCK`).
+pub const SCAN_BLOCK: u64 = 2048;
+/// Largest element count the two-level scan handles: a block of block totals.
+pub const MAX_SCAN: u64 = SCAN_BLOCK * SCAN_BLOCK;
 /// Indirect-argument slots (WGSL `ARGS_*`).
 pub mod args {
     /// One invocation per grain, if rebuilding.

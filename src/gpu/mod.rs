@@ -4,6 +4,7 @@
 pub mod device;
 mod engine;
 pub mod layout;
+pub mod plan;
 
 pub use device::{describe_all, open, Gpu, GpuError};
 pub use engine::{GpuEngine, GpuSetupError, INITIAL_PAIRS_PER_GRAIN, PAIR_GROWTH_THRESHOLD, STEPS_PER_SUBMIT};

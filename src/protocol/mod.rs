@@ -216,7 +216,7 @@ fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dy
     let StageProgress { mut done, step0, time0, initial_void_ratio } = start;
     let guard = progress.guard.clone();
     let dt = scene.time_step.dt;
-    let total = (stage.duration / dt).round().max(1.0) as u64;
+    let total = stage.max_steps(dt);
     let k = scene.stats_interval;
     let n = engine.grain_count() as f64;
     let settles = stage.kind != StageKind::Run;

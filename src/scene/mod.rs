@@ -222,6 +222,38 @@ pub struct Output {
 /// loses at most about this much work.
 pub const DEFAULT_CHECKPOINT_INTERVAL: f64 = 600.0;
 
+/// Steps above which a run cannot finish in practice: at 10^4 steps per second (a few
+/// thousand grains on a fast machine) a billion steps take 28 hours. `grains run` refuses
+/// more without `--force`.
+pub const PRACTICAL_STEPS: u64 = 1_000_000_000;
+
+impl Stage {
+    /// The stage's longest run in steps of `dt` (s).
+    pub fn max_steps(&self, dt: f64) -> u64 {
+        (self.duration / dt).round().max(1.0) as u64
+    }
+}
+
+impl Scene {
+    /// Steps of the whole run at most (every stage to its longest).
+    pub fn max_steps(&self) -> u64 {
+        self.stages.iter().map(|s| s.max_steps(self.time_step.dt)).fold(0u64, u64::saturating_add)
+    }
+
+    /// Refuses a run of more than [`PRACTICAL_STEPS`] steps, naming the count and the fix.
+    pub fn check_practical(&self) -> anyhow::Result<()> {
+        let steps = self.max_steps();
+        if steps > PRACTICAL_STEPS {
+            anyhow::bail!(
+                "{}: simulation.dt = {:e} s: the stages take up to {steps:.3e} steps, more than a run can finish ({PRACTICAL_STEPS:.0e} steps take about a day at 10^4 steps/s); fix: raise simulation.dt (or \"auto\"), shorten the stages, or pass --force",
+                self.path.display(),
+                self.time_step.dt
+            );
+        }
+        Ok(())
+    }
+}
+
 /// A validated scene, in SI units and `f64`; engines convert to their precision.
 #[derive(Clone, Debug)]
 pub struct Scene {

@@ -1,0 +1,73 @@
+//! How the GPU engine encodes the schedule: neighbouring operations that each grain runs on
+//! its own data are one dispatch (a kick and the drift after it in `integrate`; an
+//! evaluation's gather and the kick after it in `gather`), with the arithmetic of running
+//! them apart, so the step costs fewer dispatches and gives the same bits.
+
+use super::layout::Phase;
+use crate::schedule::Op;
+
+/// What one entry of a plan encodes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dispatch {
+    /// `integrate` (a kick and/or a drift), then `servo_move` after a drift in servo scenes.
+    Integrate,
+    /// `decide_rebuild` and the rebuild kernels (zero workgroups when the list is good).
+    RebuildIfNeeded,
+    /// `update_bridges` (capillary scenes), `pair_force`, `wall_contacts`, `wall_reduce` and
+    /// `gather`, which kicks too when the phase has a kick.
+    Forces,
+}
+
+/// One entry of a plan: the dispatches, their phase uniform and the operations they run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Entry {
+    /// What is encoded.
+    pub dispatch: Dispatch,
+    /// Durations it runs with.
+    pub phase: Phase,
+    /// The schedule's operations it covers, in order.
+    pub ops: Vec<Op>,
+}
+
+/// The plan of `ops`.
+pub fn plan(ops: &[Op]) -> Vec<Entry> {
+    let mut out = Vec::new();
+    let mut k = 0;
+    while k < ops.len() {
+        let next = ops.get(k + 1).copied();
+        let (dispatch, phase, covered) = match (ops[k], next) {
+            (Op::Kick { tau }, Some(Op::Drift { tau: drift })) => (Dispatch::Integrate, Phase { kick: tau as f32, drift: drift as f32, ..Default::default() }, 2),
+            (Op::Kick { tau }, _) => (Dispatch::Integrate, Phase { kick: tau as f32, ..Default::default() }, 1),
+            (Op::Drift { tau }, _) => (Dispatch::Integrate, Phase { drift: tau as f32, ..Default::default() }, 1),
+            (Op::RebuildIfNeeded, _) => (Dispatch::RebuildIfNeeded, Phase::default(), 1),
+            (Op::Forces { elapsed }, Some(Op::Kick { tau })) => (Dispatch::Forces, Phase { elapsed: elapsed as f32, kick: tau as f32, ..Default::default() }, 2),
+            (Op::Forces { elapsed }, _) => (Dispatch::Forces, Phase { elapsed: elapsed as f32, ..Default::default() }, 1),
+        };
+        out.push(Entry { dispatch, phase, ops: ops[k..k + covered].to_vec() });
+        k += covered;
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::schedule::Schedule;
+    use crate::scene::Integrator;
+
+    /// A plan covers its operations exactly once and in order, and velocity Verlet's step is
+    /// three dispatch groups: kick+drift, the rebuild check, forces+kick.
+    #[test]
+    fn a_plan_covers_the_schedule_in_order() {
+        for integrator in [Integrator::VelocityVerlet, Integrator::OptimizedVerlet] {
+            let s = Schedule::new(integrator, 1e-6);
+            for ops in [&s.prologue, &s.first, &s.step] {
+                let p = plan(ops);
+                let covered: Vec<Op> = p.iter().flat_map(|e| e.ops.clone()).collect();
+                assert_eq!(&covered, ops, "{integrator:?}");
+            }
+        }
+        let vv = plan(&Schedule::new(Integrator::VelocityVerlet, 1e-6).step);
+        assert_eq!(vv.iter().map(|e| e.dispatch).collect::<Vec<_>>(), [Dispatch::Integrate, Dispatch::RebuildIfNeeded, Dispatch::Forces]);
+    }
+}
