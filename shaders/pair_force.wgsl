@@ -24,7 +24,7 @@ fn load_history(k: u32) -> History {
     var b = k * params.hist_blocks;
     if (HAS_TANGENTIAL_HISTORY) { h.tangential = hist[b].xyz; h.sliding = hist[b].w != 0.0; b += 1u; }
     if (HAS_ROLLING_HISTORY) { h.rolling = hist[b].xyz; b += 1u; }
-    if (COHESION_LAW == 1u) { h.bridge = hist[b].x; }
+    if (COHESION_LAW == COHESION_CAPILLARY) { h.bridge = hist[b].x; }
     return h;
 }
 
@@ -32,7 +32,7 @@ fn store_history(k: u32, h: History) {
     var b = k * params.hist_blocks;
     if (HAS_TANGENTIAL_HISTORY) { hist[b] = vec4<f32>(h.tangential, select(0.0, 1.0, h.sliding)); b += 1u; }
     if (HAS_ROLLING_HISTORY) { hist[b] = vec4<f32>(h.rolling, 0.0); b += 1u; }
-    if (COHESION_LAW == 1u) { hist[b] = vec4<f32>(h.bridge, 0.0, 0.0, 0.0); }
+    if (COHESION_LAW == COHESION_CAPILLARY) { hist[b] = vec4<f32>(h.bridge, 0.0, 0.0, 0.0); }
 }
 
 @compute @workgroup_size(64)
@@ -53,7 +53,7 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
         var open = empty_history();
         var f_c = 0.0;
         var n = vec3<f32>(0.0);
-        if (COHESION_LAW == 1u) {
+        if (COHESION_LAW == COHESION_CAPILLARY) {
             open.bridge = load_history(k).bridge;
             let dist = sqrt(dist2);
             f_c = capillary_force(pi.w, pj.w, open.bridge, dist - reach);
@@ -78,7 +78,7 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
     var f = contact_force(c, g, kin, bodies, &h, phase.elapsed);
     store_history(k, h);
     var f_c = 0.0;
-    if (COHESION_LAW == 1u) {
+    if (COHESION_LAW == COHESION_CAPILLARY) {
         f_c = capillary_force(pi.w, pj.w, h.bridge, -g.h);
         f.f_i += g.n * f_c;
         f.f_j -= g.n * f_c;

@@ -8,9 +8,9 @@
 //! f64, which holds f32 exactly. A checkpoint is written to a temporary file and renamed, so
 //! the file on disk is always a whole one.
 
+pub use crate::engine::EngineState;
 use anyhow::{bail, Context};
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader, Read, Write};
 use std::path::Path;
 
@@ -43,42 +43,6 @@ pub struct CheckpointHeader {
     /// length in bytes at the checkpoint: what was written after it is cut off on resuming.
     #[serde(default)]
     pub files: Vec<(String, u64)>,
-}
-
-/// An engine's state as named arrays.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct EngineState {
-    /// Real arrays (f64; f32 engines widen exactly).
-    pub reals: BTreeMap<String, Vec<f64>>,
-    /// Integer arrays (u64; signed values stored as their two's-complement bits).
-    pub ints: BTreeMap<String, Vec<u64>>,
-}
-
-impl EngineState {
-    /// Stores a real array.
-    pub fn put_reals(&mut self, name: &str, v: impl IntoIterator<Item = f64>) {
-        self.reals.insert(name.to_string(), v.into_iter().collect());
-    }
-    /// Stores an integer array.
-    pub fn put_ints(&mut self, name: &str, v: impl IntoIterator<Item = u64>) {
-        self.ints.insert(name.to_string(), v.into_iter().collect());
-    }
-    /// A real array of `len` values.
-    pub fn reals(&self, name: &str, len: usize) -> anyhow::Result<&[f64]> {
-        let v = self.reals.get(name).with_context(|| format!("the checkpoint has no `{name}`"))?;
-        if v.len() != len {
-            bail!("the checkpoint's `{name}` holds {} values, this scene needs {len}", v.len());
-        }
-        Ok(v)
-    }
-    /// An integer array of `len` values (any length when `len` is `None`).
-    pub fn ints(&self, name: &str, len: Option<usize>) -> anyhow::Result<&[u64]> {
-        let v = self.ints.get(name).with_context(|| format!("the checkpoint has no `{name}`"))?;
-        if let Some(len) = len.filter(|&l| l != v.len()) {
-            bail!("the checkpoint's `{name}` holds {} values, this scene needs {len}", v.len());
-        }
-        Ok(v)
-    }
 }
 
 #[derive(Serialize, Deserialize)]

@@ -1,6 +1,8 @@
 //! What the host loop needs from a backend: advance, read a few statistics, take a frame.
 
+use anyhow::{bail, Context};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// Why a run stopped early.
 #[derive(Debug, thiserror::Error)]
@@ -265,6 +267,42 @@ pub struct WallContactRecord {
     pub force: [f64; 3],
 }
 
+/// An engine's state as named arrays.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct EngineState {
+    /// Real arrays (f64; f32 engines widen exactly).
+    pub reals: BTreeMap<String, Vec<f64>>,
+    /// Integer arrays (u64; signed values stored as their two's-complement bits).
+    pub ints: BTreeMap<String, Vec<u64>>,
+}
+
+impl EngineState {
+    /// Stores a real array.
+    pub fn put_reals(&mut self, name: &str, v: impl IntoIterator<Item = f64>) {
+        self.reals.insert(name.to_string(), v.into_iter().collect());
+    }
+    /// Stores an integer array.
+    pub fn put_ints(&mut self, name: &str, v: impl IntoIterator<Item = u64>) {
+        self.ints.insert(name.to_string(), v.into_iter().collect());
+    }
+    /// A real array of `len` values.
+    pub fn reals(&self, name: &str, len: usize) -> anyhow::Result<&[f64]> {
+        let v = self.reals.get(name).with_context(|| format!("the checkpoint has no `{name}`"))?;
+        if v.len() != len {
+            bail!("the checkpoint's `{name}` holds {} values, this scene needs {len}", v.len());
+        }
+        Ok(v)
+    }
+    /// An integer array of `len` values (any length when `len` is `None`).
+    pub fn ints(&self, name: &str, len: Option<usize>) -> anyhow::Result<&[u64]> {
+        let v = self.ints.get(name).with_context(|| format!("the checkpoint has no `{name}`"))?;
+        if let Some(len) = len.filter(|&l| l != v.len()) {
+            bail!("the checkpoint's `{name}` holds {} values, this scene needs {len}", v.len());
+        }
+        Ok(v)
+    }
+}
+
 /// A backend the host loop can drive.
 pub trait Engine {
     /// "cpu" or "gpu".
@@ -286,9 +324,9 @@ pub trait Engine {
     /// Sets the piston's target pressure (Pa); no effect without a piston.
     fn set_piston_pressure(&mut self, pressure: f64);
     /// The engine's whole state for a checkpoint; `None` where the backend cannot save it.
-    fn save(&self) -> Option<crate::checkpoint::EngineState>;
+    fn save(&self) -> Option<EngineState>;
     /// Restores a state `save` returned, for the same scene, backend and precision.
-    fn restore(&mut self, state: &crate::checkpoint::EngineState) -> anyhow::Result<()>;
+    fn restore(&mut self, state: &EngineState) -> anyhow::Result<()>;
     /// Sets the servo walls' target pressure (Pa, when given) and switches the z walls to a
     /// fixed strain rate (1/s, positive closing) or back to pressure control (`None`).
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>);

@@ -14,8 +14,8 @@
 //! `t_c /` [`MAX_COLLISION_STEPS`] the scene is refused.
 
 use crate::model::{ContactModel, NormalLaw, PairCoeffs};
-use crate::scene::{Grains, Material, Wall};
-use serde::Serialize;
+pub use crate::scene::types::{CharacteristicTimes, TimeStep};
+use crate::scene::types::{Grains, Material, Wall};
 
 /// `auto` uses this fraction of the Rayleigh time at most.
 pub const AUTO_RAYLEIGH_FRACTION: f64 = 0.1;
@@ -30,29 +30,12 @@ pub const MAX_RAYLEIGH_FRACTION: f64 = 1.0;
 /// Fewer steps per collision than this is refused.
 pub const MAX_COLLISION_STEPS: f64 = 5.0;
 
-/// The times a step is chosen from.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct CharacteristicTimes {
-    /// Rayleigh time of the smallest grain (s); infinite for the linear law.
-    pub rayleigh: f64,
-    /// Shortest collision time at `expected_speed` (s).
-    pub collision: f64,
-    /// Speed the collision time is computed for (m/s).
-    pub expected_speed: f64,
-}
-
-/// The chosen step and where it came from.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct TimeStep {
-    /// Time step (s).
-    pub dt: f64,
-    /// True when chosen by `auto`.
-    pub auto: bool,
-    /// The times it was chosen from.
-    pub times: CharacteristicTimes,
-}
-
 impl TimeStep {
+    /// The step suggested after an instability (s): half this one, and no more than `auto`
+    /// would pick.
+    pub fn suggested_after_instability(&self) -> f64 {
+        (0.5 * self.dt).min(self.auto_dt())
+    }
     /// The `auto` step.
     pub fn auto(times: CharacteristicTimes) -> Self {
         TimeStep { dt: auto_dt(&times), auto: true, times }

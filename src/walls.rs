@@ -1,7 +1,11 @@
 //! Wall geometry shared by the scene checks and the engines.
 
 use crate::real::{Real, Vec3};
-use crate::scene::WallShape;
+use crate::scene::types::WallShape;
+
+/// Fraction of the largest stable servo gain a servo wall keeps where its contacts are stiff
+/// (`A / (k tau + c)`, see the CPU engine's `servo_drift` and WGSL `servo_move`).
+pub const SERVO_RELAXATION: f64 = 0.5;
 
 /// The surface of a wall at one instant, in the engine's precision.
 #[derive(Clone, Copy, Debug, PartialEq)]

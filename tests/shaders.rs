@@ -77,7 +77,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     check_struct!(&m, layout::Params, "Params", [
         n_grains, n_walls, n_materials, pair_capacity, hash_size, max_neighbours, piston, hist_blocks,
         gravity, cell, periodic_lo, periodic_len, periodic_dims, skin, k_n, c_n, reach, kappa, kt_ratio,
-        damping_ratio, k_r, gamma_r, mu_r, static_damping, rolling_as_written, theta, capillary_c, bridge_cap, _pad0
+        damping_ratio, k_r, gamma_r, mu_r, static_damping, rolling_as_written, theta, capillary_c, bridge_cap, kt_law
     ]);
     check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, _pad0]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);
@@ -98,6 +98,9 @@ fn rust_mirrors_match_the_wgsl_structures() {
     assert_eq!(constant("STAT_ROW") as usize, layout::STAT_ROW);
     assert_eq!(constant("RATTLER_CONTACTS") as u64, grains::engine::RATTLER_CONTACTS);
     assert_eq!(constant("SCAN_BLOCK") as u64, layout::SCAN_BLOCK);
+    for (name, kind) in [("WALL_PLANE", layout::wall_kind::PLANE), ("WALL_CYLINDER", layout::wall_kind::CYLINDER), ("WALL_PISTON", layout::wall_kind::PISTON)] {
+        assert_eq!(constant(name), kind, "{name}");
+    }
     use layout::stat::{grain, pair};
     let grain_fields = [("G_KE_T", grain::KE_T), ("G_KE_R", grain::KE_R), ("G_PE_G", grain::PE_G), ("G_MOMENTUM", grain::MOMENTUM), ("G_ANGULAR", grain::ANGULAR), ("G_NET_FORCE", grain::NET_FORCE), ("G_WALL_FORCE", grain::WALL_FORCE), ("G_WALL_CONTACTS", grain::WALL_CONTACTS), ("G_WALL_ELASTIC", grain::WALL_ELASTIC), ("G_WALL_SLIDING", grain::WALL_SLIDING), ("G_WALL_ROLLING", grain::WALL_ROLLING), ("G_RATTLERS", grain::RATTLERS), ("G_KE_RATTLERS", grain::KE_RATTLERS), ("G_NET_LOADED", grain::NET_LOADED)];
     let pair_fields = [("P_CONTACTS", pair::CONTACTS), ("P_CLAMPED", pair::CLAMPED), ("P_ELASTIC", pair::ELASTIC), ("P_FORCE", pair::FORCE), ("P_SLIDING", pair::SLIDING), ("P_ROLLING", pair::ROLLING)];
@@ -108,5 +111,19 @@ fn rust_mirrors_match_the_wgsl_structures() {
     assert_eq!(constant("NONE"), layout::NONE);
     for (name, slot) in [("ARGS_GRAINS", layout::args::GRAINS), ("ARGS_HASH", layout::args::HASH), ("ARGS_HASH_BLOCKS", layout::args::HASH_BLOCKS), ("ARGS_GRAIN_BLOCKS", layout::args::GRAIN_BLOCKS), ("ARGS_ONE", layout::args::ONE), ("ARGS_OLD_PAIRS", layout::args::OLD_PAIRS), ("ARGS_PAIRS", layout::args::PAIRS), ("ARGS_NEW_PAIRS", layout::args::NEW_PAIRS), ("ARGS_GRAIN_STARTS", layout::args::GRAIN_STARTS), ("ARGS_SLOTS", layout::args::SLOTS)] {
         assert_eq!(constant(name) as u64, slot, "{name}");
+    }
+}
+
+/// The laws' codes in the shaders are the Rust side's, name for name.
+#[test]
+fn law_codes_match_the_rust_side() {
+    let src = grains::kernels::kernel("pair_force").wgsl();
+    let m = module(&src, "pair_force");
+    for (name, code) in grains::model::code::ALL {
+        let (_, c) = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some(*name)).unwrap_or_else(|| panic!("no WGSL const {name}"));
+        match m.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => assert_eq!(v, *code, "{name}"),
+            ref e => panic!("{name}: {e:?}"),
+        }
     }
 }

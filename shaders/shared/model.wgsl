@@ -1,15 +1,34 @@
 // Contact sub-models, the WGSL twins of src/model/*.rs. Conventions: n points from j to i;
 // h > 0 in contact; forces and torques are "on i" unless named _j.
 
+// The laws' codes (src/model/mod.rs `code`, checked by tests/shaders.rs).
+const NORMAL_HERTZ: u32 = 0u;
+const NORMAL_LINEAR: u32 = 1u;
+const DAMPING_NONE: u32 = 0u;
+const DAMPING_PAPERS: u32 = 1u;
+const DAMPING_RESTITUTION: u32 = 2u;
+const DAMPING_VISCOUS: u32 = 3u;
+const TANGENTIAL_NONE: u32 = 0u;
+const TANGENTIAL_OQUENDO: u32 = 1u;
+const TANGENTIAL_MINDLIN: u32 = 2u;
+const STIFFNESS_MINDLIN: u32 = 0u;
+const STIFFNESS_RATIO: u32 = 1u;
+const ROLLING_NONE: u32 = 0u;
+const ROLLING_SDS: u32 = 1u;
+const TWISTING_NONE: u32 = 0u;
+const TWISTING_OQUENDO: u32 = 1u;
+const COHESION_NONE: u32 = 0u;
+const COHESION_CAPILLARY: u32 = 1u;
+
 // Laws chosen per scene (pipeline-overridable constants, so unused branches fold away).
-override NORMAL_LAW: u32 = 0u;      // 0 hertz, 1 linear
-override DAMPING_LAW: u32 = 0u;     // 0 none, 1 papers, 2 restitution, 3 viscous
-override TANGENTIAL_LAW: u32 = 0u;  // 0 none, 1 oquendo, 2 mindlin
-override ROLLING_LAW: u32 = 0u;     // 0 none, 1 sds
-override TWISTING_LAW: u32 = 0u;    // 0 none, 1 oquendo
+override NORMAL_LAW: u32 = NORMAL_HERTZ;
+override DAMPING_LAW: u32 = DAMPING_NONE;
+override TANGENTIAL_LAW: u32 = TANGENTIAL_NONE;
+override ROLLING_LAW: u32 = ROLLING_NONE;
+override TWISTING_LAW: u32 = TWISTING_NONE;
+override COHESION_LAW: u32 = COHESION_NONE;    // capillary: a bridge volume per pair
 override HAS_TANGENTIAL_HISTORY: bool = false;
 override HAS_ROLLING_HISTORY: bool = false;
-override COHESION_LAW: u32 = 0u;     // 0 none, 1 capillary (a bridge volume per pair)
 
 struct Geometry {
     n: vec3<f32>,
@@ -121,7 +140,7 @@ fn geometry_grain_wall(n: vec3<f32>, dist: f32, r_i: f32, m_i: f32) -> Geometry 
 
 // Elastic normal force (N) and secant stiffness F/h (N/m).
 fn normal_elastic(c: PairCoeffs, g: Geometry) -> vec2<f32> {
-    if (NORMAL_LAW == 0u) {
+    if (NORMAL_LAW == NORMAL_HERTZ) {
         let k = 4.0 / 3.0 * c.v_eff * sqrt(g.r_eff * g.h);
         return vec2<f32>(k * g.h, k);
     }
@@ -130,7 +149,7 @@ fn normal_elastic(c: PairCoeffs, g: Geometry) -> vec2<f32> {
 
 // Normal tangent stiffness dF_el/dh (N/m): 2 V_eff sqrt(R_eff h) (Hertz), k_n (linear).
 fn normal_stiffness(c: PairCoeffs, g: Geometry) -> f32 {
-    if (NORMAL_LAW == 1u) {
+    if (NORMAL_LAW == NORMAL_LINEAR) {
         return params.k_n;
     }
     return 2.0 * c.v_eff * sqrt(g.r_eff * g.h);
@@ -138,17 +157,17 @@ fn normal_stiffness(c: PairCoeffs, g: Geometry) -> f32 {
 
 // Damping coefficient eta (kg/s): the damping force on i is -eta v_n n.
 fn normal_damping(c: PairCoeffs, g: Geometry) -> f32 {
-    if (DAMPING_LAW == 1u) {
+    if (DAMPING_LAW == DAMPING_PAPERS) {
         return g.m_eff * c.gamma_n * sqrt(g.h);
     }
-    if (DAMPING_LAW == 2u) {
-        if (NORMAL_LAW == 0u) {
+    if (DAMPING_LAW == DAMPING_RESTITUTION) {
+        if (NORMAL_LAW == NORMAL_HERTZ) {
             let s_n = 2.0 * c.v_eff * sqrt(g.r_eff * g.h);
             return 2.0 * sqrt(5.0 / 6.0) * c.beta * sqrt(s_n * g.m_eff);
         }
         return 2.0 * c.beta * sqrt(params.k_n * g.m_eff);
     }
-    if (DAMPING_LAW == 3u) {
+    if (DAMPING_LAW == DAMPING_VISCOUS) {
         return params.c_n;
     }
     return 0.0;
@@ -173,7 +192,7 @@ fn contact_tangential_velocity(g: Geometry, k: Kinematics) -> vec3<f32> {
 }
 
 fn tangential_stiffness(c: PairCoeffs, g: Geometry, k_secant: f32) -> f32 {
-    if (params.kt_ratio > 0.0) {
+    if (params.kt_law == STIFFNESS_RATIO) {
         return params.kt_ratio * k_secant;
     }
     return 8.0 * c.g_eff * sqrt(g.r_eff * g.h);
@@ -227,7 +246,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
     out.t_j = vec3<f32>(0.0);
 
     out.regime = REGIME_STATIC;
-    if (TANGENTIAL_LAW == 1u) {
+    if (TANGENTIAL_LAW == TANGENTIAL_OQUENDO) {
         // Seed 000's regimes (src/model/tangential.rs oquendo_tangential).
         let k_t = tangential_stiffness(c, g, el.y);
         let v_t = contact_tangential_velocity(g, k);
@@ -287,7 +306,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
         out.t_i += t_i;
         out.t_j += t_j;
     }
-    if (TANGENTIAL_LAW == 2u) {
+    if (TANGENTIAL_LAW == TANGENTIAL_MINDLIN) {
         let k_t = tangential_stiffness(c, g, el.y);
         let v_t = contact_tangential_velocity(g, k);
         (*hist).tangential = rotate_into_plane((*hist).tangential, g.n) + v_t * elapsed;
@@ -305,7 +324,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
         out.t_i -= cross(g.n, f_t) * g.rp_i;
         out.t_j -= cross(g.n, f_t) * g.rp_j;
     }
-    if (ROLLING_LAW == 1u) {
+    if (ROLLING_LAW == ROLLING_SDS) {
         let v_rl = cross(k.w_i - k.w_j, g.n) * g.r_eff;
         (*hist).rolling = rotate_into_plane((*hist).rolling, g.n) + v_rl * elapsed;
         let damp = v_rl * params.gamma_r;
@@ -320,7 +339,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
         out.t_i += tau;
         out.t_j -= tau;
     }
-    if (TWISTING_LAW == 1u) {
+    if (TWISTING_LAW == TWISTING_OQUENDO) {
         let w_n = g.n * dot(k.w_i - k.w_j, g.n);
         let tau = w_n * (-4.0 * 3.14159265358979 * c.gamma_nt * g.m_eff * g.r_eff * g.h);
         out.t_i += tau;
@@ -331,7 +350,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
 
 // Elastic energy (J) of a normal spring with overlap h.
 fn normal_potential(c: PairCoeffs, r_eff: f32, h: f32) -> f32 {
-    if (NORMAL_LAW == 0u) {
+    if (NORMAL_LAW == NORMAL_HERTZ) {
         return 8.0 / 15.0 * sqrt(r_eff) * c.v_eff * h * h * sqrt(h);
     }
     return 0.5 * params.k_n * h * h;

@@ -21,7 +21,7 @@ struct Params {
     c_n: f32,             // viscous damping (N s/m)
     reach: f32,           // distance beyond contact that pair detection reaches (m)
     kappa: f32,           // capillary 2 pi gamma cos(theta) (N/m)
-    kt_ratio: f32,        // k_t / (F_el / h); <= 0 selects Mindlin's k_t
+    kt_ratio: f32,        // k_t / (F_el / h) when kt_law is STIFFNESS_RATIO
     damping_ratio: f32,   // eta_t / eta_n (Hertz-Mindlin tangential dashpot)
     k_r: f32,             // rolling stiffness (N/m)
     gamma_r: f32,         // rolling damping (N s/m)
@@ -31,7 +31,7 @@ struct Params {
     theta: f32,           // capillary contact angle (rad)
     capillary_c: f32,     // capillary decay-length coefficient (-)
     bridge_cap: f32,      // largest bridge volume (m^3)
-    _pad0: f32,
+    kt_law: u32,          // STIFFNESS_MINDLIN or STIFFNESS_RATIO (kt_ratio x the normal secant stiffness)
 }
 
 // What changes between the dispatches of one step (uniform, dynamic offset).
@@ -54,7 +54,12 @@ struct PairCoeffs {
     beta: f32,
 }
 
-// A wall. kind: 0 plane, 1 cylinder, 2 piston.
+// Wall kinds (src/gpu/layout.rs wall_kind).
+const WALL_PLANE: u32 = 0u;
+const WALL_CYLINDER: u32 = 1u;
+const WALL_PISTON: u32 = 2u;
+
+// A wall of kind WALL_*.
 struct Wall {
     kind: u32,
     material: u32,

@@ -8,14 +8,17 @@
 
 mod gather;
 mod grid;
+mod controllers;
 mod integrate;
 mod lanes;
 mod pair_force;
 mod pairs;
 mod profile;
 mod reduce;
+mod snapshot;
 pub mod simd;
 mod state;
+mod stats;
 mod wall_contacts;
 
 pub use integrate::rotate;
@@ -25,14 +28,15 @@ pub use profile::PHASE_NAMES;
 pub use state::{Body, HistorySlots, Load, Props};
 pub use wall_contacts::{wall_contact_records, WallState};
 
-use crate::checkpoint::EngineState;
+use crate::engine::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
 use crate::model::{normal_potential, rupture_distance, share_liquid, CohesionLaw, ContactForce, ContactModel, PairCoeffs, Regime};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 use crate::schedule::{Op, Schedule, Trace};
 use crate::scene::{Scene, WallShape};
-use crate::walls::WallGeom;
+use crate::walls::{WallGeom, SERVO_RELAXATION};
+use controllers::{Piston, Servo};
 use gather::gather_block;
 use grid::{hash_cells, CellGrid};
 use pair_force::pair_block;
@@ -41,34 +45,8 @@ use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS, PAR_MIN_PAIRS};
 use wall_contacts::wall_block;
 
-/// Fraction of the largest stable servo gain used where a wall's contacts are stiff.
-pub const SERVO_RELAXATION: f64 = 0.5;
 
-/// The piston's dynamic state.
-#[derive(Clone, Copy, Debug)]
-struct Piston<T> {
-    /// Index into the walls.
-    wall: usize,
-    mass: T,
-    area: T,
-    /// Target pressure (Pa).
-    pressure: T,
-}
 
-/// The servo box's control state.
-#[derive(Clone, Copy, Debug)]
-struct Servo<T> {
-    /// Wall indices: x_min, x_max, y_min, y_max, z_min, z_max.
-    walls: [usize; 6],
-    /// Target pressure (Pa).
-    pressure: T,
-    /// Wall speed per pressure error (m/(s Pa)).
-    gain: T,
-    /// Largest wall speed (m/s).
-    max_speed: T,
-    /// Strain rate of the z walls (1/s), when they are strain-controlled.
-    strain_rate: Option<T>,
-}
 
 /// The CPU engine in precision `T`.
 pub struct CpuEngine<T: Real> {
@@ -180,7 +158,7 @@ impl<T: Real> CpuEngine<T> {
             n_materials,
             gravity: Vec3::of(scene.gravity),
             dt: T::of(scene.time_step.dt),
-            suggested_dt: crate::protocol::suggested_dt(scene),
+            suggested_dt: scene.time_step.suggested_after_instability(),
             schedule: Schedule::new(scene.integrator, scene.time_step.dt),
             trace: Trace::default(),
             skin: T::of(scene.skin),
@@ -464,62 +442,9 @@ impl<T: Real> CpuEngine<T> {
         self.trace.ops()
     }
 
-    /// Plane point and unit normal of wall `w` (a plane).
-    fn plane(&self, w: usize) -> (Vec3<T>, Vec3<T>) {
-        match self.walls[w].geom {
-            WallGeom::Plane { point, normal } => (point, normal),
-            _ => unreachable!("servo walls are planes"),
-        }
-    }
 
-    /// Extent of the servo box along each axis (m).
-    fn servo_extents(&self, s: &Servo<T>) -> [T; 3] {
-        let coord = |k: usize, a: usize| {
-            let p = self.plane(s.walls[k]).0;
-            [p.x, p.y, p.z][a]
-        };
-        [0, 1, 2].map(|a| coord(2 * a + 1, a) - coord(2 * a, a))
-    }
 
-    /// The pressure (Pa) the grains exert on servo wall `k` (0..6) of the box.
-    fn servo_pressure(&self, s: &Servo<T>, k: usize) -> T {
-        let e = self.servo_extents(s);
-        let a = k / 2;
-        let area = e[(a + 1) % 3] * e[(a + 2) % 3];
-        let (_, normal) = self.plane(s.walls[k]);
-        -self.wall_reaction[s.walls[k]].dot(normal) / area
-    }
 
-    /// Moves the servo walls by `tau` (s): each plane along its normal at
-    /// `gain x (target - measured pressure)`, capped at the largest speed; in triaxial mode the
-    /// z planes close at the strain rate instead. Books their work on the grains.
-    ///
-    /// The gain is lowered where the wall's contacts respond strongly: a wall moving at `v` for
-    /// `tau` changes the pressure it reads by `(k tau + c) v / A` (`k` the summed contact
-    /// stiffness, `c` the summed damping coefficients: a moving wall feels its own dashpots),
-    /// so a gain above `A / (k tau + c)` overshoots every step and the wall rattles; the servo
-    /// keeps to [`SERVO_RELAXATION`] of that, as YADE's and Thornton's servos do for stiffness.
-    fn servo_drift(&mut self, tau: T) {
-        let Some(s) = self.servo else { return };
-        let extents = self.servo_extents(&s);
-        for k in 0..6 {
-            let w = s.walls[k];
-            let (point, normal) = self.plane(w);
-            let a = k / 2;
-            let area = extents[(a + 1) % 3] * extents[(a + 2) % 3];
-            let (k_wall, c_wall) = self.wall_response[w];
-            let response = k_wall * tau + c_wall;
-            let gain = if response > T::ZERO { s.gain.min(T::of(SERVO_RELAXATION) * area / response) } else { s.gain };
-            let speed = match s.strain_rate {
-                Some(rate) if k >= 4 => rate * extents[2] * T::of(0.5),
-                _ => (gain * (s.pressure - self.servo_pressure(&s, k))).max(-s.max_speed).min(s.max_speed),
-            };
-            let velocity = normal * speed;
-            self.walls[w].geom = WallGeom::Plane { point: point + velocity * tau, normal };
-            self.walls[w].velocity = velocity;
-            self.external_work -= (self.wall_reaction[w].dot(velocity) * tau).f64();
-        }
-    }
 
     /// One time step of the scene's integrator.
     pub fn step(&mut self) -> Result<(), SimError> {
@@ -596,34 +521,7 @@ fn wall_pass<T: Real>(
     total
 }
 
-/// Per-chunk partial sums of the statistics over grains.
-#[derive(Clone, Copy, Default)]
-struct GrainSums {
-    ke_t: f64,
-    ke_r: f64,
-    pe_g: f64,
-    momentum: [f64; 3],
-    angular: [f64; 3],
-    net_force: f64,
-    net_force_loaded: f64,
-    rattlers: u64,
-    ke_rattlers: f64,
-    wall_force: f64,
-    wall_contacts: u64,
-    wall_elastic: f64,
-    max_wall_overlap: (f64, u32),
-}
 
-/// Per-chunk partial sums of the statistics over pairs.
-#[derive(Clone, Copy, Default)]
-struct PairSums {
-    contacts: u64,
-    clamped: u64,
-    regimes: RegimeCounts,
-    elastic: f64,
-    force: f64,
-    max_overlap: (f64, u32),
-}
 
 /// Bytes a vector holds allocated.
 #[allow(clippy::ptr_arg)] // the capacity lives on the Vec, not the slice
@@ -631,9 +529,6 @@ fn allocated<X>(v: &Vec<X>) -> u64 {
     (v.capacity() * std::mem::size_of::<X>()) as u64
 }
 
-fn max_by_first(a: (f64, u32), b: (f64, u32)) -> (f64, u32) {
-    if b.0 > a.0 { b } else { a }
-}
 
 impl<T: Real> Engine for CpuEngine<T> {
     fn backend(&self) -> &'static str {
@@ -658,217 +553,7 @@ impl<T: Real> Engine for CpuEngine<T> {
         Ok(())
     }
 
-    fn stats(&mut self) -> Stats {
-        // A rebuild that fails here (a non-finite grain) leaves the loads as they were: the
-        // statistics name the grain and the next step returns the error.
-        self.ensure_loads().ok();
-        let g = self.gravity;
-        let grain_sums = chunked(self.body.len(), |r| {
-            let mut s = GrainSums::default();
-            for i in r {
-                let (b, p, l) = (&self.body[i], &self.prop[i], &self.load[i]);
-                let m = p.mass.f64();
-                let v = b.vel.f64();
-                let pos = if self.image.is_empty() { b.pos } else { self.periodic.unwrap(b.pos, self.image[i]) };
-                let x = pos.f64();
-                s.ke_t += 0.5 * m * b.vel.norm2().f64();
-                s.ke_r += 0.5 * p.inertia.f64() * b.omega.norm2().f64();
-                s.pe_g -= m * g.dot(pos).f64();
-                let w = b.omega.f64();
-                let ii = p.inertia.f64();
-                let mv = [m * v[0], m * v[1], m * v[2]];
-                for (p, q) in s.momentum.iter_mut().zip(mv) {
-                    *p += q;
-                }
-                s.angular[0] += x[1] * mv[2] - x[2] * mv[1] + ii * w[0];
-                s.angular[1] += x[2] * mv[0] - x[0] * mv[2] + ii * w[1];
-                s.angular[2] += x[0] * mv[1] - x[1] * mv[0] + ii * w[2];
-                let pushes = |k: u32| (self.out[k as usize].f_n > T::ZERO) as u64;
-                let pl = &self.pairs;
-                let mut contacts: u64 = (pl.owner_start[i]..pl.owner_start[i + 1]).map(pushes).sum::<u64>() + pl.rev_pair[pl.rev_start[i] as usize..pl.rev_start[i + 1] as usize].iter().map(|&k| pushes(k)).sum::<u64>();
-                for wall in &self.walls {
-                    let (_, dist) = wall.geom.frame(b.pos);
-                    let h = p.radius - dist;
-                    if h > T::ZERO {
-                        contacts += 1;
-                        let c = &self.coeffs[wall.material as usize * self.n_materials + p.material as usize];
-                        s.wall_contacts += 1;
-                        s.wall_elastic += normal_potential(&self.model.normal, c, p.radius, h).f64();
-                        s.max_wall_overlap = max_by_first(s.max_wall_overlap, ((h / p.radius).f64(), self.id[i]));
-                    }
-                }
-                s.wall_force += self.wall_load[i].force.norm().f64();
-                let net = l.force.norm().f64();
-                s.net_force += net;
-                if contacts < RATTLER_CONTACTS {
-                    s.rattlers += 1;
-                    s.ke_rattlers += 0.5 * m * b.vel.norm2().f64();
-                } else {
-                    s.net_force_loaded += net;
-                }
-            }
-            s
-        });
-        let pair_sums = chunked(self.pairs.len(), |r| {
-            let mut s = PairSums::default();
-            for k in r {
-                let (h, r_min) = self.pair_overlap(k);
-                if h <= T::ZERO {
-                    continue;
-                }
-                let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
-                let (pi, pj) = (&self.prop[i], &self.prop[j]);
-                let c = &self.coeffs[pi.material as usize * self.n_materials + pj.material as usize];
-                let r_eff = pi.radius * pj.radius / (pi.radius + pj.radius);
-                s.contacts += 1;
-                s.clamped += self.out[k].clamped as u64;
-                s.regimes.count(self.out[k].regime);
-                s.elastic += normal_potential(&self.model.normal, c, r_eff, h).f64();
-                s.force += 2.0 * self.out[k].f_i.norm().f64();
-                s.max_overlap = max_by_first(s.max_overlap, ((h / r_min).f64(), self.id[i]));
-            }
-            s
-        });
-        let mut gs = GrainSums::default();
-        for s in grain_sums {
-            gs.ke_t += s.ke_t;
-            gs.ke_r += s.ke_r;
-            gs.pe_g += s.pe_g;
-            for a in 0..3 {
-                gs.momentum[a] += s.momentum[a];
-                gs.angular[a] += s.angular[a];
-            }
-            gs.net_force += s.net_force;
-            gs.net_force_loaded += s.net_force_loaded;
-            gs.rattlers += s.rattlers;
-            gs.ke_rattlers += s.ke_rattlers;
-            gs.wall_force += s.wall_force;
-            gs.wall_contacts += s.wall_contacts;
-            gs.wall_elastic += s.wall_elastic;
-            gs.max_wall_overlap = max_by_first(gs.max_wall_overlap, s.max_wall_overlap);
-        }
-        let mut ps = PairSums::default();
-        for s in pair_sums {
-            ps.contacts += s.contacts;
-            ps.clamped += s.clamped;
-            ps.regimes.add(s.regimes);
-            ps.elastic += s.elastic;
-            ps.force += s.force;
-            ps.max_overlap = max_by_first(ps.max_overlap, s.max_overlap);
-        }
-        let n = self.body.len() as f64;
-        // Each touching pair counts once per grain; each wall contact once.
-        let contact_ends = 2 * ps.contacts + gs.wall_contacts;
-        let unbalanced_force = crate::engine::unbalanced(gs.net_force, n, ps.force + gs.wall_force, contact_ends);
-        let unbalanced_force_loaded = crate::engine::unbalanced(gs.net_force_loaded, n - gs.rattlers as f64, ps.force + gs.wall_force, contact_ends);
-        let (max_overlap, max_overlap_grain) = max_by_first(ps.max_overlap, gs.max_wall_overlap);
-        let walls = (0..self.walls.len())
-            .map(|w| {
-                let servo = self.servo.and_then(|s| s.walls.iter().position(|&x| x == w).map(|k| (s, k)));
-                WallStats {
-                    name: self.wall_names[w].clone(),
-                    force: self.wall_reaction[w].f64(),
-                    contacts: self.wall_count[w],
-                    position: servo.map(|(_, k)| {
-                        let p = self.plane(w).0;
-                        [p.x, p.y, p.z][k / 2].f64()
-                    }),
-                    pressure: servo.map(|(s, k)| self.servo_pressure(&s, k).f64()),
-                }
-            })
-            .collect();
-        let piston = self.piston.map(|p| {
-            let wall = &self.walls[p.wall];
-            let z = match wall.geom {
-                WallGeom::Piston { z } => z.f64(),
-                _ => unreachable!("the piston's wall is a piston"),
-            };
-            PistonStats {
-                z,
-                velocity: wall.velocity.z.f64(),
-                target_pressure: p.pressure.f64(),
-                pressure: self.wall_reaction[p.wall].z.f64() / p.area.f64(),
-            }
-        });
-        let piston_ke = self.piston.map_or(0.0, |p| 0.5 * p.mass.f64() * self.walls[p.wall].velocity.z.f64().powi(2));
-        let (bridges, liquid_in_bridges) = if self.slots.layout.bridge {
-            let (stride, b) = (self.slots.stride, self.slots.bridge);
-            chunked(self.pairs.len(), |r| r.map(|k| self.hist[k * stride + b].f64()).filter(|v| *v > 0.0).fold((0u64, 0.0), |(n, s), v| (n + 1, s + v)))
-                .into_iter()
-                .fold((0, 0.0), |(n, s), (m, t)| (n + m, s + t))
-        } else {
-            (0, 0.0)
-        };
-        let liquid_on_grains: f64 = chunked(self.liquid.len(), |r| self.liquid[r].iter().map(|x| x.f64()).sum::<f64>()).into_iter().sum();
-        Stats {
-            step: self.step,
-            time: self.time,
-            ke_translational: gs.ke_t,
-            ke_rotational: gs.ke_r,
-            elastic_energy: ps.elastic + gs.wall_elastic,
-            gravity_energy: gs.pe_g,
-            piston_ke,
-            external_work: self.external_work,
-            momentum: gs.momentum,
-            angular_momentum: gs.angular,
-            pairs: self.pairs.len() as u64,
-            contacts: ps.contacts,
-            wall_contacts: gs.wall_contacts,
-            clamped: ps.clamped,
-            sliding: ps.regimes.sliding + self.wall_regimes.sliding,
-            rolling: ps.regimes.rolling + self.wall_regimes.rolling,
-            coordination: 2.0 * ps.contacts as f64 / n,
-            max_overlap,
-            max_overlap_grain,
-            unbalanced_force,
-            unbalanced_force_loaded,
-            rattlers: gs.rattlers,
-            ke_rattlers: gs.ke_rattlers,
-            non_finite_grain: self.body.iter().position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|i| self.id[i]),
-            rebuilds: self.rebuilds,
-            bridges,
-            liquid_in_bridges,
-            liquid_on_grains,
-            walls,
-            piston,
-        }
-    }
 
-    fn frame(&self, contacts: bool) -> Frame {
-        Frame {
-            time: self.time,
-            id: self.id.clone(),
-            position: self.body.iter().map(|b| b.pos.f64()).collect(),
-            radius: self.prop.iter().map(|p| p.radius.f64()).collect(),
-            velocity: self.body.iter().map(|b| b.vel.f64()).collect(),
-            angular_velocity: self.body.iter().map(|b| b.omega.f64()).collect(),
-            orientation: self.orientation.as_ref().map(|q| q.iter().map(|q| [q[0].f64(), q[1].f64(), q[2].f64(), q[3].f64()]).collect()),
-            contacts: contacts.then(|| {
-                (0..self.pairs.len())
-                    .filter_map(|k| {
-                        let (h, _) = self.pair_overlap(k);
-                        (h > T::ZERO || self.out[k].f_c != T::ZERO).then(|| {
-                            let springs = self.slots.load(&self.hist[k * self.slots.stride..]);
-                            ContactRecord {
-                                i: self.id[self.pairs.owner[k] as usize],
-                                j: self.id[self.pairs.partner[k] as usize],
-                                overlap: h.f64(),
-                                normal_force: (self.out[k].f_n + self.out[k].f_c).f64(),
-                                force: self.out[k].f_i.f64(),
-                                force_j: self.out[k].f_j.f64(),
-                                tangential_spring: springs.tangential.f64(),
-                                rolling_spring: springs.rolling.f64(),
-                            }
-                        })
-                    })
-                    .collect()
-            }),
-            wall_contacts: contacts.then(|| {
-                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic };
-                wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_hist)
-            }),
-        }
-    }
 
     fn set_piston_pressure(&mut self, pressure: f64) {
         if let Some(p) = &mut self.piston {
@@ -911,6 +596,22 @@ impl<T: Real> Engine for CpuEngine<T> {
         Ok(())
     }
 
+    fn stats(&mut self) -> Stats {
+        self.statistics()
+    }
+
+    fn frame(&self, contacts: bool) -> Frame {
+        self.snapshot(contacts)
+    }
+
+    fn save(&self) -> Option<EngineState> {
+        Some(self.save_state())
+    }
+
+    fn restore(&mut self, s: &EngineState) -> anyhow::Result<()> {
+        self.restore_state(s)
+    }
+
     fn memory_bytes(&self) -> u64 {
         let l = &self.pairs;
         let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.body) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
@@ -927,120 +628,7 @@ impl<T: Real> Engine for CpuEngine<T> {
         self.clock.totals()
     }
 
-    fn save(&self) -> Option<EngineState> {
-        let mut s = EngineState::default();
-        let v3 = |v: &Vec3<T>| [v.x.f64(), v.y.f64(), v.z.f64()];
-        s.put_reals("body", self.body.iter().flat_map(|b| [v3(&b.pos), v3(&b.vel), v3(&b.omega)].concat()));
-        s.put_reals("load", self.load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
-        s.put_reals("wall_load", self.wall_load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
-        s.put_reals("built_at", self.built_at.iter().flat_map(v3));
-        s.put_ints("image", self.image.iter().flat_map(|i| i.map(|x| x as i64 as u64)));
-        if let Some(q) = &self.orientation {
-            s.put_reals("orientation", q.iter().flat_map(|q| q.map(T::f64)));
-        }
-        s.put_reals("wall_hist", self.wall_hist.iter().map(|x| x.f64()));
-        s.put_reals("wall_reaction", self.wall_reaction.iter().flat_map(v3));
-        s.put_ints("wall_count", self.wall_count.iter().copied());
-        let piston = self.piston.map_or(Vec::new(), |p| {
-            let z = match self.walls[p.wall].geom {
-                WallGeom::Piston { z } => z.f64(),
-                _ => unreachable!("the piston's wall is a piston"),
-            };
-            vec![z, self.walls[p.wall].velocity.z.f64(), p.pressure.f64()]
-        });
-        s.put_reals("piston", piston);
-        let servo = self.servo.map_or(Vec::new(), |sv| {
-            let mut v: Vec<f64> = sv.walls.iter().flat_map(|&w| [v3(&self.plane(w).0), v3(&self.walls[w].velocity)].concat()).collect();
-            v.extend([sv.pressure.f64(), sv.strain_rate.map_or(f64::NAN, |r| r.f64())]);
-            v
-        });
-        s.put_reals("servo", servo);
-        let l = &self.pairs;
-        for (name, v) in [("owner_start", &l.owner_start), ("owner", &l.owner), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
-            s.put_ints(name, v.iter().map(|&x| x as u64));
-        }
-        s.put_reals("hist", self.hist.iter().map(|x| x.f64()));
-        s.put_reals("liquid", self.liquid.iter().map(|x| x.f64()));
-        s.put_reals(
-            "out",
-            self.out.iter().flat_map(|o| {
-                let mut r = [v3(&o.f_i), v3(&o.f_j), v3(&o.t_i), v3(&o.t_j), [o.f_n.f64(), if o.clamped { 1.0 } else { 0.0 }, o.f_c.f64()]].concat();
-                r.push(o.regime as u8 as f64);
-                r
-            }),
-        );
-        s.put_reals("clock", [self.max_moved2.f64(), self.time, self.external_work]);
-        s.put_ints("counters", [self.step, self.rebuilds, self.forces_valid as u64]);
-        Some(s)
-    }
 
-    fn restore(&mut self, s: &EngineState) -> anyhow::Result<()> {
-        let n = self.body.len();
-        let v3 = |a: &[f64]| Vec3::new(T::of(a[0]), T::of(a[1]), T::of(a[2]));
-        for (b, c) in self.body.iter_mut().zip(s.reals("body", 9 * n)?.chunks_exact(9)) {
-            *b = Body { pos: v3(&c[0..3]), vel: v3(&c[3..6]), omega: v3(&c[6..9]) };
-        }
-        for (l, c) in self.load.iter_mut().zip(s.reals("load", 6 * n)?.chunks_exact(6)) {
-            *l = Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) };
-        }
-        for (l, c) in self.wall_load.iter_mut().zip(s.reals("wall_load", 6 * n)?.chunks_exact(6)) {
-            *l = Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) };
-        }
-        for (b, c) in self.built_at.iter_mut().zip(s.reals("built_at", 3 * n)?.chunks_exact(3)) {
-            *b = v3(c);
-        }
-        let images = s.ints("image", Some(3 * self.image.len()))?;
-        for (i, c) in self.image.iter_mut().zip(images.chunks_exact(3)) {
-            *i = [c[0] as i64 as i32, c[1] as i64 as i32, c[2] as i64 as i32];
-        }
-        if let Some(q) = &mut self.orientation {
-            for (q, c) in q.iter_mut().zip(s.reals("orientation", 4 * n)?.chunks_exact(4)) {
-                *q = [T::of(c[0]), T::of(c[1]), T::of(c[2]), T::of(c[3])];
-            }
-        }
-        self.wall_hist = s.reals("wall_hist", self.wall_hist.len())?.iter().map(|&x| T::of(x)).collect();
-        self.wall_reaction = s.reals("wall_reaction", 3 * self.walls.len())?.chunks_exact(3).map(v3).collect();
-        self.wall_count = s.ints("wall_count", Some(self.walls.len()))?.to_vec();
-        if let Some(p) = &mut self.piston {
-            let v = s.reals("piston", 3)?;
-            self.walls[p.wall].geom = WallGeom::Piston { z: T::of(v[0]) };
-            self.walls[p.wall].velocity.z = T::of(v[1]);
-            p.pressure = T::of(v[2]);
-        }
-        if let Some(mut sv) = self.servo {
-            let v = s.reals("servo", 6 * 6 + 2)?;
-            for (k, &w) in sv.walls.iter().enumerate() {
-                let (_, normal) = self.plane(w);
-                self.walls[w].geom = WallGeom::Plane { point: v3(&v[6 * k..6 * k + 3]), normal };
-                self.walls[w].velocity = v3(&v[6 * k + 3..6 * k + 6]);
-            }
-            sv.pressure = T::of(v[36]);
-            sv.strain_rate = (!v[37].is_nan()).then(|| T::of(v[37]));
-            self.servo = Some(sv);
-        }
-        let u32s = |name: &str, len: Option<usize>| -> anyhow::Result<Vec<u32>> { Ok(s.ints(name, len)?.iter().map(|&x| x as u32).collect()) };
-        let owner = u32s("owner", None)?;
-        let n_pairs = owner.len();
-        self.pairs = PairList {
-            owner_start: u32s("owner_start", Some(n + 1))?,
-            owner,
-            partner: u32s("partner", Some(n_pairs))?,
-            rev_start: u32s("rev_start", Some(n + 1))?,
-            rev_pair: u32s("rev_pair", Some(n_pairs))?,
-        };
-        self.hist = s.reals("hist", n_pairs * self.slots.stride)?.iter().map(|&x| T::of(x)).collect();
-        self.liquid = s.reals("liquid", self.liquid.len())?.iter().map(|&x| T::of(x)).collect();
-        self.out = s
-            .reals("out", 16 * n_pairs)?
-            .chunks_exact(16)
-            .map(|c| ContactForce { f_i: v3(&c[0..3]), f_j: v3(&c[3..6]), t_i: v3(&c[6..9]), t_j: v3(&c[9..12]), f_n: T::of(c[12]), clamped: c[13] != 0.0, f_c: T::of(c[14]), regime: Regime::from_code(c[15] as u8) })
-            .collect();
-        let clock = s.reals("clock", 3)?;
-        (self.max_moved2, self.time, self.external_work) = (T::of(clock[0]), clock[1], clock[2]);
-        let counters = s.ints("counters", Some(3))?;
-        (self.step, self.rebuilds, self.forces_valid) = (counters[0], counters[1], counters[2] != 0);
-        Ok(())
-    }
 
     fn place_piston(&mut self, z: f64) {
         if let Some(p) = self.piston {

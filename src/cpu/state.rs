@@ -62,7 +62,7 @@ impl HistorySlots {
         let sliding = if layout.tangential { 3 } else { 0 };
         let rolling = sliding + if layout.sliding { 1 } else { 0 };
         let bridge = rolling + if layout.rolling { 3 } else { 0 };
-        let stride = bridge + if layout.bridge { 1 } else { 0 };
+        let stride = layout.reals();
         HistorySlots { layout, tangential, sliding, rolling, bridge, stride }
     }
 

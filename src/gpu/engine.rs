@@ -4,11 +4,16 @@
 //! rebuild kernels' indirect dispatch sizes), so the host only records steps and reads a few
 //! statistics back every `stats_interval` steps.
 
+mod encode;
+mod readback;
+mod snapshot;
+
 use super::device::Gpu;
+use encode::Size;
 use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, SCAN_BLOCK, STAT_ROW, WG};
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::kernels::{Access, KERNELS};
-use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness};
 use super::plan::{plan, Dispatch, Entry};
 use crate::schedule::{Op, Schedule, Trace};
 use crate::scene::{Scene, WallShape};
@@ -52,16 +57,6 @@ pub enum GpuSetupError {
     },
 }
 
-/// How a kernel is dispatched.
-#[derive(Clone, Copy, Debug)]
-enum Size {
-    /// One invocation per grain.
-    Grains,
-    /// One workgroup.
-    One,
-    /// From an indirect-argument slot.
-    Indirect(u64),
-}
 
 /// The GPU engine (f32).
 pub struct GpuEngine {
@@ -102,44 +97,7 @@ pub struct GpuEngine {
     dispatches: std::cell::Cell<u64>,
 }
 
-/// The GPU's history (one vec4 per block and contact: tangential with the sliding flag in w,
-/// rolling, bridge volume in x) in the CPU engine's packed slots.
-fn cpu_history(blocks: &[[f32; 4]], slots: &crate::cpu::HistorySlots) -> Vec<f32> {
-    let layout = slots.layout;
-    let per_contact = [layout.tangential, layout.rolling, layout.bridge].into_iter().filter(|&b| b).count().max(1);
-    let mut out = Vec::with_capacity(blocks.len() / per_contact * slots.stride);
-    for contact in blocks.chunks_exact(per_contact) {
-        let mut s = vec![0.0f32; slots.stride];
-        let mut b = contact.iter();
-        if layout.tangential {
-            let t = b.next().expect("a tangential block");
-            s[slots.tangential..slots.tangential + 3].copy_from_slice(&t[..3]);
-            if layout.sliding {
-                s[slots.sliding] = t[3];
-            }
-        }
-        if layout.rolling {
-            let r = b.next().expect("a rolling block");
-            s[slots.rolling..slots.rolling + 3].copy_from_slice(&r[..3]);
-        }
-        if layout.bridge {
-            s[slots.bridge] = b.next().expect("a bridge block")[0];
-        }
-        out.extend(s);
-    }
-    out
-}
 
-/// The pressure the grains exert on plane `k` (0..6) of the servo box whose walls are
-/// `planes` (Pa): the CPU's `servo_pressure`, from the GPU's walls and reactions.
-fn servo_pressure(walls: &[layout::Wall], reaction: &[[f32; 4]], planes: [usize; 6], k: usize) -> f64 {
-    let coord = |k: usize| walls[planes[k]].point[k / 2] as f64;
-    let extents = [0, 1, 2].map(|a| coord(2 * a + 1) - coord(2 * a));
-    let a = k / 2;
-    let area = extents[(a + 1) % 3] * extents[(a + 2) % 3];
-    let (r, n) = (reaction[planes[k]], walls[planes[k]].normal);
-    -(0..3).map(|c| r[c] as f64 * n[c] as f64).sum::<f64>() / area
-}
 
 fn groups_for(n: u64) -> (u32, u32) {
     let g = n.div_ceil(WG as u64);
@@ -208,20 +166,22 @@ impl GpuEngine {
         if let DampingLaw::Viscous { c_n } = model.damping {
             params.c_n = c_n as f32;
         }
-        let stiffness = |s: TangentialStiffness<f64>| match s {
-            TangentialStiffness::Mindlin => -1.0,
-            TangentialStiffness::RatioToNormal(r) => r as f32,
+        let stiffness = |s: TangentialStiffness<f64>, params: &mut Params| {
+            params.kt_law = s.code();
+            if let TangentialStiffness::RatioToNormal(r) = s {
+                params.kt_ratio = r as f32;
+            }
         };
         match model.tangential {
             TangentialLaw::None => {}
             TangentialLaw::Oquendo(l) => {
                 params.static_damping = l.static_damping as f32;
                 params.rolling_as_written = (l.rolling_friction == RollingFriction::AsWritten) as u32;
-                params.kt_ratio = stiffness(l.stiffness);
+                stiffness(l.stiffness, &mut params);
             }
             TangentialLaw::Mindlin { damping_ratio, stiffness: s } => {
                 params.damping_ratio = damping_ratio as f32;
-                params.kt_ratio = stiffness(s);
+                stiffness(s, &mut params);
             }
         }
         if let RollingLaw::Sds { k_r, gamma_r, mu_r } = model.rolling {
@@ -240,17 +200,17 @@ impl GpuEngine {
                 let mut g = layout::Wall { material: wall.material as u32, ..Default::default() };
                 match wall.shape {
                     WallShape::Plane { point, normal } => {
-                        g.kind = 0;
+                        g.kind = layout::wall_kind::PLANE;
                         g.point = [point[0] as f32, point[1] as f32, point[2] as f32, 0.0];
                         g.normal = [normal[0] as f32, normal[1] as f32, normal[2] as f32, 0.0];
                     }
                     WallShape::Cylinder { center, radius } => {
-                        g.kind = 1;
+                        g.kind = layout::wall_kind::CYLINDER;
                         g.point = [center[0] as f32, center[1] as f32, 0.0, 0.0];
                         g.normal = [0.0, 0.0, 0.0, radius as f32];
                     }
                     WallShape::Piston { z, pressure, mass, area } => {
-                        g.kind = 2;
+                        g.kind = layout::wall_kind::PISTON;
                         g.point = [0.0, 0.0, z as f32, 0.0];
                         g.piston = [mass as f32, area as f32, pressure as f32, 0.0];
                         piston = Some(w);
@@ -312,7 +272,7 @@ impl GpuEngine {
                 pressure: s.pressure as f32,
                 gain: s.gain as f32,
                 max_speed: s.max_speed as f32,
-                relaxation: crate::cpu::SERVO_RELAXATION as f32,
+                relaxation: crate::walls::SERVO_RELAXATION as f32,
                 ..Default::default()
             }
         });
@@ -437,31 +397,13 @@ impl GpuEngine {
 
     fn build_pipelines(&mut self, scene: &Scene) {
         let m = &scene.model;
-        let normal = match m.normal {
-            NormalLaw::Hertz => 0.0,
-            NormalLaw::Linear { .. } => 1.0,
-        };
-        let damping = match m.damping {
-            DampingLaw::None => 0.0,
-            DampingLaw::Papers => 1.0,
-            DampingLaw::Restitution => 2.0,
-            DampingLaw::Viscous { .. } => 3.0,
-        };
-        let tangential = match m.tangential {
-            TangentialLaw::None => 0.0,
-            TangentialLaw::Oquendo { .. } => 1.0,
-            TangentialLaw::Mindlin { .. } => 2.0,
-        };
-        let rolling = if let RollingLaw::Sds { .. } = m.rolling { 1.0 } else { 0.0 };
-        let twisting = if let TwistingLaw::Oquendo = m.twisting { 1.0 } else { 0.0 };
-        let cohesion = if self.history.bridge { 1.0 } else { 0.0 };
         let model_constants = [
-            ("NORMAL_LAW", normal),
-            ("DAMPING_LAW", damping),
-            ("TANGENTIAL_LAW", tangential),
-            ("ROLLING_LAW", rolling),
-            ("TWISTING_LAW", twisting),
-            ("COHESION_LAW", cohesion),
+            ("NORMAL_LAW", m.normal.code() as f64),
+            ("DAMPING_LAW", m.damping.code() as f64),
+            ("TANGENTIAL_LAW", m.tangential.code() as f64),
+            ("ROLLING_LAW", m.rolling.code() as f64),
+            ("TWISTING_LAW", m.twisting.code() as f64),
+            ("COHESION_LAW", m.cohesion.code() as f64),
             ("HAS_TANGENTIAL_HISTORY", self.history.tangential as u8 as f64),
             ("HAS_ROLLING_HISTORY", self.history.rolling as u8 as f64),
         ];
@@ -550,163 +492,17 @@ impl GpuEngine {
         }
     }
 
-    fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, group: &str, size: Size, phase: Option<Phase>) {
-        pass.set_pipeline(&self.pipelines[name]);
-        // A kernel with a phase binding is given its phase; the others none.
-        let slot = |p: Phase| self.phases.iter().position(|q| *q == p).expect("every phase of the plans has a uniform slot");
-        let offsets: Vec<u32> = phase.map(|p| (slot(p) as u64 * self.phase_stride) as u32).into_iter().collect();
-        pass.set_bind_group(0, &self.bind_groups[group], &offsets);
-        self.dispatches.set(self.dispatches.get() + 1);
-        match size {
-            Size::Grains => {
-                let (x, y) = groups_for(self.n as u64);
-                pass.dispatch_workgroups(x, y, 1);
-            }
-            Size::One => pass.dispatch_workgroups(1, 1, 1),
-            Size::Indirect(slot) => pass.dispatch_workgroups_indirect(&self.buffers["args"], slot * std::mem::size_of::<DispatchArgs>() as u64),
-        }
-    }
 
-    fn run(&self, pass: &mut wgpu::ComputePass, name: &str, size: Size, phase: Option<Phase>) {
-        self.dispatch(pass, name, name, size, phase);
-    }
 
-    /// Exclusive scan of an array of `elements`: blocks, the blocks' totals, then the offsets
-    /// added back (the last two only when there is more than one block).
-    fn scan(&self, pass: &mut wgpu::ComputePass, tag: &str, sums_tag: &str, blocks: u64, elements: u64) {
-        self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{tag}"), Size::Indirect(blocks), None);
-        // An array of one block is scanned by then: its offset would be 0.
-        if elements <= SCAN_BLOCK {
-            return;
-        }
-        self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{sums_tag}"), Size::Indirect(args::ONE), None);
-        self.dispatch(pass, "scan_add", &format!("scan_add:{tag}"), Size::Indirect(blocks), None);
-    }
 
-    /// `decide_rebuild` and the rebuild kernels, which run with zero workgroups when the
-    /// list is still good.
-    fn encode_rebuild_if_needed(&self, pass: &mut wgpu::ComputePass) {
-        self.run(pass, "decide_rebuild", Size::One, None);
-        let keeps_history = self.params.hist_blocks > 0;
-        if keeps_history {
-            self.run(pass, "save_starts", Size::Indirect(args::GRAIN_STARTS), None);
-            self.run(pass, "save_pairs", Size::Indirect(args::OLD_PAIRS), None);
-        }
-        self.run(pass, "clear_cells", Size::Indirect(args::HASH), None);
-        self.run(pass, "hash_cells", Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "cell", "cell_sums", args::HASH_BLOCKS, self.params.hash_size as u64);
-        self.run(pass, "scatter_cells", Size::Indirect(args::GRAINS), None);
-        self.run(pass, "detect_count", Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
-        self.run(pass, "pairs_ready", Size::One, None);
-        self.run(pass, "detect_fill", Size::Indirect(args::GRAINS), None);
-        if keeps_history {
-            self.run(pass, "remap_history", Size::Indirect(args::NEW_PAIRS), None);
-        }
-        self.run(pass, "reverse_count", Size::Indirect(args::NEW_PAIRS), None);
-        self.scan(pass, "rev", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
-        self.run(pass, "reverse_fill", Size::Indirect(args::NEW_PAIRS), None);
-        self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
-    }
 
-    /// `update_bridges` (capillary scenes), `pair_force`, `wall_contacts` (+ `wall_reduce`),
-    /// `gather` (and the kick after it), with the durations of `phase`.
-    fn encode_forces(&self, pass: &mut wgpu::ComputePass, phase: Phase) {
-        if self.history.bridge {
-            self.run(pass, "update_bridges", Size::One, None);
-        }
-        self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(phase));
-        if self.has_walls {
-            self.run(pass, "wall_contacts", Size::Grains, Some(phase));
-            self.run(pass, "wall_reduce", Size::One, None);
-        }
-        self.run(pass, "gather", Size::Grains, Some(phase));
-    }
 
-    /// Encodes one entry of a plan.
-    fn encode(&self, pass: &mut wgpu::ComputePass, e: &Entry) {
-        match e.dispatch {
-            Dispatch::Integrate => {
-                self.run(pass, "integrate", Size::Grains, Some(e.phase));
-                if self.servo.is_some() && e.phase.drift > 0.0 {
-                    self.run(pass, "servo_move", Size::One, Some(e.phase));
-                }
-            }
-            Dispatch::RebuildIfNeeded => self.encode_rebuild_if_needed(pass),
-            Dispatch::Forces => self.encode_forces(pass, e.phase),
-        }
-    }
 
-    /// Encodes plan `which` (0 prologue, 1 first step, 2 later steps) and traces its
-    /// operations.
-    fn encode_plan(&mut self, pass: &mut wgpu::ComputePass, which: usize) {
-        for k in 0..self.plans[which].len() {
-            self.encode(pass, &self.plans[which][k]);
-            for op in self.plans[which][k].ops.clone() {
-                self.trace.record(op);
-            }
-        }
-    }
 
-    /// Runs the schedule's prologue (the list built if need be, forces evaluated) where
-    /// nothing has evaluated the loads yet: before the first step, or after wetting.
-    fn ensure_loads(&mut self) {
-        if self.forces_valid {
-            return;
-        }
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.encode_plan(&mut pass, 0);
-        }
-        self.gpu.queue.submit([encoder.finish()]);
-        self.forces_valid = true;
-    }
 
-    /// Starts recording the operations encoded (see [`Trace`]).
-    pub fn trace_schedule(&mut self) {
-        self.trace.start();
-    }
 
-    /// The operations encoded since [`Self::trace_schedule`].
-    pub fn traced(&self) -> &[Op] {
-        self.trace.ops()
-    }
 
-    /// Copies buffers out: `(buffer, offset, bytes)` each, returned in order as 4-byte words
-    /// (every type the kernels share is 4-byte aligned).
-    fn read(&self, parts: &[(&str, u64, u64)]) -> Vec<Vec<u32>> {
-        let total: u64 = parts.iter().map(|p| p.2.next_multiple_of(4)).sum();
-        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: total.max(4),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        let mut at = 0;
-        for &(name, offset, bytes) in parts {
-            encoder.copy_buffer_to_buffer(&self.buffers[name], offset, &staging, at, bytes.next_multiple_of(4));
-            at += bytes.next_multiple_of(4);
-        }
-        self.gpu.queue.submit([encoder.finish()]);
-        staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping a readback buffer"));
-        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).expect("the GPU finishes");
-        let view = staging.slice(..).get_mapped_range().expect("a mapped readback buffer");
-        let mut out = Vec::new();
-        let mut at = 0usize;
-        for &(_, _, bytes) in parts {
-            out.push(bytemuck::pod_collect_to_vec(&view[at..at + bytes as usize]));
-            at += bytes.next_multiple_of(4) as usize;
-        }
-        out
-    }
 
-    fn read_control(&mut self) -> Control {
-        let c = self.read(&[("control", 0, std::mem::size_of::<Control>() as u64)]);
-        self.control = *bytemuck::from_bytes(bytemuck::cast_slice(&c[0]));
-        self.control
-    }
 
     /// The adapter this engine runs on.
     pub fn adapter(&self) -> &wgpu::AdapterInfo {
@@ -718,109 +514,12 @@ impl GpuEngine {
         self.params.pair_capacity
     }
 
-    /// Checks the flags the last steps raised, and grows the pair buffers when they fill up.
-    fn check(&mut self) -> Result<(), SimError> {
-        let c = self.read_control();
-        if c.overflow_grain != NONE {
-            return Err(SimError::Capacity { step: self.step, grain: c.overflow_grain, count: c.overflow_count as usize, capacity: self.params.max_neighbours as usize });
-        }
-        if c.pair_overflow != 0 {
-            return Err(SimError::Capacity {
-                step: self.step,
-                grain: NONE,
-                count: self.params.pair_capacity as usize + 1,
-                capacity: self.params.pair_capacity as usize,
-            });
-        }
-        if c.n_pairs as f64 > PAIR_GROWTH_THRESHOLD * self.params.pair_capacity as f64 {
-            let binding = self.gpu.limits.max_storage_buffer_binding_size;
-            let per_pair = 16 * (self.params.hist_blocks as u64).max(1);
-            let grown = (2 * c.n_pairs as u64).min(binding / per_pair);
-            if grown > self.params.pair_capacity as u64 {
-                self.allocate_pairs(grown);
-                self.build_bind_groups();
-            }
-        }
-        Ok(())
-    }
 
-    /// Rebuilds the neighbour list at the next step, whatever the displacements.
-    pub fn rebuild_next_step(&mut self) {
-        self.gpu.queue.write_buffer(&self.buffers["control"], 0, bytemuck::bytes_of(&f32::INFINITY.to_bits()));
-    }
 
-    /// The pair list (CSR: starts per grain, partners), read back.
-    pub fn pair_list(&mut self) -> (Vec<u32>, Vec<u32>) {
-        let n_pairs = self.read_control().n_pairs as u64;
-        let parts = self.read(&[("pair_start", 0, 4 * (self.n as u64 + 1)), ("pair_j", 0, 4 * n_pairs)]);
-        (parts[0].clone(), parts[1].clone())
-    }
 
-    /// Force and torque on each grain from the last force evaluation (N, N m), read back.
-    pub fn loads(&self) -> Vec<([f32; 3], [f32; 3])> {
-        let a = self.read_vec4s(&["force", "torque"]);
-        a[0].iter().zip(&a[1]).map(|(f, t)| ([f[0], f[1], f[2]], [t[0], t[1], t[2]])).collect()
-    }
 
-    /// Grain-wall contacts re-evaluated on the host from the GPU's state (the CPU twin's
-    /// function in f32), given the grain arrays `[pos, vel, omega, ..]` already read.
-    fn wall_contact_records(&self, arrays: &[Vec<[f32; 4]>]) -> Vec<crate::engine::WallContactRecord> {
-        use crate::cpu::{wall_contact_records, Body, ForceContext, HistorySlots, Props, WallState};
-        use crate::real::Vec3;
-        let n_walls = self.wall_names.len();
-        let blocks = self.params.hist_blocks as usize;
-        let parts = self.read(&[
-            ("material", 0, 4 * self.n as u64),
-            ("walls", 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64),
-            ("wall_hist", 0, if blocks > 0 { 16 * (self.n as usize * n_walls * blocks) as u64 } else { 0 }),
-        ]);
-        let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[1]);
-        let gpu_hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
-        let v3 = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
-        let body: Vec<Body<f32>> = (0..self.n as usize).map(|i| Body { pos: v3(arrays[0][i]), vel: v3(arrays[1][i]), omega: v3(arrays[2][i]) }).collect();
-        let prop: Vec<Props<f32>> = (0..self.n as usize).map(|i| Props { radius: arrays[0][i][3], mass: arrays[1][i][3], inertia: arrays[2][i][3], material: parts[0][i] }).collect();
-        let states: Vec<WallState<f32>> = walls
-            .iter()
-            .map(|w| WallState {
-                geom: match w.kind {
-                    0 => crate::walls::WallGeom::Plane { point: v3(w.point), normal: v3(w.normal) },
-                    1 => crate::walls::WallGeom::Cylinder { cx: w.point[0], cy: w.point[1], radius: w.normal[3] },
-                    _ => crate::walls::WallGeom::Piston { z: w.point[2] },
-                },
-                velocity: v3(w.velocity),
-                material: w.material,
-            })
-            .collect();
-        let slots = HistorySlots::new(self.history);
-        let hist = cpu_history(gpu_hist, &slots);
-        let ctx = ForceContext {
-            model: &self.model,
-            coeffs: &self.coeffs,
-            n_materials: self.n_materials,
-            slots,
-            elapsed: 0.0,
-            periodic: crate::periodic::Periodic::default(),
-        };
-        wall_contact_records(&body, &prop, &(0..self.n).collect::<Vec<u32>>(), &states, &ctx, &hist)
-    }
 
-    /// Liquid bridges among the first `n_pairs` pairs, the liquid they hold and the liquid
-    /// waiting on the grains (m^3), read back.
-    fn liquid_sums(&self, n_pairs: u64) -> (u64, f64, f64) {
-        let blocks = self.params.hist_blocks as usize;
-        let parts = self.read(&[("hist", 0, 16 * n_pairs * blocks as u64), ("liquid", 0, 4 * self.n as u64)]);
-        let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
-        let liquid: &[f32] = bytemuck::cast_slice(&parts[1]);
-        let volumes = hist.iter().skip(blocks - 1).step_by(blocks).map(|b| b[0]).filter(|&v| v > 0.0);
-        let (bridges, held) = volumes.fold((0, 0.0), |(n, s), v| (n + 1, s + v as f64));
-        (bridges, held, liquid.iter().map(|&l| l as f64).sum())
-    }
 
-    /// Reads grain arrays back (vec4 per grain).
-    fn read_vec4s(&self, names: &[&str]) -> Vec<Vec<[f32; 4]>> {
-        let parts: Vec<(&str, u64, u64)> = names.iter().map(|n| (*n, 0, 16 * self.n as u64)).collect();
-        self.read(&parts).into_iter().map(|b| bytemuck::cast_slice(&b).to_vec()).collect()
-    }
 }
 
 impl Engine for GpuEngine {
@@ -863,157 +562,26 @@ impl Engine for GpuEngine {
         self.check()
     }
 
+
+
     fn stats(&mut self) -> Stats {
-        self.ensure_loads();
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.run(&mut pass, "reduce_grains", Size::Grains, None);
-            self.run(&mut pass, "reduce_pairs", Size::Indirect(args::PAIRS), None);
-            self.run(&mut pass, "reduce_final", Size::One, None);
-        }
-        self.gpu.queue.submit([encoder.finish()]);
-        let n_walls = self.wall_names.len();
-        let parts = self.read(&[
-            ("control", 0, std::mem::size_of::<Control>() as u64),
-            ("stats", 0, 2 * STAT_ROW as u64 * 4),
-            ("wall_reaction", 0, MAX_WALLS as u64 * 16),
-            ("walls", 0, (n_walls.max(1) * std::mem::size_of::<layout::Wall>()) as u64),
-            ("servo", 0, std::mem::size_of::<layout::Servo>() as u64),
-        ]);
-        let control: Control = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[0]));
-        let servo: layout::Servo = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[4]));
-        self.control = control;
-        let s: &[f32] = bytemuck::cast_slice(&parts[1]);
-        let reaction: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
-        let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[3]);
-        use layout::stat::{grain as gr, pair as pr};
-        let g = |f: usize| s[f] as f64;
-        let p = |f: usize| s[STAT_ROW + f] as f64;
-        let g_count = |f: usize| s[f].to_bits() as u64;
-        let p_count = |f: usize| s[STAT_ROW + f].to_bits() as u64;
-        let n = self.n as f64;
-        let contacts = p_count(pr::CONTACTS);
-        let wall_contacts = g_count(gr::WALL_CONTACTS);
-        let contact_ends = 2 * contacts + wall_contacts;
-        let rattlers = g_count(gr::RATTLERS);
-        let contact_force = p(pr::FORCE) + g(gr::WALL_FORCE);
-        let unbalanced_force = crate::engine::unbalanced(g(gr::NET_FORCE), n, contact_force, contact_ends);
-        let unbalanced_force_loaded = crate::engine::unbalanced(g(gr::NET_LOADED), n - rattlers as f64, contact_force, contact_ends);
-        let (max_overlap, max_overlap_grain) = {
-            let (gv, gi) = (g(STAT_ROW - 2), s[STAT_ROW - 1].to_bits());
-            let (pv, pi) = (p(STAT_ROW - 2), s[2 * STAT_ROW - 1].to_bits());
-            if gv > pv || (gv == pv && gi < pi) { (gv, gi) } else { (pv, pi) }
-        };
-        let (bridges, liquid_in_bridges, liquid_on_grains) = if self.history.bridge { self.liquid_sums(control.n_pairs as u64) } else { (0, 0.0, 0.0) };
-        let piston = self.piston.map(|w| {
-            let wall = &walls[w];
-            PistonStats {
-                z: wall.point[2] as f64,
-                velocity: wall.velocity[2] as f64,
-                target_pressure: wall.piston[2] as f64,
-                pressure: reaction[w][2] as f64 / wall.piston[1] as f64,
-            }
-        });
-        Stats {
-            step: self.step,
-            time: self.time,
-            ke_translational: g(gr::KE_T),
-            ke_rotational: g(gr::KE_R),
-            elastic_energy: p(pr::ELASTIC) + g(gr::WALL_ELASTIC),
-            gravity_energy: g(gr::PE_G),
-            piston_ke: self.piston.map_or(0.0, |w| 0.5 * walls[w].piston[0] as f64 * (walls[w].velocity[2] as f64).powi(2)),
-            external_work: self.piston.map_or(0.0, |w| walls[w].piston[3] as f64) + servo.work as f64 + servo.work_lo as f64,
-            momentum: [0, 1, 2].map(|a| g(gr::MOMENTUM + a)),
-            angular_momentum: [0, 1, 2].map(|a| g(gr::ANGULAR + a)),
-            pairs: control.n_pairs as u64,
-            contacts,
-            wall_contacts,
-            clamped: p_count(pr::CLAMPED),
-            sliding: p_count(pr::SLIDING) + g_count(gr::WALL_SLIDING),
-            rolling: p_count(pr::ROLLING) + g_count(gr::WALL_ROLLING),
-            coordination: 2.0 * contacts as f64 / n,
-            max_overlap,
-            max_overlap_grain: if max_overlap_grain == NONE { 0 } else { max_overlap_grain },
-            unbalanced_force,
-            unbalanced_force_loaded,
-            rattlers,
-            ke_rattlers: g(gr::KE_RATTLERS),
-            non_finite_grain: (control.non_finite != NONE).then_some(control.non_finite),
-            rebuilds: control.rebuilds as u64,
-            bridges,
-            liquid_in_bridges,
-            liquid_on_grains,
-            walls: (0..n_walls)
-                .map(|w| {
-                    let servo_plane = self.servo.and_then(|planes| planes.iter().position(|&p| p == w));
-                    WallStats {
-                        name: self.wall_names[w].clone(),
-                        force: [reaction[w][0] as f64, reaction[w][1] as f64, reaction[w][2] as f64],
-                        contacts: reaction[w][3].round() as u64,
-                        position: servo_plane.map(|k| walls[w].point[k / 2] as f64),
-                        pressure: servo_plane.map(|k| servo_pressure(walls, reaction, self.servo.expect("a servo plane"), k)),
-                    }
-                })
-                .collect(),
-            piston,
-        }
+        self.statistics()
     }
 
     fn frame(&self, contacts: bool) -> Frame {
-        let mut names = vec!["pos", "vel", "omega"];
-        if self.track_orientation {
-            names.push("quat");
-        }
-        let arrays = self.read_vec4s(&names);
-        let xyz = |v: &[f32; 4]| [v[0] as f64, v[1] as f64, v[2] as f64];
-        let contact_records = contacts.then(|| {
-            let np = self.control.n_pairs as u64;
-            let blocks = self.params.hist_blocks as u64;
-            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, 16 * np), ("hist", 0, 16 * np * blocks), ("out_tj", 0, 16 * np)]);
-            let (pi, pj): (&[u32], &[u32]) = (&parts[0], &parts[1]);
-            let fi: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
-            let fj: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
-            let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[4]);
-            // out_tj.w: the capillary force.
-            let f_c: Vec<f32> = bytemuck::cast_slice::<u32, [f32; 4]>(&parts[5]).iter().map(|t| t[3]).collect();
-            let pos = &arrays[0];
-            (0..np as usize)
-                .filter_map(|k| {
-                    let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
-                    let d = [(a[0] - b[0]) as f64, (a[1] - b[1]) as f64, (a[2] - b[2]) as f64];
-                    let mut d2 = 0.0;
-                    for (axis, x) in d.iter().enumerate() {
-                        let len = self.params.periodic_len[axis] as f64;
-                        let x = if len > 0.0 { x - len * (x / len + 0.5).floor() } else { *x };
-                        d2 += x * x;
-                    }
-                    let h = (a[3] + b[3]) as f64 - d2.sqrt();
-                    (h > 0.0 || f_c[k] != 0.0).then(|| ContactRecord {
-                        i: pi[k],
-                        j: pj[k],
-                        overlap: h,
-                        normal_force: (fi[k][3] + f_c[k]) as f64,
-                        force: xyz(&fi[k]),
-                        force_j: xyz(&fj[k]),
-                        tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
-                        rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + self.history.tangential as usize]) } else { [0.0; 3] },
-                    })
-                })
-                .collect()
-        });
-        let wall_records = (contacts && self.has_walls).then(|| self.wall_contact_records(&arrays)).or(contacts.then(Vec::new));
-        Frame {
-            time: self.time,
-            id: (0..self.n).collect(),
-            position: arrays[0].iter().map(xyz).collect(),
-            radius: arrays[0].iter().map(|v| v[3] as f64).collect(),
-            velocity: arrays[1].iter().map(xyz).collect(),
-            angular_velocity: arrays[2].iter().map(xyz).collect(),
-            orientation: self.track_orientation.then(|| arrays[3].iter().map(|q| [q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]).collect()),
-            contacts: contact_records,
-            wall_contacts: wall_records,
-        }
+        self.snapshot(contacts)
+    }
+
+    fn wet(&mut self, volume: f64) -> anyhow::Result<()> {
+        self.wet_pairs(volume)
+    }
+
+    fn save(&self) -> Option<crate::engine::EngineState> {
+        self.save_state()
+    }
+
+    fn restore(&mut self, s: &crate::engine::EngineState) -> anyhow::Result<()> {
+        self.restore_state(s)
     }
 
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
@@ -1030,81 +598,8 @@ impl Engine for GpuEngine {
         self.gpu.queue.write_buffer(buffer, at(std::mem::offset_of!(layout::Servo, strain)), bytemuck::bytes_of(&strain));
     }
 
-    fn wet(&mut self, volume: f64) -> anyhow::Result<()> {
-        use crate::real::Vec3;
-        let crate::model::CohesionLaw::Capillary { theta, .. } = self.model.cohesion else {
-            anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
-        };
-        // The liquid goes to the pairs of the current list.
-        self.ensure_loads();
-        let (n, np, blocks) = (self.n as u64, self.read_control().n_pairs as u64, self.params.hist_blocks as u64);
-        let parts = self.read(&[("pos", 0, 16 * n), ("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("hist", 0, 16 * np * blocks), ("liquid", 0, 4 * n)]);
-        let pos: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
-        let (pi, pj) = (&parts[1], &parts[2]);
-        let mut hist: Vec<[f32; 4]> = bytemuck::cast_slice(&parts[3]).to_vec();
-        let mut liquid: Vec<f32> = bytemuck::cast_slice(&parts[4]).to_vec();
-        // The CPU twin's reduced diameters and gaps (in f32, as its f32 engine has them).
-        let v3 = |p: &[f32; 4]| Vec3::new(p[0], p[1], p[2]);
-        let d: Vec<f64> = (0..np as usize).map(|k| {
-            let (ri, rj) = (pos[pi[k] as usize][3] as f64, pos[pj[k] as usize][3] as f64);
-            2.0 * ri * rj / (ri + rj)
-        }).collect();
-        let gaps: Vec<f64> = (0..np as usize).map(|k| {
-            let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
-            (self.periodic.min_image(v3(a) - v3(b)).norm() - a[3] - b[3]) as f64
-        }).collect();
-        let (shares, rest) = crate::model::share_liquid(volume, &d, &gaps, self.params.bridge_cap as f64, theta as f64);
-        let last = blocks as usize - 1;
-        for (k, v) in shares {
-            hist[k * blocks as usize + last][0] += v as f32;
-        }
-        let rest = (rest / n as f64) as f32;
-        for l in &mut liquid {
-            *l += rest;
-        }
-        self.gpu.queue.write_buffer(&self.buffers["hist"], 0, bytemuck::cast_slice(&hist));
-        self.gpu.queue.write_buffer(&self.buffers["liquid"], 0, bytemuck::cast_slice(&liquid));
-        self.forces_valid = false;
-        Ok(())
-    }
 
-    fn save(&self) -> Option<crate::checkpoint::EngineState> {
-        let mut s = crate::checkpoint::EngineState::default();
-        let n_pairs = self.control.n_pairs as u64;
-        let per_pair: HashMap<&str, u64> = self.pair_buffers().into_iter().collect();
-        let mut names: Vec<&'static str> = self.buffers.keys().copied().filter(|name| !NOT_STATE.contains(name)).collect();
-        names.sort_unstable();
-        let parts: Vec<(&str, u64, u64)> = names.iter().map(|&name| (name, 0, per_pair.get(name).map_or(self.buffers[name].size(), |b| b * n_pairs))).collect();
-        for (name, words) in names.iter().zip(self.read(&parts)) {
-            // Two 4-byte words per stored integer, the first in the low half.
-            s.put_ints(&format!("gpu:{name}"), words.chunks(2).map(|c| c[0] as u64 | (c.get(1).copied().unwrap_or(0) as u64) << 32));
-        }
-        s.put_ints("counters", [self.step, self.forces_valid as u64, self.params.pair_capacity as u64]);
-        s.put_reals("time", [self.time]);
-        Some(s)
-    }
 
-    fn restore(&mut self, s: &crate::checkpoint::EngineState) -> anyhow::Result<()> {
-        let counters = s.ints("counters", Some(3))?;
-        if counters[2] != self.params.pair_capacity as u64 {
-            self.allocate_pairs(counters[2]);
-            self.build_bind_groups();
-        }
-        for (key, words) in &s.ints {
-            let Some(name) = key.strip_prefix("gpu:") else { continue };
-            let buffer = self.buffers.get(name).ok_or_else(|| anyhow::anyhow!("the checkpoint holds a GPU buffer `{name}` this engine lacks; fix: resume with the grains version that wrote it"))?;
-            let bytes: Vec<u8> = words.iter().flat_map(|&w| w.to_le_bytes()).collect();
-            // A list of an odd number of words was padded with one (beyond the live pairs).
-            if bytes.len() as u64 > buffer.size() + 4 {
-                anyhow::bail!("the checkpoint's GPU buffer `{name}` holds {} bytes, this scene's {}; fix: resume with the scene the checkpoint was written for", bytes.len(), buffer.size());
-            }
-            self.gpu.queue.write_buffer(buffer, 0, &bytes[..bytes.len().min(buffer.size() as usize)]);
-        }
-        (self.step, self.forces_valid) = (counters[0], counters[1] != 0);
-        self.time = s.reals("time", 1)?[0];
-        self.read_control();
-        Ok(())
-    }
 
     fn memory_bytes(&self) -> u64 {
         self.buffers.values().map(wgpu::Buffer::size).sum()

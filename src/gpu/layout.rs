@@ -45,7 +45,7 @@ pub struct Params {
     pub reach: f32,
     /// Capillary `kappa = 2 pi gamma cos(theta)` (N/m).
     pub kappa: f32,
-    /// k_t over the normal secant stiffness; <= 0 selects Mindlin.
+    /// k_t over the normal secant stiffness, when `kt_law` is the ratio.
     pub kt_ratio: f32,
     /// Hertz-Mindlin tangential damping ratio.
     pub damping_ratio: f32,
@@ -65,8 +65,9 @@ pub struct Params {
     pub capillary_c: f32,
     /// Largest bridge volume (m^3).
     pub bridge_cap: f32,
-    /// Padding.
-    pub _pad0: f32,
+    /// Tangential stiffness: [`crate::model::code::STIFFNESS_MINDLIN`] or `STIFFNESS_RATIO`
+    /// (`kt_ratio` times the normal secant stiffness).
+    pub kt_law: u32,
 }
 
 /// What changes between dispatches of one step (WGSL `Phase`, uniform with dynamic offset).
@@ -105,11 +106,21 @@ pub struct PairCoeffs {
     pub beta: f32,
 }
 
-/// A wall (WGSL `Wall`). `kind`: 0 plane, 1 cylinder, 2 piston.
+/// Wall kinds (WGSL `WALL_*`).
+pub mod wall_kind {
+    /// A plane.
+    pub const PLANE: u32 = 0;
+    /// A vertical cylinder.
+    pub const CYLINDER: u32 = 1;
+    /// The oedometer's piston.
+    pub const PISTON: u32 = 2;
+}
+
+/// A wall (WGSL `Wall`), of kind [`wall_kind`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub struct Wall {
-    /// 0 plane, 1 cylinder, 2 piston.
+    /// A [`wall_kind`].
     pub kind: u32,
     /// Material index.
     pub material: u32,

@@ -25,6 +25,139 @@ pub use twisting::twisting_torque;
 
 use crate::real::{Real, Vec3};
 
+/// The codes by which the WGSL kernels know each law (WGSL constants of the same names in
+/// `shaders/shared/model.wgsl`, checked against these by `tests/shaders.rs`); each law's
+/// `code()` gives its own.
+pub mod code {
+    /// [`super::NormalLaw::Hertz`].
+    pub const NORMAL_HERTZ: u32 = 0;
+    /// [`super::NormalLaw::Linear`].
+    pub const NORMAL_LINEAR: u32 = 1;
+    /// [`super::DampingLaw::None`].
+    pub const DAMPING_NONE: u32 = 0;
+    /// [`super::DampingLaw::Papers`].
+    pub const DAMPING_PAPERS: u32 = 1;
+    /// [`super::DampingLaw::Restitution`].
+    pub const DAMPING_RESTITUTION: u32 = 2;
+    /// [`super::DampingLaw::Viscous`].
+    pub const DAMPING_VISCOUS: u32 = 3;
+    /// [`super::TangentialLaw::None`].
+    pub const TANGENTIAL_NONE: u32 = 0;
+    /// [`super::TangentialLaw::Oquendo`].
+    pub const TANGENTIAL_OQUENDO: u32 = 1;
+    /// [`super::TangentialLaw::Mindlin`].
+    pub const TANGENTIAL_MINDLIN: u32 = 2;
+    /// [`super::TangentialStiffness::Mindlin`].
+    pub const STIFFNESS_MINDLIN: u32 = 0;
+    /// [`super::TangentialStiffness::RatioToNormal`].
+    pub const STIFFNESS_RATIO: u32 = 1;
+    /// [`super::RollingLaw::None`].
+    pub const ROLLING_NONE: u32 = 0;
+    /// [`super::RollingLaw::Sds`].
+    pub const ROLLING_SDS: u32 = 1;
+    /// [`super::TwistingLaw::None`].
+    pub const TWISTING_NONE: u32 = 0;
+    /// [`super::TwistingLaw::Oquendo`].
+    pub const TWISTING_OQUENDO: u32 = 1;
+    /// [`super::CohesionLaw::None`].
+    pub const COHESION_NONE: u32 = 0;
+    /// [`super::CohesionLaw::Capillary`].
+    pub const COHESION_CAPILLARY: u32 = 1;
+    /// Every code by its WGSL name.
+    pub const ALL: &[(&str, u32)] = &[
+        ("NORMAL_HERTZ", NORMAL_HERTZ),
+        ("NORMAL_LINEAR", NORMAL_LINEAR),
+        ("DAMPING_NONE", DAMPING_NONE),
+        ("DAMPING_PAPERS", DAMPING_PAPERS),
+        ("DAMPING_RESTITUTION", DAMPING_RESTITUTION),
+        ("DAMPING_VISCOUS", DAMPING_VISCOUS),
+        ("TANGENTIAL_NONE", TANGENTIAL_NONE),
+        ("TANGENTIAL_OQUENDO", TANGENTIAL_OQUENDO),
+        ("TANGENTIAL_MINDLIN", TANGENTIAL_MINDLIN),
+        ("STIFFNESS_MINDLIN", STIFFNESS_MINDLIN),
+        ("STIFFNESS_RATIO", STIFFNESS_RATIO),
+        ("ROLLING_NONE", ROLLING_NONE),
+        ("ROLLING_SDS", ROLLING_SDS),
+        ("TWISTING_NONE", TWISTING_NONE),
+        ("TWISTING_OQUENDO", TWISTING_OQUENDO),
+        ("COHESION_NONE", COHESION_NONE),
+        ("COHESION_CAPILLARY", COHESION_CAPILLARY),
+    ];
+}
+
+impl<T> NormalLaw<T> {
+    /// The law's WGSL code.
+    pub fn code(&self) -> u32 {
+        match self {
+            NormalLaw::Hertz => code::NORMAL_HERTZ,
+            NormalLaw::Linear { .. } => code::NORMAL_LINEAR,
+        }
+    }
+}
+
+impl<T> DampingLaw<T> {
+    /// The law's WGSL code.
+    pub fn code(&self) -> u32 {
+        match self {
+            DampingLaw::None => code::DAMPING_NONE,
+            DampingLaw::Papers => code::DAMPING_PAPERS,
+            DampingLaw::Restitution => code::DAMPING_RESTITUTION,
+            DampingLaw::Viscous { .. } => code::DAMPING_VISCOUS,
+        }
+    }
+}
+
+impl<T> TangentialLaw<T> {
+    /// The law's WGSL code.
+    pub fn code(&self) -> u32 {
+        match self {
+            TangentialLaw::None => code::TANGENTIAL_NONE,
+            TangentialLaw::Oquendo(_) => code::TANGENTIAL_OQUENDO,
+            TangentialLaw::Mindlin { .. } => code::TANGENTIAL_MINDLIN,
+        }
+    }
+}
+
+impl<T> TangentialStiffness<T> {
+    /// The stiffness's WGSL code.
+    pub fn code(&self) -> u32 {
+        match self {
+            TangentialStiffness::Mindlin => code::STIFFNESS_MINDLIN,
+            TangentialStiffness::RatioToNormal(_) => code::STIFFNESS_RATIO,
+        }
+    }
+}
+
+impl<T> RollingLaw<T> {
+    /// The law's WGSL code.
+    pub fn code(&self) -> u32 {
+        match self {
+            RollingLaw::None => code::ROLLING_NONE,
+            RollingLaw::Sds { .. } => code::ROLLING_SDS,
+        }
+    }
+}
+
+impl TwistingLaw {
+    /// The law's WGSL code.
+    pub fn code(&self) -> u32 {
+        match self {
+            TwistingLaw::None => code::TWISTING_NONE,
+            TwistingLaw::Oquendo => code::TWISTING_OQUENDO,
+        }
+    }
+}
+
+impl<T> CohesionLaw<T> {
+    /// The law's WGSL code.
+    pub fn code(&self) -> u32 {
+        match self {
+            CohesionLaw::None => code::COHESION_NONE,
+            CohesionLaw::Capillary { .. } => code::COHESION_CAPILLARY,
+        }
+    }
+}
+
 /// Elastic normal law.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum NormalLaw<T> {
@@ -204,6 +337,13 @@ pub struct HistoryLayout {
     pub rolling: bool,
     /// Liquid bridge volume `V_b` (m^3), one real.
     pub bridge: bool,
+}
+
+impl HistoryLayout {
+    /// Reals a contact's history holds: 3 per spring, 1 for the sliding flag, 1 for a bridge.
+    pub fn reals(&self) -> usize {
+        3 * self.tangential as usize + self.sliding as usize + 3 * self.rolling as usize + self.bridge as usize
+    }
 }
 
 /// Per-contact history, world frame, zero when a contact forms.

@@ -2,7 +2,6 @@
 
 use crate::analysis::fit::{e0_profile, fit_bauer, profile_e0s, BauerFit, E0Profile};
 use crate::analysis::packing_fraction;
-use crate::cpu::HistorySlots;
 use crate::engine::Engine;
 use crate::protocol::{CompressionPoint, StageResult};
 use crate::scene::Scene;
@@ -210,7 +209,7 @@ pub const ESTIMATE_PAIRS_PER_GRAIN: f64 = 6.0;
 
 /// Bytes the CPU engine holds per grain and per pair, for reals of `real` bytes.
 fn engine_bytes(scene: &Scene, real: usize) -> f64 {
-    let stride = HistorySlots::new(scene.model.cast::<f64>().history_layout()).stride;
+    let stride = scene.model.cast::<f64>().history_layout().reals();
     let walls = scene.walls.len();
     // body 9, props 3 + u32, load 6, wall load 6, built_at 3 reals; id, cell, sorted index.
     let per_grain = (27 * real + 4 + 12 + walls * stride * real + if scene.track_orientation { 4 * real } else { 0 }) as f64;

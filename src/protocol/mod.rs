@@ -14,10 +14,6 @@ use serde::{Deserialize, Serialize};
 /// steps.
 pub const ENERGY_GROWTH_TOLERANCE: f64 = 0.5;
 
-/// The step suggested after an instability: half the step, and no more than `auto` would pick.
-pub fn suggested_dt(scene: &Scene) -> f64 {
-    (0.5 * scene.time_step.dt).min(scene.time_step.auto_dt())
-}
 
 /// What a stage did.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -322,7 +318,7 @@ struct Guard {
 
 impl Guard {
     fn new(scene: &Scene, s: &Stats) -> Self {
-        Guard { max_overlap: scene.max_overlap, suggested_dt: suggested_dt(scene), energy0: s.mechanical_energy(), kinetic_elastic0: s.kinetic_energy() + s.elastic_energy, gravity0: s.gravity_energy }
+        Guard { max_overlap: scene.max_overlap, suggested_dt: scene.time_step.suggested_after_instability(), energy0: s.mechanical_energy(), kinetic_elastic0: s.kinetic_energy() + s.elastic_energy, gravity0: s.gravity_energy }
     }
 
     fn check(&self, s: &Stats) -> Result<(), SimError> {

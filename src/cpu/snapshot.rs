@@ -1,0 +1,160 @@
+//! Snapshots of the engine: frames for the recording, and the whole state for checkpoints.
+
+use super::*;
+
+impl<T: Real> CpuEngine<T> {
+    /// The grain state, and the touching pairs and wall contacts with their forces when
+    /// `contacts`.
+    pub(super) fn snapshot(&self, contacts: bool) -> Frame {
+        Frame {
+            time: self.time,
+            id: self.id.clone(),
+            position: self.body.iter().map(|b| b.pos.f64()).collect(),
+            radius: self.prop.iter().map(|p| p.radius.f64()).collect(),
+            velocity: self.body.iter().map(|b| b.vel.f64()).collect(),
+            angular_velocity: self.body.iter().map(|b| b.omega.f64()).collect(),
+            orientation: self.orientation.as_ref().map(|q| q.iter().map(|q| [q[0].f64(), q[1].f64(), q[2].f64(), q[3].f64()]).collect()),
+            contacts: contacts.then(|| {
+                (0..self.pairs.len())
+                    .filter_map(|k| {
+                        let (h, _) = self.pair_overlap(k);
+                        (h > T::ZERO || self.out[k].f_c != T::ZERO).then(|| {
+                            let springs = self.slots.load(&self.hist[k * self.slots.stride..]);
+                            ContactRecord {
+                                i: self.id[self.pairs.owner[k] as usize],
+                                j: self.id[self.pairs.partner[k] as usize],
+                                overlap: h.f64(),
+                                normal_force: (self.out[k].f_n + self.out[k].f_c).f64(),
+                                force: self.out[k].f_i.f64(),
+                                force_j: self.out[k].f_j.f64(),
+                                tangential_spring: springs.tangential.f64(),
+                                rolling_spring: springs.rolling.f64(),
+                            }
+                        })
+                    })
+                    .collect()
+            }),
+            wall_contacts: contacts.then(|| {
+                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic };
+                wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_hist)
+            }),
+        }
+    }
+
+    /// The whole state, for a checkpoint.
+    pub(super) fn save_state(&self) -> EngineState {
+        let mut s = EngineState::default();
+        let v3 = |v: &Vec3<T>| [v.x.f64(), v.y.f64(), v.z.f64()];
+        s.put_reals("body", self.body.iter().flat_map(|b| [v3(&b.pos), v3(&b.vel), v3(&b.omega)].concat()));
+        s.put_reals("load", self.load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
+        s.put_reals("wall_load", self.wall_load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
+        s.put_reals("built_at", self.built_at.iter().flat_map(v3));
+        s.put_ints("image", self.image.iter().flat_map(|i| i.map(|x| x as i64 as u64)));
+        if let Some(q) = &self.orientation {
+            s.put_reals("orientation", q.iter().flat_map(|q| q.map(T::f64)));
+        }
+        s.put_reals("wall_hist", self.wall_hist.iter().map(|x| x.f64()));
+        s.put_reals("wall_reaction", self.wall_reaction.iter().flat_map(v3));
+        s.put_ints("wall_count", self.wall_count.iter().copied());
+        let piston = self.piston.map_or(Vec::new(), |p| {
+            let z = match self.walls[p.wall].geom {
+                WallGeom::Piston { z } => z.f64(),
+                _ => unreachable!("the piston's wall is a piston"),
+            };
+            vec![z, self.walls[p.wall].velocity.z.f64(), p.pressure.f64()]
+        });
+        s.put_reals("piston", piston);
+        let servo = self.servo.map_or(Vec::new(), |sv| {
+            let mut v: Vec<f64> = sv.walls.iter().flat_map(|&w| [v3(&self.plane(w).0), v3(&self.walls[w].velocity)].concat()).collect();
+            v.extend([sv.pressure.f64(), sv.strain_rate.map_or(f64::NAN, |r| r.f64())]);
+            v
+        });
+        s.put_reals("servo", servo);
+        let l = &self.pairs;
+        for (name, v) in [("owner_start", &l.owner_start), ("owner", &l.owner), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
+            s.put_ints(name, v.iter().map(|&x| x as u64));
+        }
+        s.put_reals("hist", self.hist.iter().map(|x| x.f64()));
+        s.put_reals("liquid", self.liquid.iter().map(|x| x.f64()));
+        s.put_reals(
+            "out",
+            self.out.iter().flat_map(|o| {
+                let mut r = [v3(&o.f_i), v3(&o.f_j), v3(&o.t_i), v3(&o.t_j), [o.f_n.f64(), if o.clamped { 1.0 } else { 0.0 }, o.f_c.f64()]].concat();
+                r.push(o.regime as u8 as f64);
+                r
+            }),
+        );
+        s.put_reals("clock", [self.max_moved2.f64(), self.time, self.external_work]);
+        s.put_ints("counters", [self.step, self.rebuilds, self.forces_valid as u64]);
+        s
+    }
+
+    /// Restores what [`Self::save_state`] returned, for the same scene.
+    pub(super) fn restore_state(&mut self, s: &EngineState) -> anyhow::Result<()> {
+        let n = self.body.len();
+        let v3 = |a: &[f64]| Vec3::new(T::of(a[0]), T::of(a[1]), T::of(a[2]));
+        for (b, c) in self.body.iter_mut().zip(s.reals("body", 9 * n)?.chunks_exact(9)) {
+            *b = Body { pos: v3(&c[0..3]), vel: v3(&c[3..6]), omega: v3(&c[6..9]) };
+        }
+        for (l, c) in self.load.iter_mut().zip(s.reals("load", 6 * n)?.chunks_exact(6)) {
+            *l = Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) };
+        }
+        for (l, c) in self.wall_load.iter_mut().zip(s.reals("wall_load", 6 * n)?.chunks_exact(6)) {
+            *l = Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) };
+        }
+        for (b, c) in self.built_at.iter_mut().zip(s.reals("built_at", 3 * n)?.chunks_exact(3)) {
+            *b = v3(c);
+        }
+        let images = s.ints("image", Some(3 * self.image.len()))?;
+        for (i, c) in self.image.iter_mut().zip(images.chunks_exact(3)) {
+            *i = [c[0] as i64 as i32, c[1] as i64 as i32, c[2] as i64 as i32];
+        }
+        if let Some(q) = &mut self.orientation {
+            for (q, c) in q.iter_mut().zip(s.reals("orientation", 4 * n)?.chunks_exact(4)) {
+                *q = [T::of(c[0]), T::of(c[1]), T::of(c[2]), T::of(c[3])];
+            }
+        }
+        self.wall_hist = s.reals("wall_hist", self.wall_hist.len())?.iter().map(|&x| T::of(x)).collect();
+        self.wall_reaction = s.reals("wall_reaction", 3 * self.walls.len())?.chunks_exact(3).map(v3).collect();
+        self.wall_count = s.ints("wall_count", Some(self.walls.len()))?.to_vec();
+        if let Some(p) = &mut self.piston {
+            let v = s.reals("piston", 3)?;
+            self.walls[p.wall].geom = WallGeom::Piston { z: T::of(v[0]) };
+            self.walls[p.wall].velocity.z = T::of(v[1]);
+            p.pressure = T::of(v[2]);
+        }
+        if let Some(mut sv) = self.servo {
+            let v = s.reals("servo", 6 * 6 + 2)?;
+            for (k, &w) in sv.walls.iter().enumerate() {
+                let (_, normal) = self.plane(w);
+                self.walls[w].geom = WallGeom::Plane { point: v3(&v[6 * k..6 * k + 3]), normal };
+                self.walls[w].velocity = v3(&v[6 * k + 3..6 * k + 6]);
+            }
+            sv.pressure = T::of(v[36]);
+            sv.strain_rate = (!v[37].is_nan()).then(|| T::of(v[37]));
+            self.servo = Some(sv);
+        }
+        let u32s = |name: &str, len: Option<usize>| -> anyhow::Result<Vec<u32>> { Ok(s.ints(name, len)?.iter().map(|&x| x as u32).collect()) };
+        let owner = u32s("owner", None)?;
+        let n_pairs = owner.len();
+        self.pairs = PairList {
+            owner_start: u32s("owner_start", Some(n + 1))?,
+            owner,
+            partner: u32s("partner", Some(n_pairs))?,
+            rev_start: u32s("rev_start", Some(n + 1))?,
+            rev_pair: u32s("rev_pair", Some(n_pairs))?,
+        };
+        self.hist = s.reals("hist", n_pairs * self.slots.stride)?.iter().map(|&x| T::of(x)).collect();
+        self.liquid = s.reals("liquid", self.liquid.len())?.iter().map(|&x| T::of(x)).collect();
+        self.out = s
+            .reals("out", 16 * n_pairs)?
+            .chunks_exact(16)
+            .map(|c| ContactForce { f_i: v3(&c[0..3]), f_j: v3(&c[3..6]), t_i: v3(&c[6..9]), t_j: v3(&c[9..12]), f_n: T::of(c[12]), clamped: c[13] != 0.0, f_c: T::of(c[14]), regime: Regime::from_code(c[15] as u8) })
+            .collect();
+        let clock = s.reals("clock", 3)?;
+        (self.max_moved2, self.time, self.external_work) = (T::of(clock[0]), clock[1], clock[2]);
+        let counters = s.ints("counters", Some(3))?;
+        (self.step, self.rebuilds, self.forces_valid) = (counters[0], counters[1], counters[2] != 0);
+        Ok(())
+    }
+}

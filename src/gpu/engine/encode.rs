@@ -1,0 +1,139 @@
+//! Encoding the step: the plan's dispatches into a compute pass.
+
+use super::*;
+
+/// How a kernel is dispatched.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Size {
+    /// One invocation per grain.
+    Grains,
+    /// One workgroup.
+    One,
+    /// From an indirect-argument slot.
+    Indirect(u64),
+}
+
+impl GpuEngine {
+    pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, group: &str, size: Size, phase: Option<Phase>) {
+        pass.set_pipeline(&self.pipelines[name]);
+        // A kernel with a phase binding is given its phase; the others none.
+        let slot = |p: Phase| self.phases.iter().position(|q| *q == p).expect("every phase of the plans has a uniform slot");
+        let offsets: Vec<u32> = phase.map(|p| (slot(p) as u64 * self.phase_stride) as u32).into_iter().collect();
+        pass.set_bind_group(0, &self.bind_groups[group], &offsets);
+        self.dispatches.set(self.dispatches.get() + 1);
+        match size {
+            Size::Grains => {
+                let (x, y) = groups_for(self.n as u64);
+                pass.dispatch_workgroups(x, y, 1);
+            }
+            Size::One => pass.dispatch_workgroups(1, 1, 1),
+            Size::Indirect(slot) => pass.dispatch_workgroups_indirect(&self.buffers["args"], slot * std::mem::size_of::<DispatchArgs>() as u64),
+        }
+    }
+
+    pub(super) fn run(&self, pass: &mut wgpu::ComputePass, name: &str, size: Size, phase: Option<Phase>) {
+        self.dispatch(pass, name, name, size, phase);
+    }
+
+    /// Exclusive scan of an array of `elements`: blocks, the blocks' totals, then the offsets
+    /// added back (the last two only when there is more than one block).
+    pub(super) fn scan(&self, pass: &mut wgpu::ComputePass, tag: &str, sums_tag: &str, blocks: u64, elements: u64) {
+        self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{tag}"), Size::Indirect(blocks), None);
+        // An array of one block is scanned by then: its offset would be 0.
+        if elements <= SCAN_BLOCK {
+            return;
+        }
+        self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{sums_tag}"), Size::Indirect(args::ONE), None);
+        self.dispatch(pass, "scan_add", &format!("scan_add:{tag}"), Size::Indirect(blocks), None);
+    }
+
+    /// `decide_rebuild` and the rebuild kernels, which run with zero workgroups when the
+    /// list is still good.
+    pub(super) fn encode_rebuild_if_needed(&self, pass: &mut wgpu::ComputePass) {
+        self.run(pass, "decide_rebuild", Size::One, None);
+        let keeps_history = self.params.hist_blocks > 0;
+        if keeps_history {
+            self.run(pass, "save_starts", Size::Indirect(args::GRAIN_STARTS), None);
+            self.run(pass, "save_pairs", Size::Indirect(args::OLD_PAIRS), None);
+        }
+        self.run(pass, "clear_cells", Size::Indirect(args::HASH), None);
+        self.run(pass, "hash_cells", Size::Indirect(args::GRAINS), None);
+        self.scan(pass, "cell", "cell_sums", args::HASH_BLOCKS, self.params.hash_size as u64);
+        self.run(pass, "scatter_cells", Size::Indirect(args::GRAINS), None);
+        self.run(pass, "detect_count", Size::Indirect(args::GRAINS), None);
+        self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
+        self.run(pass, "pairs_ready", Size::One, None);
+        self.run(pass, "detect_fill", Size::Indirect(args::GRAINS), None);
+        if keeps_history {
+            self.run(pass, "remap_history", Size::Indirect(args::NEW_PAIRS), None);
+        }
+        self.run(pass, "reverse_count", Size::Indirect(args::NEW_PAIRS), None);
+        self.scan(pass, "rev", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
+        self.run(pass, "reverse_fill", Size::Indirect(args::NEW_PAIRS), None);
+        self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
+    }
+
+    /// `update_bridges` (capillary scenes), `pair_force`, `wall_contacts` (+ `wall_reduce`),
+    /// `gather` (and the kick after it), with the durations of `phase`.
+    pub(super) fn encode_forces(&self, pass: &mut wgpu::ComputePass, phase: Phase) {
+        if self.history.bridge {
+            self.run(pass, "update_bridges", Size::One, None);
+        }
+        self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(phase));
+        if self.has_walls {
+            self.run(pass, "wall_contacts", Size::Grains, Some(phase));
+            self.run(pass, "wall_reduce", Size::One, None);
+        }
+        self.run(pass, "gather", Size::Grains, Some(phase));
+    }
+
+    /// Encodes one entry of a plan.
+    pub(super) fn encode(&self, pass: &mut wgpu::ComputePass, e: &Entry) {
+        match e.dispatch {
+            Dispatch::Integrate => {
+                self.run(pass, "integrate", Size::Grains, Some(e.phase));
+                if self.servo.is_some() && e.phase.drift > 0.0 {
+                    self.run(pass, "servo_move", Size::One, Some(e.phase));
+                }
+            }
+            Dispatch::RebuildIfNeeded => self.encode_rebuild_if_needed(pass),
+            Dispatch::Forces => self.encode_forces(pass, e.phase),
+        }
+    }
+
+    /// Encodes plan `which` (0 prologue, 1 first step, 2 later steps) and traces its
+    /// operations.
+    pub(super) fn encode_plan(&mut self, pass: &mut wgpu::ComputePass, which: usize) {
+        for k in 0..self.plans[which].len() {
+            self.encode(pass, &self.plans[which][k]);
+            for op in self.plans[which][k].ops.clone() {
+                self.trace.record(op);
+            }
+        }
+    }
+
+    /// Runs the schedule's prologue (the list built if need be, forces evaluated) where
+    /// nothing has evaluated the loads yet: before the first step, or after wetting.
+    pub(super) fn ensure_loads(&mut self) {
+        if self.forces_valid {
+            return;
+        }
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.encode_plan(&mut pass, 0);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        self.forces_valid = true;
+    }
+
+    /// Starts recording the operations encoded (see [`Trace`]).
+    pub fn trace_schedule(&mut self) {
+        self.trace.start();
+    }
+
+    /// The operations encoded since [`Self::trace_schedule`].
+    pub fn traced(&self) -> &[Op] {
+        self.trace.ops()
+    }
+}

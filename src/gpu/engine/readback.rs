@@ -1,0 +1,211 @@
+//! Reading the device back: buffers, the control flags, the statistics.
+
+use super::*;
+
+/// The pressure the grains exert on plane `k` (0..6) of the servo box whose walls are
+/// `planes` (Pa): the CPU's `servo_pressure`, from the GPU's walls and reactions.
+fn servo_pressure(walls: &[layout::Wall], reaction: &[[f32; 4]], planes: [usize; 6], k: usize) -> f64 {
+    let coord = |k: usize| walls[planes[k]].point[k / 2] as f64;
+    let extents = [0, 1, 2].map(|a| coord(2 * a + 1) - coord(2 * a));
+    let a = k / 2;
+    let area = extents[(a + 1) % 3] * extents[(a + 2) % 3];
+    let (r, n) = (reaction[planes[k]], walls[planes[k]].normal);
+    -(0..3).map(|c| r[c] as f64 * n[c] as f64).sum::<f64>() / area
+}
+
+impl GpuEngine {
+    /// Copies buffers out: `(buffer, offset, bytes)` each, returned in order as 4-byte words
+    /// (every type the kernels share is 4-byte aligned).
+    pub(super) fn read(&self, parts: &[(&str, u64, u64)]) -> Vec<Vec<u32>> {
+        let total: u64 = parts.iter().map(|p| p.2.next_multiple_of(4)).sum();
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: total.max(4),
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        let mut at = 0;
+        for &(name, offset, bytes) in parts {
+            encoder.copy_buffer_to_buffer(&self.buffers[name], offset, &staging, at, bytes.next_multiple_of(4));
+            at += bytes.next_multiple_of(4);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping a readback buffer"));
+        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).expect("the GPU finishes");
+        let view = staging.slice(..).get_mapped_range().expect("a mapped readback buffer");
+        let mut out = Vec::new();
+        let mut at = 0usize;
+        for &(_, _, bytes) in parts {
+            out.push(bytemuck::pod_collect_to_vec(&view[at..at + bytes as usize]));
+            at += bytes.next_multiple_of(4) as usize;
+        }
+        out
+    }
+
+    pub(super) fn read_control(&mut self) -> Control {
+        let c = self.read(&[("control", 0, std::mem::size_of::<Control>() as u64)]);
+        self.control = *bytemuck::from_bytes(bytemuck::cast_slice(&c[0]));
+        self.control
+    }
+
+    /// Checks the flags the last steps raised, and grows the pair buffers when they fill up.
+    pub(super) fn check(&mut self) -> Result<(), SimError> {
+        let c = self.read_control();
+        if c.overflow_grain != NONE {
+            return Err(SimError::Capacity { step: self.step, grain: c.overflow_grain, count: c.overflow_count as usize, capacity: self.params.max_neighbours as usize });
+        }
+        if c.pair_overflow != 0 {
+            return Err(SimError::Capacity {
+                step: self.step,
+                grain: NONE,
+                count: self.params.pair_capacity as usize + 1,
+                capacity: self.params.pair_capacity as usize,
+            });
+        }
+        if c.n_pairs as f64 > PAIR_GROWTH_THRESHOLD * self.params.pair_capacity as f64 {
+            let binding = self.gpu.limits.max_storage_buffer_binding_size;
+            let per_pair = 16 * (self.params.hist_blocks as u64).max(1);
+            let grown = (2 * c.n_pairs as u64).min(binding / per_pair);
+            if grown > self.params.pair_capacity as u64 {
+                self.allocate_pairs(grown);
+                self.build_bind_groups();
+            }
+        }
+        Ok(())
+    }
+
+    /// Rebuilds the neighbour list at the next step, whatever the displacements.
+    pub fn rebuild_next_step(&mut self) {
+        self.gpu.queue.write_buffer(&self.buffers["control"], 0, bytemuck::bytes_of(&f32::INFINITY.to_bits()));
+    }
+
+    /// The pair list (CSR: starts per grain, partners), read back.
+    pub fn pair_list(&mut self) -> (Vec<u32>, Vec<u32>) {
+        let n_pairs = self.read_control().n_pairs as u64;
+        let parts = self.read(&[("pair_start", 0, 4 * (self.n as u64 + 1)), ("pair_j", 0, 4 * n_pairs)]);
+        (parts[0].clone(), parts[1].clone())
+    }
+
+    /// Force and torque on each grain from the last force evaluation (N, N m), read back.
+    pub fn loads(&self) -> Vec<([f32; 3], [f32; 3])> {
+        let a = self.read_vec4s(&["force", "torque"]);
+        a[0].iter().zip(&a[1]).map(|(f, t)| ([f[0], f[1], f[2]], [t[0], t[1], t[2]])).collect()
+    }
+
+    /// Liquid bridges among the first `n_pairs` pairs, the liquid they hold and the liquid
+    /// waiting on the grains (m^3), read back.
+    pub(super) fn liquid_sums(&self, n_pairs: u64) -> (u64, f64, f64) {
+        let blocks = self.params.hist_blocks as usize;
+        let parts = self.read(&[("hist", 0, 16 * n_pairs * blocks as u64), ("liquid", 0, 4 * self.n as u64)]);
+        let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
+        let liquid: &[f32] = bytemuck::cast_slice(&parts[1]);
+        let volumes = hist.iter().skip(blocks - 1).step_by(blocks).map(|b| b[0]).filter(|&v| v > 0.0);
+        let (bridges, held) = volumes.fold((0, 0.0), |(n, s), v| (n + 1, s + v as f64));
+        (bridges, held, liquid.iter().map(|&l| l as f64).sum())
+    }
+
+    /// Reads grain arrays back (vec4 per grain).
+    pub(super) fn read_vec4s(&self, names: &[&str]) -> Vec<Vec<[f32; 4]>> {
+        let parts: Vec<(&str, u64, u64)> = names.iter().map(|n| (*n, 0, 16 * self.n as u64)).collect();
+        self.read(&parts).into_iter().map(|b| bytemuck::cast_slice(&b).to_vec()).collect()
+    }
+
+    /// The statistics of the current state (loads evaluated first if nothing has).
+    pub(super) fn statistics(&mut self) -> Stats {
+        self.ensure_loads();
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.run(&mut pass, "reduce_grains", Size::Grains, None);
+            self.run(&mut pass, "reduce_pairs", Size::Indirect(args::PAIRS), None);
+            self.run(&mut pass, "reduce_final", Size::One, None);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        let n_walls = self.wall_names.len();
+        let parts = self.read(&[
+            ("control", 0, std::mem::size_of::<Control>() as u64),
+            ("stats", 0, 2 * STAT_ROW as u64 * 4),
+            ("wall_reaction", 0, MAX_WALLS as u64 * 16),
+            ("walls", 0, (n_walls.max(1) * std::mem::size_of::<layout::Wall>()) as u64),
+            ("servo", 0, std::mem::size_of::<layout::Servo>() as u64),
+        ]);
+        let control: Control = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[0]));
+        let servo: layout::Servo = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[4]));
+        self.control = control;
+        let s: &[f32] = bytemuck::cast_slice(&parts[1]);
+        let reaction: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
+        let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[3]);
+        use layout::stat::{grain as gr, pair as pr};
+        let g = |f: usize| s[f] as f64;
+        let p = |f: usize| s[STAT_ROW + f] as f64;
+        let g_count = |f: usize| s[f].to_bits() as u64;
+        let p_count = |f: usize| s[STAT_ROW + f].to_bits() as u64;
+        let n = self.n as f64;
+        let contacts = p_count(pr::CONTACTS);
+        let wall_contacts = g_count(gr::WALL_CONTACTS);
+        let contact_ends = 2 * contacts + wall_contacts;
+        let rattlers = g_count(gr::RATTLERS);
+        let contact_force = p(pr::FORCE) + g(gr::WALL_FORCE);
+        let unbalanced_force = crate::engine::unbalanced(g(gr::NET_FORCE), n, contact_force, contact_ends);
+        let unbalanced_force_loaded = crate::engine::unbalanced(g(gr::NET_LOADED), n - rattlers as f64, contact_force, contact_ends);
+        let (max_overlap, max_overlap_grain) = {
+            let (gv, gi) = (g(STAT_ROW - 2), s[STAT_ROW - 1].to_bits());
+            let (pv, pi) = (p(STAT_ROW - 2), s[2 * STAT_ROW - 1].to_bits());
+            if gv > pv || (gv == pv && gi < pi) { (gv, gi) } else { (pv, pi) }
+        };
+        let (bridges, liquid_in_bridges, liquid_on_grains) = if self.history.bridge { self.liquid_sums(control.n_pairs as u64) } else { (0, 0.0, 0.0) };
+        let piston = self.piston.map(|w| {
+            let wall = &walls[w];
+            PistonStats {
+                z: wall.point[2] as f64,
+                velocity: wall.velocity[2] as f64,
+                target_pressure: wall.piston[2] as f64,
+                pressure: reaction[w][2] as f64 / wall.piston[1] as f64,
+            }
+        });
+        Stats {
+            step: self.step,
+            time: self.time,
+            ke_translational: g(gr::KE_T),
+            ke_rotational: g(gr::KE_R),
+            elastic_energy: p(pr::ELASTIC) + g(gr::WALL_ELASTIC),
+            gravity_energy: g(gr::PE_G),
+            piston_ke: self.piston.map_or(0.0, |w| 0.5 * walls[w].piston[0] as f64 * (walls[w].velocity[2] as f64).powi(2)),
+            external_work: self.piston.map_or(0.0, |w| walls[w].piston[3] as f64) + servo.work as f64 + servo.work_lo as f64,
+            momentum: [0, 1, 2].map(|a| g(gr::MOMENTUM + a)),
+            angular_momentum: [0, 1, 2].map(|a| g(gr::ANGULAR + a)),
+            pairs: control.n_pairs as u64,
+            contacts,
+            wall_contacts,
+            clamped: p_count(pr::CLAMPED),
+            sliding: p_count(pr::SLIDING) + g_count(gr::WALL_SLIDING),
+            rolling: p_count(pr::ROLLING) + g_count(gr::WALL_ROLLING),
+            coordination: 2.0 * contacts as f64 / n,
+            max_overlap,
+            max_overlap_grain: if max_overlap_grain == NONE { 0 } else { max_overlap_grain },
+            unbalanced_force,
+            unbalanced_force_loaded,
+            rattlers,
+            ke_rattlers: g(gr::KE_RATTLERS),
+            non_finite_grain: (control.non_finite != NONE).then_some(control.non_finite),
+            rebuilds: control.rebuilds as u64,
+            bridges,
+            liquid_in_bridges,
+            liquid_on_grains,
+            walls: (0..n_walls)
+                .map(|w| {
+                    let servo_plane = self.servo.and_then(|planes| planes.iter().position(|&p| p == w));
+                    WallStats {
+                        name: self.wall_names[w].clone(),
+                        force: [reaction[w][0] as f64, reaction[w][1] as f64, reaction[w][2] as f64],
+                        contacts: reaction[w][3].round() as u64,
+                        position: servo_plane.map(|k| walls[w].point[k / 2] as f64),
+                        pressure: servo_plane.map(|k| servo_pressure(walls, reaction, self.servo.expect("a servo plane"), k)),
+                    }
+                })
+                .collect(),
+            piston,
+        }
+    }
+}

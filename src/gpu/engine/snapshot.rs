@@ -1,0 +1,212 @@
+//! The host's work on state read back: frames, checkpoints and wetting.
+
+use super::*;
+
+/// The GPU's history (one vec4 per block and contact: tangential with the sliding flag in w,
+/// rolling, bridge volume in x) in the CPU engine's packed slots.
+fn cpu_history(blocks: &[[f32; 4]], slots: &crate::cpu::HistorySlots) -> Vec<f32> {
+    let layout = slots.layout;
+    let per_contact = [layout.tangential, layout.rolling, layout.bridge].into_iter().filter(|&b| b).count().max(1);
+    let mut out = Vec::with_capacity(blocks.len() / per_contact * slots.stride);
+    for contact in blocks.chunks_exact(per_contact) {
+        let mut s = vec![0.0f32; slots.stride];
+        let mut b = contact.iter();
+        if layout.tangential {
+            let t = b.next().expect("a tangential block");
+            s[slots.tangential..slots.tangential + 3].copy_from_slice(&t[..3]);
+            if layout.sliding {
+                s[slots.sliding] = t[3];
+            }
+        }
+        if layout.rolling {
+            let r = b.next().expect("a rolling block");
+            s[slots.rolling..slots.rolling + 3].copy_from_slice(&r[..3]);
+        }
+        if layout.bridge {
+            s[slots.bridge] = b.next().expect("a bridge block")[0];
+        }
+        out.extend(s);
+    }
+    out
+}
+
+impl GpuEngine {
+    /// Grain-wall contacts re-evaluated on the host from the GPU's state (the CPU twin's
+    /// function in f32), given the grain arrays `[pos, vel, omega, ..]` already read.
+    pub(super) fn wall_contact_records(&self, arrays: &[Vec<[f32; 4]>]) -> Vec<crate::engine::WallContactRecord> {
+        use crate::cpu::{wall_contact_records, Body, ForceContext, HistorySlots, Props, WallState};
+        use crate::real::Vec3;
+        let n_walls = self.wall_names.len();
+        let blocks = self.params.hist_blocks as usize;
+        let parts = self.read(&[
+            ("material", 0, 4 * self.n as u64),
+            ("walls", 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64),
+            ("wall_hist", 0, if blocks > 0 { 16 * (self.n as usize * n_walls * blocks) as u64 } else { 0 }),
+        ]);
+        let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[1]);
+        let gpu_hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
+        let v3 = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
+        let body: Vec<Body<f32>> = (0..self.n as usize).map(|i| Body { pos: v3(arrays[0][i]), vel: v3(arrays[1][i]), omega: v3(arrays[2][i]) }).collect();
+        let prop: Vec<Props<f32>> = (0..self.n as usize).map(|i| Props { radius: arrays[0][i][3], mass: arrays[1][i][3], inertia: arrays[2][i][3], material: parts[0][i] }).collect();
+        let states: Vec<WallState<f32>> = walls
+            .iter()
+            .map(|w| WallState {
+                geom: match w.kind {
+                    layout::wall_kind::PLANE => crate::walls::WallGeom::Plane { point: v3(w.point), normal: v3(w.normal) },
+                    layout::wall_kind::CYLINDER => crate::walls::WallGeom::Cylinder { cx: w.point[0], cy: w.point[1], radius: w.normal[3] },
+                    _ => crate::walls::WallGeom::Piston { z: w.point[2] },
+                },
+                velocity: v3(w.velocity),
+                material: w.material,
+            })
+            .collect();
+        let slots = HistorySlots::new(self.history);
+        let hist = cpu_history(gpu_hist, &slots);
+        let ctx = ForceContext {
+            model: &self.model,
+            coeffs: &self.coeffs,
+            n_materials: self.n_materials,
+            slots,
+            elapsed: 0.0,
+            periodic: crate::periodic::Periodic::default(),
+        };
+        wall_contact_records(&body, &prop, &(0..self.n).collect::<Vec<u32>>(), &states, &ctx, &hist)
+    }
+
+    /// The grain state, and the touching pairs and wall contacts with their forces when
+    /// `contacts`.
+    pub(super) fn snapshot(&self, contacts: bool) -> Frame {
+        let mut names = vec!["pos", "vel", "omega"];
+        if self.track_orientation {
+            names.push("quat");
+        }
+        let arrays = self.read_vec4s(&names);
+        let xyz = |v: &[f32; 4]| [v[0] as f64, v[1] as f64, v[2] as f64];
+        let contact_records = contacts.then(|| {
+            let np = self.control.n_pairs as u64;
+            let blocks = self.params.hist_blocks as u64;
+            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, 16 * np), ("hist", 0, 16 * np * blocks), ("out_tj", 0, 16 * np)]);
+            let (pi, pj): (&[u32], &[u32]) = (&parts[0], &parts[1]);
+            let fi: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
+            let fj: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
+            let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[4]);
+            // out_tj.w: the capillary force.
+            let f_c: Vec<f32> = bytemuck::cast_slice::<u32, [f32; 4]>(&parts[5]).iter().map(|t| t[3]).collect();
+            let pos = &arrays[0];
+            (0..np as usize)
+                .filter_map(|k| {
+                    let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
+                    let d = [(a[0] - b[0]) as f64, (a[1] - b[1]) as f64, (a[2] - b[2]) as f64];
+                    let mut d2 = 0.0;
+                    for (axis, x) in d.iter().enumerate() {
+                        let len = self.params.periodic_len[axis] as f64;
+                        let x = if len > 0.0 { x - len * (x / len + 0.5).floor() } else { *x };
+                        d2 += x * x;
+                    }
+                    let h = (a[3] + b[3]) as f64 - d2.sqrt();
+                    (h > 0.0 || f_c[k] != 0.0).then(|| ContactRecord {
+                        i: pi[k],
+                        j: pj[k],
+                        overlap: h,
+                        normal_force: (fi[k][3] + f_c[k]) as f64,
+                        force: xyz(&fi[k]),
+                        force_j: xyz(&fj[k]),
+                        tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
+                        rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + self.history.tangential as usize]) } else { [0.0; 3] },
+                    })
+                })
+                .collect()
+        });
+        let wall_records = (contacts && self.has_walls).then(|| self.wall_contact_records(&arrays)).or(contacts.then(Vec::new));
+        Frame {
+            time: self.time,
+            id: (0..self.n).collect(),
+            position: arrays[0].iter().map(xyz).collect(),
+            radius: arrays[0].iter().map(|v| v[3] as f64).collect(),
+            velocity: arrays[1].iter().map(xyz).collect(),
+            angular_velocity: arrays[2].iter().map(xyz).collect(),
+            orientation: self.track_orientation.then(|| arrays[3].iter().map(|q| [q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]).collect()),
+            contacts: contact_records,
+            wall_contacts: wall_records,
+        }
+    }
+
+    /// Wets the sample with `volume` (m^3) of liquid, as the CPU twin does.
+    pub(super) fn wet_pairs(&mut self, volume: f64) -> anyhow::Result<()> {
+        use crate::real::Vec3;
+        let crate::model::CohesionLaw::Capillary { theta, .. } = self.model.cohesion else {
+            anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
+        };
+        // The liquid goes to the pairs of the current list.
+        self.ensure_loads();
+        let (n, np, blocks) = (self.n as u64, self.read_control().n_pairs as u64, self.params.hist_blocks as u64);
+        let parts = self.read(&[("pos", 0, 16 * n), ("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("hist", 0, 16 * np * blocks), ("liquid", 0, 4 * n)]);
+        let pos: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
+        let (pi, pj) = (&parts[1], &parts[2]);
+        let mut hist: Vec<[f32; 4]> = bytemuck::cast_slice(&parts[3]).to_vec();
+        let mut liquid: Vec<f32> = bytemuck::cast_slice(&parts[4]).to_vec();
+        // The CPU twin's reduced diameters and gaps (in f32, as its f32 engine has them).
+        let v3 = |p: &[f32; 4]| Vec3::new(p[0], p[1], p[2]);
+        let d: Vec<f64> = (0..np as usize).map(|k| {
+            let (ri, rj) = (pos[pi[k] as usize][3] as f64, pos[pj[k] as usize][3] as f64);
+            2.0 * ri * rj / (ri + rj)
+        }).collect();
+        let gaps: Vec<f64> = (0..np as usize).map(|k| {
+            let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
+            (self.periodic.min_image(v3(a) - v3(b)).norm() - a[3] - b[3]) as f64
+        }).collect();
+        let (shares, rest) = crate::model::share_liquid(volume, &d, &gaps, self.params.bridge_cap as f64, theta as f64);
+        let last = blocks as usize - 1;
+        for (k, v) in shares {
+            hist[k * blocks as usize + last][0] += v as f32;
+        }
+        let rest = (rest / n as f64) as f32;
+        for l in &mut liquid {
+            *l += rest;
+        }
+        self.gpu.queue.write_buffer(&self.buffers["hist"], 0, bytemuck::cast_slice(&hist));
+        self.gpu.queue.write_buffer(&self.buffers["liquid"], 0, bytemuck::cast_slice(&liquid));
+        self.forces_valid = false;
+        Ok(())
+    }
+
+    /// The whole state, for a checkpoint: every buffer but constants and scratch, bit for bit.
+    pub(super) fn save_state(&self) -> Option<crate::engine::EngineState> {
+        let mut s = crate::engine::EngineState::default();
+        let n_pairs = self.control.n_pairs as u64;
+        let per_pair: HashMap<&str, u64> = self.pair_buffers().into_iter().collect();
+        let mut names: Vec<&'static str> = self.buffers.keys().copied().filter(|name| !NOT_STATE.contains(name)).collect();
+        names.sort_unstable();
+        let parts: Vec<(&str, u64, u64)> = names.iter().map(|&name| (name, 0, per_pair.get(name).map_or(self.buffers[name].size(), |b| b * n_pairs))).collect();
+        for (name, words) in names.iter().zip(self.read(&parts)) {
+            // Two 4-byte words per stored integer, the first in the low half.
+            s.put_ints(&format!("gpu:{name}"), words.chunks(2).map(|c| c[0] as u64 | (c.get(1).copied().unwrap_or(0) as u64) << 32));
+        }
+        s.put_ints("counters", [self.step, self.forces_valid as u64, self.params.pair_capacity as u64]);
+        s.put_reals("time", [self.time]);
+        Some(s)
+    }
+
+    /// Restores what [`Self::save_state`] returned, for the same scene.
+    pub(super) fn restore_state(&mut self, s: &crate::engine::EngineState) -> anyhow::Result<()> {
+        let counters = s.ints("counters", Some(3))?;
+        if counters[2] != self.params.pair_capacity as u64 {
+            self.allocate_pairs(counters[2]);
+            self.build_bind_groups();
+        }
+        for (key, words) in &s.ints {
+            let Some(name) = key.strip_prefix("gpu:") else { continue };
+            let buffer = self.buffers.get(name).ok_or_else(|| anyhow::anyhow!("the checkpoint holds a GPU buffer `{name}` this engine lacks; fix: resume with the grains version that wrote it"))?;
+            let bytes: Vec<u8> = words.iter().flat_map(|&w| w.to_le_bytes()).collect();
+            // A list of an odd number of words was padded with one (beyond the live pairs).
+            if bytes.len() as u64 > buffer.size() + 4 {
+                anyhow::bail!("the checkpoint's GPU buffer `{name}` holds {} bytes, this scene's {}; fix: resume with the scene the checkpoint was written for", bytes.len(), buffer.size());
+            }
+            self.gpu.queue.write_buffer(buffer, 0, &bytes[..bytes.len().min(buffer.size() as usize)]);
+        }
+        (self.step, self.forces_valid) = (counters[0], counters[1] != 0);
+        self.time = s.reals("time", 1)?[0];
+        self.read_control();
+        Ok(())
+    }
+}

@@ -1,0 +1,351 @@
+//! The validated scene's types, in SI units and `f64`: what the engines, the host loop and
+//! the analysis read. Plain data: the checks that make them live in [`super`] (validation),
+//! [`crate::timestep`] (the time step) and [`crate::walls`] (wall geometry).
+
+use crate::model::{ContactModel, MaterialConstants};
+use serde::Serialize;
+use std::path::PathBuf;
+
+/// A material, validated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name grains and walls refer to.
+    pub name: String,
+    /// Density (kg/m^3); `None` for wall-only materials.
+    pub density: Option<f64>,
+    /// Restitution coefficient as given (`constants.restitution` is 1 when not given).
+    pub restitution: Option<f64>,
+    /// Elastic and frictional constants.
+    pub constants: MaterialConstants,
+}
+
+/// The initial state of every grain, indexed by permanent id.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Grains {
+    /// Radius (m).
+    pub radius: Vec<f64>,
+    /// Mass (kg).
+    pub mass: Vec<f64>,
+    /// Centre position (m).
+    pub position: Vec<[f64; 3]>,
+    /// Velocity (m/s).
+    pub velocity: Vec<[f64; 3]>,
+    /// Angular velocity (rad/s).
+    pub angular_velocity: Vec<[f64; 3]>,
+    /// Index into [`Scene::materials`].
+    pub material: Vec<u16>,
+}
+
+impl Grains {
+    /// The same grains renumbered: grain `k` of the result is grain `order[k]` of `self`.
+    pub fn permuted(&self, order: &[usize]) -> Grains {
+        let pick = |v: &[[f64; 3]]| order.iter().map(|&i| v[i]).collect();
+        Grains {
+            radius: order.iter().map(|&i| self.radius[i]).collect(),
+            mass: order.iter().map(|&i| self.mass[i]).collect(),
+            position: pick(&self.position),
+            velocity: pick(&self.velocity),
+            angular_velocity: pick(&self.angular_velocity),
+            material: order.iter().map(|&i| self.material[i]).collect(),
+        }
+    }
+
+    /// Number of grains.
+    pub fn len(&self) -> usize {
+        self.radius.len()
+    }
+    /// True when there are no grains.
+    pub fn is_empty(&self) -> bool {
+        self.radius.is_empty()
+    }
+    pub(super) fn push(&mut self, radius: f64, mass: f64, position: [f64; 3], velocity: [f64; 3], angular_velocity: [f64; 3], material: u16) {
+        self.radius.push(radius);
+        self.mass.push(mass);
+        self.position.push(position);
+        self.velocity.push(velocity);
+        self.angular_velocity.push(angular_velocity);
+        self.material.push(material);
+    }
+}
+
+/// Shape and motion of a wall.
+#[derive(Clone, Debug, PartialEq)]
+pub enum WallShape {
+    /// Fixed plane through `point` with unit `normal` pointing into the domain.
+    Plane {
+        /// A point on the plane (m).
+        point: [f64; 3],
+        /// Unit normal into the domain.
+        normal: [f64; 3],
+    },
+    /// Fixed vertical cylinder, grains inside.
+    Cylinder {
+        /// Axis (x, y) (m).
+        center: [f64; 2],
+        /// Radius (m).
+        radius: f64,
+    },
+    /// Horizontal plate facing down, driven by a target pressure.
+    Piston {
+        /// Initial height (m).
+        z: f64,
+        /// Target pressure (Pa).
+        pressure: f64,
+        /// Mass (kg).
+        mass: f64,
+        /// Area the pressure acts on (m^2).
+        area: f64,
+    },
+}
+
+/// The servo-controlled box of a scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ServoBox {
+    /// Wall indices of the x_min, x_max, y_min, y_max, z_min, z_max planes.
+    pub walls: [usize; 6],
+    /// Initial target pressure (Pa).
+    pub pressure: f64,
+    /// Wall speed per pressure error (m/(s Pa)).
+    pub gain: f64,
+    /// Largest wall speed (m/s).
+    pub max_speed: f64,
+}
+
+/// Default largest speed of servo walls (m/s).
+pub const DEFAULT_SERVO_SPEED: f64 = 0.005;
+/// Pressure (Pa) below which the default servo gain stops growing.
+pub const SERVO_PRESSURE_FLOOR: f64 = 10.0;
+
+/// A wall, validated.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Wall {
+    /// Name in reports, e.g. `wall[0]` or `wall[1].bottom`.
+    pub name: String,
+    /// Geometry and motion.
+    pub shape: WallShape,
+    /// Index into [`Scene::materials`].
+    pub material: u16,
+}
+
+/// Time integration scheme (seed 000 sec. 3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Integrator {
+    /// Velocity Verlet: one force evaluation per step.
+    VelocityVerlet,
+    /// Optimised velocity Verlet (seed 000 eqs. 11-15), `xi = 0.1931833275037836`, two force
+    /// evaluations per step.
+    OptimizedVerlet,
+}
+
+impl Integrator {
+    /// Name as written in scenes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Integrator::VelocityVerlet => "velocity_verlet",
+            Integrator::OptimizedVerlet => "optimized_verlet",
+        }
+    }
+
+}
+
+/// What a stage waits for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StageKind {
+    /// Deposition under gravity until settled.
+    Fill,
+    /// Relaxation until settled.
+    Settle,
+    /// A fixed duration.
+    Run,
+}
+
+/// One stage of the host loop's program.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stage {
+    /// Name in reports.
+    pub name: String,
+    /// What ends the stage.
+    pub kind: StageKind,
+    /// Run: the duration (s); fill/settle: the longest wait (s).
+    pub duration: f64,
+    /// Settled when the kinetic energy per grain (J) is below this ...
+    pub ke_per_grain: f64,
+    /// ... or, when set, when the translational kinetic energy of the loaded grains (rattlers
+    /// left out) over the elastic energy of the contacts is below this (-), in place of
+    /// `ke_per_grain`; the unbalanced force is then that of the loaded grains too ...
+    pub ke_ratio: Option<f64>,
+    /// ... and the unbalanced-force ratio is below this (-).
+    pub unbalanced_force: f64,
+    /// Piston target pressure during the stage (Pa), if it changes.
+    pub piston_pressure: Option<f64>,
+    /// Settling also needs the piston's measured pressure within this fraction of its
+    /// target (stages with a piston pressure).
+    pub pressure_tolerance: f64,
+    /// Move the piston down onto the sample (just above the highest grain) at the start.
+    pub lower_piston: bool,
+    /// Record a compression point (pressure, void ratio, macroscopic stress) at the end.
+    pub records_compression: bool,
+    /// The oedometer's seating load: its compression point gives Bauer's e0.
+    pub seating: bool,
+    /// Wet the sample at the start with this liquid volume (m^3).
+    pub wet_volume: Option<f64>,
+    /// Servo walls' target pressure during the stage (Pa), if it changes.
+    pub servo_pressure: Option<f64>,
+    /// Triaxial: strain rate (1/s) of the servo box's z walls, or `None` for all-servo.
+    pub axial_strain_rate: Option<f64>,
+}
+
+/// What `--out` records.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Output {
+    /// Simulated time between MCAP frames (s); 0 for one frame per stage end.
+    pub frame_interval: f64,
+    /// Record contact forces in frames.
+    pub contact_forces: bool,
+    /// Analyse the force transmission at the end of the run.
+    pub analysis: bool,
+    /// Wall-clock seconds between checkpoints inside a stage; 0 for stage ends only.
+    pub checkpoint_interval: f64,
+}
+
+/// Wall-clock seconds between checkpoints inside a stage by default: a run killed mid-stage
+/// loses at most about this much work.
+pub const DEFAULT_CHECKPOINT_INTERVAL: f64 = 600.0;
+
+/// Steps above which a run cannot finish in practice: at 10^4 steps per second (a few
+/// thousand grains on a fast machine) a billion steps take 28 hours. `grains run` refuses
+/// more without `--force`.
+pub const PRACTICAL_STEPS: u64 = 1_000_000_000;
+
+impl Stage {
+    /// The stage's longest run in steps of `dt` (s).
+    pub fn max_steps(&self, dt: f64) -> u64 {
+        (self.duration / dt).round().max(1.0) as u64
+    }
+}
+
+impl Scene {
+    /// Steps of the whole run at most (every stage to its longest).
+    pub fn max_steps(&self) -> u64 {
+        self.stages.iter().map(|s| s.max_steps(self.time_step.dt)).fold(0u64, u64::saturating_add)
+    }
+
+    /// Refuses a run of more than [`PRACTICAL_STEPS`] steps, naming the count and the fix.
+    pub fn check_practical(&self) -> anyhow::Result<()> {
+        let steps = self.max_steps();
+        if steps > PRACTICAL_STEPS {
+            anyhow::bail!(
+                "{}: simulation.dt = {:e} s: the stages take up to {steps:.3e} steps, more than a run can finish ({PRACTICAL_STEPS:.0e} steps take about a day at 10^4 steps/s); fix: raise simulation.dt (or \"auto\"), shorten the stages, or pass --force",
+                self.path.display(),
+                self.time_step.dt
+            );
+        }
+        Ok(())
+    }
+}
+
+/// A validated scene, in SI units and `f64`; engines convert to their precision.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The file it came from.
+    pub path: PathBuf,
+    /// Name in reports.
+    pub name: String,
+    /// One line saying what it is for.
+    pub description: String,
+    /// Materials.
+    pub materials: Vec<Material>,
+    /// Initial grain state.
+    pub grains: Grains,
+    /// Walls.
+    pub walls: Vec<Wall>,
+    /// The servo-controlled box, if any (its planes are among the walls).
+    pub servo: Option<ServoBox>,
+    /// Wrapping interval `[lo, hi)` (m) of each periodic axis.
+    pub periodic: [Option<[f64; 2]>; 3],
+    /// Gravity (m/s^2).
+    pub gravity: [f64; 3],
+    /// Contact law per slot.
+    pub model: ContactModel<f64>,
+    /// Time integration scheme.
+    pub integrator: Integrator,
+    /// The time step and the times it was chosen from.
+    pub time_step: TimeStep,
+    /// Verlet skin (m).
+    pub skin: f64,
+    /// Steps between statistics reads.
+    pub stats_interval: u64,
+    /// Pairs a grain may own before the run stops with a capacity error.
+    pub max_neighbours: usize,
+    /// Overlap / smaller radius at which a run stops as unstable.
+    pub max_overlap: f64,
+    /// Integrate orientation quaternions.
+    pub track_orientation: bool,
+    /// Host-loop program.
+    pub stages: Vec<Stage>,
+    /// Recording options.
+    pub output: Output,
+    /// Warnings found while validating (e.g. a time step above the recommended fraction).
+    pub warnings: Vec<String>,
+    /// Capillary scenes: the largest bridge volume (m^3) and the rupture distance it reaches
+    /// (m), which the neighbour search adds to the skin; zero without cohesion.
+    pub bridges: BridgeLimits,
+}
+
+/// Bounds on liquid bridges.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BridgeLimits {
+    /// Largest bridge volume (m^3).
+    pub volume_cap: f64,
+    /// Rupture distance of the largest bridge (m).
+    pub reach: f64,
+}
+
+/// Default damping of seed 000's static and rolling springs, as a fraction of critical (-).
+pub const DEFAULT_STATIC_DAMPING: f64 = 0.3;
+/// Default tangential-to-normal stiffness ratio for the linear law (the classic 2/7).
+pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
+/// Default settle criterion on the unbalanced-force ratio.
+pub const DEFAULT_UNBALANCED_FORCE: f64 = 0.01;
+/// Water's surface tension (N/m), the default of `model.surface_tension`.
+pub const DEFAULT_SURFACE_TENSION: f64 = 0.0728;
+/// Seed 001's decay-length constant `c` (its eq. 6).
+pub const CAPILLARY_C: f64 = 0.9;
+/// Default liquid density (kg/m^3).
+pub const DEFAULT_LIQUID_DENSITY: f64 = 1000.0;
+/// Bridges per grain assumed when sizing the largest bridge: the mean bridge holds the
+/// liquid over `BRIDGES_PER_GRAIN / 2` pairs per grain...
+pub const BRIDGES_PER_GRAIN: f64 = 6.0;
+/// ... and no bridge holds more than this many mean bridges (the excess stays on the grains),
+/// which bounds the rupture distance the neighbour search must reach.
+pub const BRIDGE_CAP_IN_MEANS: f64 = 8.0;
+
+/// Default tolerance on the piston's pressure at the end of a pressure stage.
+pub const DEFAULT_PRESSURE_TOLERANCE: f64 = 0.01;
+/// Default pressure multiplier between oedometer steps (seed 000: doubled).
+pub const DEFAULT_OEDOMETER_FACTOR: f64 = 2.0;
+/// Default settle speed, as a fraction of `sqrt(|g| d_mean)`.
+pub const DEFAULT_SETTLE_SPEED_FRACTION: f64 = 1e-2;
+
+/// The times a step is chosen from.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CharacteristicTimes {
+    /// Rayleigh time of the smallest grain (s); infinite for the linear law.
+    pub rayleigh: f64,
+    /// Shortest collision time at `expected_speed` (s).
+    pub collision: f64,
+    /// Speed the collision time is computed for (m/s).
+    pub expected_speed: f64,
+}
+
+/// The chosen step and where it came from.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct TimeStep {
+    /// Time step (s).
+    pub dt: f64,
+    /// True when chosen by `auto`.
+    pub auto: bool,
+    /// The times it was chosen from.
+    pub times: CharacteristicTimes,
+}
+
