@@ -43,7 +43,7 @@ fn engine<T: Real>(c: &mut Criterion, label: &str) {
     let mut e = CpuEngine::<T>::new(&s).expect("engine");
     group.bench_function(BenchmarkId::new("step", label), |b| b.iter(|| e.step().expect("stable")));
     group.bench_function(BenchmarkId::new("rebuild", label), |b| b.iter(|| e.rebuild().expect("rebuild")));
-    group.bench_function(BenchmarkId::new("stats", label), |b| b.iter(|| black_box(e.stats())));
+    group.bench_function(BenchmarkId::new("stats", label), |b| b.iter(|| black_box(e.stats().unwrap())));
     group.finish();
 }
 

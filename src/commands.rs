@@ -36,7 +36,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                     }
                     let summary = pool.install(|| {
                         let mut engine = engine_for(&scene, backend, adapter.as_deref(), precision, json)?;
-                        let start = Progress::start(&scene, engine.as_mut());
+                        let start = Progress::start(&scene, engine.as_mut())?;
                         let identity = grains::runner::identity(&path, engine.as_ref())?;
                         grains::runner::execute(&scene, engine.as_mut(), out.as_deref(), start, identity, None, progress_bar(json))
                     })?;

@@ -125,7 +125,7 @@ fn difference(a: &Frame, b: &Frame, sa: &Stats, sb: &Stats, d_mean: f64) -> Diff
 pub fn compare(scene: &crate::scene::Scene, adapter: &str, gpu: &mut dyn Engine, f32_: &mut dyn Engine, f64_: &mut dyn Engine, steps: u64, checkpoints: u64) -> Result<Comparison, SimError> {
     let d_mean = 2.0 * scene.grains.radius.iter().sum::<f64>() / scene.grains.len() as f64;
     let every = (steps / checkpoints.max(1)).max(1);
-    let ke0 = f64_.stats().kinetic_energy();
+    let ke0 = f64_.stats()?.kinetic_energy();
     let steps = steps.max(1);
     let mut out = Vec::new();
     let mut done = 0;
@@ -136,8 +136,8 @@ pub fn compare(scene: &crate::scene::Scene, adapter: &str, gpu: &mut dyn Engine,
         f32_.advance(n)?;
         f64_.advance(n)?;
         done += n;
-        let (sg, s32, s64) = (gpu.stats(), f32_.stats(), f64_.stats());
-        let (fg, f32f, f64f) = (gpu.frame(true), f32_.frame(true), f64_.frame(true));
+        let (sg, s32, s64) = (gpu.stats()?, f32_.stats()?, f64_.stats()?);
+        let (fg, f32f, f64f) = (gpu.frame(true)?, f32_.frame(true)?, f64_.frame(true)?);
         out.push(Checkpoint {
             step: done,
             time: f64_.time(),

@@ -21,6 +21,14 @@ pub enum SimError {
         /// The capacity.
         capacity: usize,
     },
+    /// The GPU failed to answer a readback (device lost, mapping refused).
+    #[error("the GPU failed while reading back {what}: {reason}; fix: check the GPU driver (a device lost after a long dispatch is often the driver's watchdog) or run with --backend cpu")]
+    Device {
+        /// What was being read.
+        what: String,
+        /// The driver's reason.
+        reason: String,
+    },
     /// The state became non-finite, overlaps ran away, or energy grew with no input.
     #[error("unstable at step {step} (t = {time:.6e} s): {what} (grain {grain}); fix: lower simulation.dt to {suggested_dt:.3e} s or less{also}")]
     Unstable {
@@ -80,6 +88,9 @@ pub struct Stats {
     pub ke_rotational: f64,
     /// Elastic energy in the normal springs of touching pairs and wall contacts (J).
     pub elastic_energy: f64,
+    /// Potential energy of the liquid bridges (J, negative: they pull; 0 without liquid).
+    #[serde(default)]
+    pub capillary_energy: f64,
     /// Gravitational potential energy `-sum m g.r` (J).
     pub gravity_energy: f64,
     /// Kinetic energy of the piston (J).
@@ -195,10 +206,11 @@ impl Stats {
     pub fn kinetic_energy(&self) -> f64 {
         self.ke_translational + self.ke_rotational
     }
-    /// Kinetic + elastic + gravitational + piston kinetic energy minus the external work (J):
-    /// constant without dissipation, never growing with it.
+    /// Kinetic + elastic + capillary + gravitational + piston kinetic energy minus the external
+    /// work (J): constant without dissipation, never growing with it (a bridge that forms
+    /// lowers it).
     pub fn mechanical_energy(&self) -> f64 {
-        self.kinetic_energy() + self.elastic_energy + self.gravity_energy + self.piston_ke - self.external_work
+        self.kinetic_energy() + self.elastic_energy + self.capillary_energy + self.gravity_energy + self.piston_ke - self.external_work
     }
 }
 
@@ -318,13 +330,13 @@ pub trait Engine {
     /// Advances `n` steps.
     fn advance(&mut self, n: u64) -> Result<(), SimError>;
     /// Reads the statistics back.
-    fn stats(&mut self) -> Stats;
+    fn stats(&mut self) -> Result<Stats, SimError>;
     /// Copies the grain state out.
-    fn frame(&self, contacts: bool) -> Frame;
+    fn frame(&self, contacts: bool) -> Result<Frame, SimError>;
     /// Sets the piston's target pressure (Pa); no effect without a piston.
     fn set_piston_pressure(&mut self, pressure: f64);
-    /// The engine's whole state for a checkpoint; `None` where the backend cannot save it.
-    fn save(&self) -> Option<EngineState>;
+    /// The engine's whole state for a checkpoint.
+    fn save(&self) -> Result<EngineState, SimError>;
     /// Restores a state `save` returned, for the same scene, backend and precision.
     fn restore(&mut self, state: &EngineState) -> anyhow::Result<()>;
     /// Sets the servo walls' target pressure (Pa, when given) and switches the z walls to a

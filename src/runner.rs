@@ -59,7 +59,7 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
     rec.finish()?;
     let stages = result?;
     let threads = if engine.backend() == "cpu" { rayon::current_num_threads() } else { 1 };
-    let summary = Summary::new(scene, engine, threads, wall_seconds, stages);
+    let summary = Summary::new(scene, engine, threads, wall_seconds, stages)?;
     if let Some(dir) = out {
         if !summary.compression.is_empty() {
             let path = dir.join("compression.csv");
@@ -77,8 +77,8 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
             }
         }
         if scene.output.analysis {
-            let stats = engine.stats();
-            let a = crate::output::network::write(scene, &engine.frame(true), &stats, dir)?;
+            let stats = engine.stats()?;
+            let a = crate::output::network::write(scene, &engine.frame(true)?, &stats, dir)?;
             if progress_bar {
                 eprint!("{}", crate::output::network::human(&a));
             }
@@ -93,7 +93,7 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
 pub fn run_cpu(scene_file: &Path, precision: &str, out: Option<&Path>, progress_bar: bool) -> anyhow::Result<Summary> {
     let scene = scene::load(scene_file)?;
     let mut engine = cpu_engine(&scene, precision)?;
-    let start = Progress::start(&scene, engine.as_mut());
+    let start = Progress::start(&scene, engine.as_mut())?;
     let id = identity(scene_file, engine.as_ref())?;
     execute(&scene, engine.as_mut(), out, start, id, None, progress_bar)
 }

@@ -104,7 +104,7 @@ impl Recorder for StopAt {
 }
 
 fn bits(e: &dyn Engine) -> Vec<u64> {
-    let f = e.frame(true);
+    let f = e.frame(true).unwrap();
     let mut v: Vec<u64> = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|x| x.map(f64::to_bits)).collect();
     v.extend(f.orientation.unwrap().iter().flat_map(|q| q.map(f64::to_bits)));
     v.extend(f.contacts.unwrap().iter().flat_map(|c| c.tangential_spring.map(f64::to_bits)));

@@ -52,11 +52,11 @@ fn hertz_mindlin_conserves_linear_and_angular_momentum_to_round_off() {
     let mut scene = common::parse(&FRICTIONAL_GAS.replace("mu_s = 0.5", "mu_s = 0.5\ngamma_nt = 50.0"));
     scene.track_orientation = false;
     let mut e: CpuEngine<f64> = common::engine(&scene);
-    let s0 = e.stats();
+    let s0 = e.stats().unwrap();
     let scale_p: f64 = e.bodies().iter().zip(&scene.grains.mass).map(|(b, m)| m * b.vel.norm()).sum();
     let scale_l: f64 = e.bodies().iter().zip(&scene.grains.mass).map(|(b, m)| m * b.vel.norm() * b.pos.norm()).sum();
     e.advance(3000).unwrap();
-    let s1 = e.stats();
+    let s1 = e.stats().unwrap();
     let dp: Vec3<f64> = Vec3::of(s1.momentum) - Vec3::of(s0.momentum);
     let dl: Vec3<f64> = Vec3::of(s1.angular_momentum) - Vec3::of(s0.angular_momentum);
     println!(

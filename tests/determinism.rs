@@ -52,7 +52,7 @@ fn trajectory_bits<T: Real>(threads: usize, steps: u64) -> (Vec<u64>, u64) {
     common::with_threads(threads, || {
         let mut e: CpuEngine<T> = common::engine(&scene);
         e.advance(steps).unwrap();
-        let s = e.stats();
+        let s = e.stats().unwrap();
         let mut bits: Vec<u64> = Vec::new();
         for b in e.bodies() {
             for v in [b.pos, b.vel, b.omega] {

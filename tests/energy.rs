@@ -29,7 +29,7 @@ fn fluctuation(scene: &Scene, integrator: Integrator, dt: f64) -> f64 {
     while done < steps {
         e.advance(every).unwrap();
         done += every;
-        energies.push(e.stats().mechanical_energy());
+        energies.push(e.stats().unwrap().mechanical_energy());
     }
     let n = energies.len() as f64;
     let mean = energies.iter().sum::<f64>() / n;

@@ -56,17 +56,17 @@ fn run(rebuild: bool) -> (Vec<[f64; 3]>, Record, Record, u64) {
     let (mut before, mut mid) = (None, None);
     for step in 0..2 * MID_CONTACT {
         if step == REBUILD_AT {
-            before = e.frame(true).contacts.unwrap().first().copied();
+            before = e.frame(true).unwrap().contacts.unwrap().first().copied();
             if rebuild {
                 e.rebuild().unwrap();
             }
         }
         e.step().unwrap();
         if step == MID_CONTACT {
-            mid = e.frame(true).contacts.unwrap().first().copied();
+            mid = e.frame(true).unwrap().contacts.unwrap().first().copied();
         }
     }
-    let rebuilds = e.stats().rebuilds;
+    let rebuilds = e.stats().unwrap().rebuilds;
     let state = e.bodies().iter().flat_map(|b| [b.pos.f64(), b.vel.f64(), b.omega.f64()]).collect();
     (state, before.expect("in contact at the rebuild"), mid.expect("in contact at mid-contact"), rebuilds)
 }

@@ -42,7 +42,7 @@ fn void_ratio_of_a_simple_cubic_lattice_is_6_over_pi_minus_1() {
     let (n, r) = (6, 5.0e-4);
     let scene = common::parse(&lattice(n, r));
     let e: CpuEngine<f64> = common::engine(&scene);
-    let frame = e.frame(false);
+    let frame = e.frame(false).unwrap();
     let volume = container_volume(&scene, 2.0 * r * SPACING * n as f64).unwrap();
     let got = void_ratio(solid_volume(&frame), volume);
     // Cube of side 2r per grain: e = (8 r^3 - 4/3 pi r^3) / (4/3 pi r^3) = 6/pi - 1.

@@ -28,7 +28,7 @@ fn collide(text: &str) -> (f64, Vec<f64>) {
     let mut overlaps = Vec::new();
     for _ in 0..1500 {
         e.step().unwrap();
-        overlaps.push(e.stats().max_overlap);
+        overlaps.push(e.stats().unwrap().max_overlap);
     }
     let b = e.bodies();
     (b[1].vel.x - b[0].vel.x, overlaps)
@@ -80,10 +80,10 @@ duration = 1.0e-3
 "#;
     let scene = common::parse(text);
     let mut e: CpuEngine<f64> = common::engine(&scene);
-    let s0 = e.stats();
+    let s0 = e.stats().unwrap();
     let scale: f64 = e.bodies().iter().zip(&scene.grains.mass).map(|(b, m)| m * b.vel.norm()).sum();
     e.advance(4000).unwrap();
-    let s1 = e.stats();
+    let s1 = e.stats().unwrap();
     let dp: Vec3<f64> = Vec3::of(s1.momentum) - Vec3::of(s0.momentum);
     println!("{} rebuilds, {} contacts, KE {:.3e} -> {:.3e} J, |dP| / sum|p| = {:.2e}", s1.rebuilds, s1.contacts, s0.kinetic_energy(), s1.kinetic_energy(), dp.norm() / scale);
     assert!(s1.kinetic_energy() < 0.9 * s0.kinetic_energy(), "inelastic collisions must have happened");

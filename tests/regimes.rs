@@ -99,7 +99,7 @@ fn roll(g: f64, v0: f64, duration: f64) -> Rolled {
             worst_late = worst_late.max(slip.max(speed));
         }
     }
-    Rolled { t_06: t_06.expect("slows below 0.6 v0"), t_02: t_02.expect("slows below 0.2 v0"), worst_late, stats: e.stats() }
+    Rolled { t_06: t_06.expect("slows below 0.6 v0"), t_02: t_02.expect("slows below 0.2 v0"), worst_late, stats: e.stats().unwrap() }
 }
 
 /// Rigid-body rolling deceleration of eqs. 8-9 on a sphere, g tan(theta_r) / (1 + I/(m R^2)).
@@ -192,10 +192,10 @@ fn largest_energy_rise(rolling_friction: &str) -> (f64, u64, u64) {
     let k_t = 0.3 * 2000.0;
     let mut e: CpuEngine<f64> = common::engine(&scene);
     let energy = |e: &mut CpuEngine<f64>| {
-        let s = e.stats();
+        let s = e.stats().unwrap();
         // The rolling spring has the static spring's stiffness.
         let norm2 = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>();
-        let springs: f64 = e.frame(true).contacts.unwrap().iter().map(|c| 0.5 * k_t * (norm2(c.tangential_spring) + norm2(c.rolling_spring))).sum();
+        let springs: f64 = e.frame(true).unwrap().contacts.unwrap().iter().map(|c| 0.5 * k_t * (norm2(c.tangential_spring) + norm2(c.rolling_spring))).sum();
         (s.kinetic_energy() + s.elastic_energy + springs, s)
     };
     let (e0, _) = energy(&mut e);

@@ -53,7 +53,7 @@ duration = 1.0e-3
     let (mut t_on, mut t_off) = (None, None);
     while t_off.is_none() && e.time() < 0.05 {
         e.step().unwrap();
-        let touching = e.stats().wall_contacts > 0;
+        let touching = e.stats().unwrap().wall_contacts > 0;
         if touching && t_on.is_none() {
             t_on = Some(e.time());
         }

@@ -129,7 +129,7 @@ fn run(scene: &Scene, integrator: Integrator, precision: &str, dt: f64, duration
     };
     let mut energy_error = None;
     if energy {
-        let e0 = engine.stats().mechanical_energy();
+        let e0 = engine.stats()?.mechanical_energy();
         let chunk = (steps / ENERGY_SAMPLES).max(1);
         let mut worst: f64 = 0.0;
         let mut done = 0;
@@ -137,13 +137,13 @@ fn run(scene: &Scene, integrator: Integrator, precision: &str, dt: f64, duration
             let k = chunk.min(steps - done);
             engine.advance(k)?;
             done += k;
-            worst = worst.max((engine.stats().mechanical_energy() - e0).abs() / e0.abs());
+            worst = worst.max((engine.stats()?.mechanical_energy() - e0).abs() / e0.abs());
         }
         energy_error = Some(worst);
     } else {
         engine.advance(steps)?;
     }
-    let frame = engine.frame(!energy);
+    let frame = engine.frame(!energy)?;
     Ok(RunEnd { frame, steps, seconds: started.elapsed().as_secs_f64(), energy_error })
 }
 

@@ -90,6 +90,12 @@ pub fn machine() -> Machine {
     Machine { cpu, cores: std::thread::available_parallelism().map_or(1, |n| n.get()), build_features, simd_level: format!("{:?}", crate::cpu::simd::level()), version: env!("CARGO_PKG_VERSION").to_string() }
 }
 
+/// Half the range of `repeats` over their `median` (%): the run-to-run noise.
+pub fn spread_percent(repeats: &[f64], median: f64) -> f64 {
+    let (lo, hi) = repeats.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+    50.0 * (hi - lo) / median
+}
+
 fn pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")
 }
@@ -211,7 +217,6 @@ impl BenchReport {
             s.push_str("\nsmall scenes (from their initial state; the GPU's dispatches per step include the rebuild kernels, empty on steps that keep the list)\n");
             s.push_str("scene                grains backend prec  steps/s  spread  dispatches/step\n");
             for r in &self.small {
-                let (lo, hi) = r.repeats.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &x| (lo.min(x), hi.max(x)));
                 s.push_str(&format!(
                     "{:<20} {:>6} {:<7} {:<4} {:>8.0} {:>6.1}% {:>16}\n",
                     r.scene,
@@ -219,7 +224,7 @@ impl BenchReport {
                     r.backend,
                     r.precision,
                     r.steps_per_second,
-                    50.0 * (hi - lo) / r.steps_per_second,
+                    spread_percent(&r.repeats, r.steps_per_second),
                     r.dispatches_per_step.map_or("-".to_string(), |d| format!("{d:.1}"))
                 ));
             }

@@ -38,14 +38,14 @@ pub fn oedometer_scenes() -> anyhow::Result<Vec<crate::scene::Scene>> {
 /// Times `repeats` runs of `steps` steps of `engine` after `warmup` untimed ones.
 pub fn measure(engine: &mut dyn Engine, scene: &str, warmup: u64, steps: u64, repeats: usize, dispatches: &dyn Fn(&dyn Engine) -> Option<u64>) -> anyhow::Result<SmallScene> {
     engine.advance(warmup)?;
-    engine.stats();
+    engine.stats()?;
     let mut rates = Vec::with_capacity(repeats);
     let mut per_step = None;
     for _ in 0..repeats {
         let before = dispatches(engine);
         let t = Instant::now();
         engine.advance(steps)?;
-        engine.stats();
+        engine.stats()?;
         rates.push(steps as f64 / t.elapsed().as_secs_f64());
         per_step = before.zip(dispatches(engine)).map(|(a, b)| (b - a) as f64 / steps as f64);
     }

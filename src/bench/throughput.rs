@@ -64,8 +64,7 @@ pub struct Throughput {
 impl Throughput {
     /// Half the range of the repeats over their median (%): the run-to-run noise.
     pub fn spread_percent(&self) -> f64 {
-        let (lo, hi) = self.repeats.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| (lo.min(r), hi.max(r)));
-        50.0 * (hi - lo) / self.particle_steps_per_second
+        super::spread_percent(&self.repeats, self.particle_steps_per_second)
     }
 }
 
@@ -74,7 +73,7 @@ impl Throughput {
 /// memory was reset before the engine was built.
 pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u64, steps: u64, repeats: usize, peak_reset: bool) -> anyhow::Result<Throughput> {
     engine.advance(warmup)?;
-    let before = engine.stats();
+    let before = engine.stats()?;
     engine.set_profiling(true);
     let mut seconds_each = Vec::with_capacity(repeats);
     let mut after = before.clone();
@@ -82,7 +81,7 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u6
         let started = Instant::now();
         engine.advance(steps)?;
         // The GPU queues work: the statistics' read-back waits for it.
-        after = engine.stats();
+        after = engine.stats()?;
         seconds_each.push(started.elapsed().as_secs_f64());
     }
     engine.set_profiling(false);

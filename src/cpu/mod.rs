@@ -30,7 +30,7 @@ pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::engine::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
-use crate::model::{normal_potential, rupture_distance, share_liquid, CohesionLaw, ContactForce, ContactModel, PairCoeffs, Regime};
+use crate::model::{capillary_potential, normal_potential, rupture_distance, share_liquid, CohesionLaw, ContactForce, ContactModel, PairCoeffs, Regime};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 use crate::schedule::{Op, Schedule, Trace};
@@ -596,16 +596,16 @@ impl<T: Real> Engine for CpuEngine<T> {
         Ok(())
     }
 
-    fn stats(&mut self) -> Stats {
-        self.statistics()
+    fn stats(&mut self) -> Result<Stats, SimError> {
+        Ok(self.statistics())
     }
 
-    fn frame(&self, contacts: bool) -> Frame {
-        self.snapshot(contacts)
+    fn frame(&self, contacts: bool) -> Result<Frame, SimError> {
+        Ok(self.snapshot(contacts))
     }
 
-    fn save(&self) -> Option<EngineState> {
-        Some(self.save_state())
+    fn save(&self) -> Result<EngineState, SimError> {
+        Ok(self.save_state())
     }
 
     fn restore(&mut self, s: &EngineState) -> anyhow::Result<()> {

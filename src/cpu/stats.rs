@@ -171,13 +171,19 @@ impl<T: Real> CpuEngine<T> {
             }
         });
         let piston_ke = self.piston.map_or(0.0, |p| 0.5 * p.mass.f64() * self.walls[p.wall].velocity.z.f64().powi(2));
-        let (bridges, liquid_in_bridges) = if self.slots.layout.bridge {
-            let (stride, b) = (self.slots.stride, self.slots.bridge);
-            chunked(self.pairs.len(), |r| r.map(|k| self.hist[k * stride + b].f64()).filter(|v| *v > 0.0).fold((0u64, 0.0), |(n, s), v| (n + 1, s + v)))
-                .into_iter()
-                .fold((0, 0.0), |(n, s), (m, t)| (n + m, s + t))
-        } else {
-            (0, 0.0)
+        let (bridges, liquid_in_bridges, capillary_energy) = match self.model.cohesion {
+            CohesionLaw::Capillary { kappa, theta, c } => {
+                let (stride, b) = (self.slots.stride, self.slots.bridge);
+                let bridge = |k: usize| {
+                    let v = self.hist[k * stride + b];
+                    let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+                    (v, capillary_potential(kappa, theta, c, self.prop[i].radius, self.prop[j].radius, v, self.gap(k)))
+                };
+                chunked(self.pairs.len(), |r| r.map(bridge).filter(|(v, _)| *v > T::ZERO).fold((0u64, 0.0, 0.0), |(n, s, u), (v, e)| (n + 1, s + v.f64(), u + e.f64())))
+                    .into_iter()
+                    .fold((0, 0.0, 0.0), |(n, s, u), (m, t, e)| (n + m, s + t, u + e))
+            }
+            CohesionLaw::None => (0, 0.0, 0.0),
         };
         let liquid_on_grains: f64 = chunked(self.liquid.len(), |r| self.liquid[r].iter().map(|x| x.f64()).sum::<f64>()).into_iter().sum();
         Stats {
@@ -186,6 +192,7 @@ impl<T: Real> CpuEngine<T> {
             ke_translational: gs.ke_t,
             ke_rotational: gs.ke_r,
             elastic_energy: ps.elastic + gs.wall_elastic,
+            capillary_energy,
             gravity_energy: gs.pe_g,
             piston_ke,
             external_work: self.external_work,

@@ -564,11 +564,11 @@ impl Engine for GpuEngine {
 
 
 
-    fn stats(&mut self) -> Stats {
+    fn stats(&mut self) -> Result<Stats, SimError> {
         self.statistics()
     }
 
-    fn frame(&self, contacts: bool) -> Frame {
+    fn frame(&self, contacts: bool) -> Result<Frame, SimError> {
         self.snapshot(contacts)
     }
 
@@ -576,7 +576,7 @@ impl Engine for GpuEngine {
         self.wet_pairs(volume)
     }
 
-    fn save(&self) -> Option<crate::engine::EngineState> {
+    fn save(&self) -> Result<crate::engine::EngineState, SimError> {
         self.save_state()
     }
 

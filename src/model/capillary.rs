@@ -38,6 +38,27 @@ pub fn capillary_force<T: Real>(kappa: T, theta: T, c: T, r_i: T, r_j: T, v_b: T
     }
 }
 
+/// The potential energy (J, zero at rupture, negative while the bridge pulls) of the bridge
+/// of [`capillary_force`] at gap `delta` (m): `U(delta) = int_delta^delta_max f ds`, so that
+/// `f = -dU/d(delta)`: `f0 lambda (e^(-delta/lambda) - e^(-delta_max/lambda))` across the gap,
+/// plus `-f0 delta` in contact (`delta < 0`). A bridge that forms lowers it at once (the
+/// liquid's own energy is not counted); one that ruptures leaves it continuous.
+#[inline(always)]
+pub fn capillary_potential<T: Real>(kappa: T, theta: T, c: T, r_i: T, r_j: T, v_b: T, delta: T) -> T {
+    let delta_max = rupture_distance(theta, v_b);
+    if v_b <= T::ZERO || delta > delta_max {
+        return T::ZERO;
+    }
+    let f0 = -kappa * (r_i * r_j).sqrt();
+    let lambda = decay_length(c, r_i, r_j, v_b);
+    let tail = (-(delta_max / lambda)).exp();
+    if delta < T::ZERO {
+        f0 * lambda * (T::ONE - tail) - f0 * delta
+    } else {
+        f0 * lambda * ((-(delta / lambda)).exp() - tail)
+    }
+}
+
 /// How a volume of liquid (m^3) wets a sample: pairs within their rupture distance share it
 /// in proportion to their reduced diameter `d` (m), each share capped at `cap` (m^3); pairs
 /// beyond the rupture distance of their share drop out and raise the others' shares, until

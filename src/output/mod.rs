@@ -192,7 +192,8 @@ impl Recorder for RunRecorder {
         Ok(())
     }
     fn checkpoint(&mut self, progress: &Progress, engine: &dyn Engine) -> anyhow::Result<()> {
-        let (Some((path, identity)), Some(state)) = (&self.checkpoint, engine.save()) else { return Ok(()) };
+        let Some((path, identity)) = &self.checkpoint else { return Ok(()) };
+        let state = engine.save()?;
         let files = [&mut self.stats, &mut self.stages].into_iter().flatten().map(Csv::flushed_length).collect::<anyhow::Result<_>>()?;
         let header = CheckpointHeader { identity: identity.clone(), progress: progress.clone(), files };
         crate::checkpoint::write(path, &header, &state)

@@ -70,9 +70,9 @@ pub struct Summary {
 
 impl Summary {
     /// Summarises a finished run.
-    pub fn new(scene: &Scene, engine: &dyn Engine, threads: usize, wall_seconds: f64, stages: Vec<StageResult>) -> Self {
+    pub fn new(scene: &Scene, engine: &dyn Engine, threads: usize, wall_seconds: f64, stages: Vec<StageResult>) -> Result<Self, crate::engine::SimError> {
         let last = stages.last().map(|s| &s.stats);
-        let frame = engine.frame(false);
+        let frame = engine.frame(false)?;
         let piston_z = last.and_then(|s| s.piston.as_ref().map(|p| p.z));
         let compression: Vec<CompressionPoint> = stages.iter().filter_map(|s| s.compression.clone()).collect();
         // Bauer's e0: the void ratio under the seating load when there is one, else with the
@@ -87,7 +87,7 @@ impl Summary {
         let bauer_free = if enough { fit_bauer(&data, None, 1.0).ok() } else { None };
         let reach = e0_top.into_iter().chain(e0).chain(bauer_free.map(|b| b.e0.value)).fold(0.0, f64::max);
         let bauer_profile = enough.then(|| e0_profile(&data, &profile_e0s(&data, reach, PROFILE_POINTS), 1.0));
-        Summary {
+        Ok(Summary {
             scene: scene.name.clone(),
             file: scene.path.display().to_string(),
             backend: engine.backend(),
@@ -113,7 +113,7 @@ impl Summary {
             bauer_profile,
             stages,
             warnings: scene.warnings.clone(),
-        }
+        })
     }
 
     /// The compression points as CSV (the input of `grains fit bauer`).

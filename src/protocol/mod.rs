@@ -146,21 +146,21 @@ impl CheckpointClock {
 
 impl Progress {
     /// The start of a run on a freshly set-up engine.
-    pub fn start(scene: &Scene, engine: &mut dyn Engine) -> Self {
-        let stats = engine.stats();
-        Progress {
+    pub fn start(scene: &Scene, engine: &mut dyn Engine) -> Result<Self, SimError> {
+        let stats = engine.stats()?;
+        Ok(Progress {
             next_stage: 0,
             results: Vec::new(),
             guard: Guard::new(scene, &stats),
             next_frame: (scene.output.frame_interval > 0.0).then(|| engine.time()),
             in_stage: None,
-        }
+        })
     }
 }
 
 /// Runs every stage of `scene` on `engine`.
 pub fn run(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn Recorder) -> anyhow::Result<Vec<StageResult>> {
-    let progress = Progress::start(scene, engine);
+    let progress = Progress::start(scene, engine)?;
     run_from(scene, engine, rec, progress)
 }
 
@@ -194,7 +194,7 @@ fn start_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine) -> anyhow:
     }
     let mut initial_void_ratio = None;
     if stage.lower_piston {
-        let f = engine.frame(false);
+        let f = engine.frame(false)?;
         let top = (0..f.radius.len()).map(|i| f.position[i][2] + f.radius[i]).fold(f64::NEG_INFINITY, f64::max);
         engine.place_piston(top);
         initial_void_ratio = container_volume(scene, top).map(|v| void_ratio(solid_volume(&f), v));
@@ -217,17 +217,17 @@ fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dy
     let n = engine.grain_count() as f64;
     let settles = stage.kind != StageKind::Run;
     let mut settled = false;
-    let mut stats = engine.stats();
+    let mut stats = engine.stats()?;
     while done < total {
         let chunk = k.min(total - done);
         engine.advance(chunk)?;
         done += chunk;
-        stats = engine.stats();
+        stats = engine.stats()?;
         guard.check(&stats)?;
         rec.stats(&stage.name, &stats)?;
         rec.progress(&stage.name, done, total);
         if let Some(t) = progress.next_frame.as_mut().filter(|t| engine.time() >= **t) {
-            rec.frame(&engine.frame(scene.output.contact_forces))?;
+            rec.frame(&engine.frame(scene.output.contact_forces)?)?;
             *t += scene.output.frame_interval;
         }
         let pressure_reached = match (stage.piston_pressure, &stats.piston) {
@@ -255,9 +255,9 @@ fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dy
         }
     }
     if progress.next_frame.is_none() {
-        rec.frame(&engine.frame(scene.output.contact_forces))?;
+        rec.frame(&engine.frame(scene.output.contact_forces)?)?;
     }
-    let compression = if stage.records_compression { Some(CompressionPoint { seating: stage.seating, ..compression_point(scene, engine, &stats, settled) }) } else { None };
+    let compression = if stage.records_compression { Some(CompressionPoint { seating: stage.seating, ..compression_point(scene, engine, &stats, settled)? }) } else { None };
     let result = StageResult {
         name: stage.name.clone(),
         kind: match stage.kind {
@@ -281,9 +281,9 @@ fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dy
 }
 
 /// Measures the sample at the end of a pressure step.
-fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, settled: bool) -> CompressionPoint {
+fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, settled: bool) -> Result<CompressionPoint, SimError> {
     let piston = stats.piston.clone().unwrap_or_default();
-    let frame = engine.frame(true);
+    let frame = engine.frame(true)?;
     let volume = container_volume(scene, piston.z).unwrap_or(f64::NAN);
     let moments = contact_moments(&frame, &Periodic::of(&scene.periodic));
     let mut stress = macroscopic_stress(&moments, volume);
@@ -292,7 +292,7 @@ fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, sett
             *x = -*x;
         }
     }
-    CompressionPoint {
+    Ok(CompressionPoint {
         target_pressure: piston.target_pressure,
         pressure: piston.pressure,
         piston_z: piston.z,
@@ -303,7 +303,7 @@ fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, sett
         stress,
         settled,
         seating: false,
-    }
+    })
 }
 
 /// The stability checks made at every statistics read.

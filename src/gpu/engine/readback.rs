@@ -13,10 +13,15 @@ fn servo_pressure(walls: &[layout::Wall], reaction: &[[f32; 4]], planes: [usize;
     -(0..3).map(|c| r[c] as f64 * n[c] as f64).sum::<f64>() / area
 }
 
+/// Force (N) and torque (N m) on one grain.
+pub type GrainLoad = ([f32; 3], [f32; 3]);
+
 impl GpuEngine {
     /// Copies buffers out: `(buffer, offset, bytes)` each, returned in order as 4-byte words
-    /// (every type the kernels share is 4-byte aligned).
-    pub(super) fn read(&self, parts: &[(&str, u64, u64)]) -> Vec<Vec<u32>> {
+    /// (every type the kernels share is 4-byte aligned); a device that fails to answer is a
+    /// [`SimError::Device`] naming the buffers.
+    pub(super) fn read(&self, parts: &[(&str, u64, u64)]) -> Result<Vec<Vec<u32>>, SimError> {
+        let failed = |reason: String| SimError::Device { what: parts.iter().map(|p| p.0).collect::<Vec<_>>().join(", "), reason };
         let total: u64 = parts.iter().map(|p| p.2.next_multiple_of(4)).sum();
         let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -31,27 +36,33 @@ impl GpuEngine {
             at += bytes.next_multiple_of(4);
         }
         self.gpu.queue.submit([encoder.finish()]);
-        staging.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping a readback buffer"));
-        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).expect("the GPU finishes");
-        let view = staging.slice(..).get_mapped_range().expect("a mapped readback buffer");
+        let (sent, mapped) = std::sync::mpsc::channel();
+        staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+            // The receiver waits below; a send fails only if it is gone, and then nobody asks.
+            sent.send(r).ok();
+        });
+        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| failed(e.to_string()))?;
+        mapped.recv().map_err(|e| failed(e.to_string()))?.map_err(|e| failed(e.to_string()))?;
+        let view = staging.slice(..).get_mapped_range().map_err(|e| failed(e.to_string()))?;
         let mut out = Vec::new();
         let mut at = 0usize;
         for &(_, _, bytes) in parts {
             out.push(bytemuck::pod_collect_to_vec(&view[at..at + bytes as usize]));
             at += bytes.next_multiple_of(4) as usize;
         }
-        out
+        Ok(out)
     }
 
-    pub(super) fn read_control(&mut self) -> Control {
-        let c = self.read(&[("control", 0, std::mem::size_of::<Control>() as u64)]);
+    /// Reads the control flags and counters back (and keeps them).
+    pub(super) fn read_control(&mut self) -> Result<Control, SimError> {
+        let c = self.read(&[("control", 0, std::mem::size_of::<Control>() as u64)])?;
         self.control = *bytemuck::from_bytes(bytemuck::cast_slice(&c[0]));
-        self.control
+        Ok(self.control)
     }
 
     /// Checks the flags the last steps raised, and grows the pair buffers when they fill up.
     pub(super) fn check(&mut self) -> Result<(), SimError> {
-        let c = self.read_control();
+        let c = self.read_control()?;
         if c.overflow_grain != NONE {
             return Err(SimError::Capacity { step: self.step, grain: c.overflow_grain, count: c.overflow_count as usize, capacity: self.params.max_neighbours as usize });
         }
@@ -81,38 +92,54 @@ impl GpuEngine {
     }
 
     /// The pair list (CSR: starts per grain, partners), read back.
-    pub fn pair_list(&mut self) -> (Vec<u32>, Vec<u32>) {
-        let n_pairs = self.read_control().n_pairs as u64;
-        let parts = self.read(&[("pair_start", 0, 4 * (self.n as u64 + 1)), ("pair_j", 0, 4 * n_pairs)]);
-        (parts[0].clone(), parts[1].clone())
+    pub fn pair_list(&mut self) -> Result<(Vec<u32>, Vec<u32>), SimError> {
+        let n_pairs = self.read_control()?.n_pairs as u64;
+        let parts = self.read(&[("pair_start", 0, 4 * (self.n as u64 + 1)), ("pair_j", 0, 4 * n_pairs)])?;
+        Ok((parts[0].clone(), parts[1].clone()))
     }
 
     /// Force and torque on each grain from the last force evaluation (N, N m), read back.
-    pub fn loads(&self) -> Vec<([f32; 3], [f32; 3])> {
-        let a = self.read_vec4s(&["force", "torque"]);
-        a[0].iter().zip(&a[1]).map(|(f, t)| ([f[0], f[1], f[2]], [t[0], t[1], t[2]])).collect()
+    pub fn loads(&self) -> Result<Vec<GrainLoad>, SimError> {
+        let a = self.read_vec4s(&["force", "torque"])?;
+        Ok(a[0].iter().zip(&a[1]).map(|(f, t)| ([f[0], f[1], f[2]], [t[0], t[1], t[2]])).collect())
     }
 
     /// Liquid bridges among the first `n_pairs` pairs, the liquid they hold and the liquid
-    /// waiting on the grains (m^3), read back.
-    pub(super) fn liquid_sums(&self, n_pairs: u64) -> (u64, f64, f64) {
+    /// waiting on the grains (m^3), and the bridges' potential energy (J, the CPU twin's law
+    /// in f32 on the host), read back.
+    pub(super) fn liquid_sums(&self, n_pairs: u64) -> Result<(u64, f64, f64, f64), SimError> {
+        use crate::real::Vec3;
+        let crate::model::CohesionLaw::Capillary { kappa, theta, c } = self.model.cohesion else { return Ok((0, 0.0, 0.0, 0.0)) };
         let blocks = self.params.hist_blocks as usize;
-        let parts = self.read(&[("hist", 0, 16 * n_pairs * blocks as u64), ("liquid", 0, 4 * self.n as u64)]);
+        let n = self.n as u64;
+        let parts = self.read(&[("hist", 0, 16 * n_pairs * blocks as u64), ("liquid", 0, 4 * n), ("pos", 0, 16 * n), ("pair_i", 0, 4 * n_pairs), ("pair_j", 0, 4 * n_pairs)])?;
         let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
         let liquid: &[f32] = bytemuck::cast_slice(&parts[1]);
-        let volumes = hist.iter().skip(blocks - 1).step_by(blocks).map(|b| b[0]).filter(|&v| v > 0.0);
-        let (bridges, held) = volumes.fold((0, 0.0), |(n, s), v| (n + 1, s + v as f64));
-        (bridges, held, liquid.iter().map(|&l| l as f64).sum())
+        let pos: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
+        let (pi, pj) = (&parts[3], &parts[4]);
+        let v3 = |p: &[f32; 4]| Vec3::new(p[0], p[1], p[2]);
+        let (mut bridges, mut held, mut energy) = (0u64, 0.0f64, 0.0f64);
+        for k in 0..n_pairs as usize {
+            let v = hist[k * blocks + blocks - 1][0];
+            if v > 0.0 {
+                let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
+                let gap = self.periodic.min_image(v3(a) - v3(b)).norm() - a[3] - b[3];
+                bridges += 1;
+                held += v as f64;
+                energy += crate::model::capillary_potential(kappa, theta, c, a[3], b[3], v, gap) as f64;
+            }
+        }
+        Ok((bridges, held, liquid.iter().map(|&l| l as f64).sum(), energy))
     }
 
     /// Reads grain arrays back (vec4 per grain).
-    pub(super) fn read_vec4s(&self, names: &[&str]) -> Vec<Vec<[f32; 4]>> {
+    pub(super) fn read_vec4s(&self, names: &[&str]) -> Result<Vec<Vec<[f32; 4]>>, SimError> {
         let parts: Vec<(&str, u64, u64)> = names.iter().map(|n| (*n, 0, 16 * self.n as u64)).collect();
-        self.read(&parts).into_iter().map(|b| bytemuck::cast_slice(&b).to_vec()).collect()
+        Ok(self.read(&parts)?.into_iter().map(|b| bytemuck::cast_slice(&b).to_vec()).collect())
     }
 
     /// The statistics of the current state (loads evaluated first if nothing has).
-    pub(super) fn statistics(&mut self) -> Stats {
+    pub(super) fn statistics(&mut self) -> Result<Stats, SimError> {
         self.ensure_loads();
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
@@ -129,7 +156,7 @@ impl GpuEngine {
             ("wall_reaction", 0, MAX_WALLS as u64 * 16),
             ("walls", 0, (n_walls.max(1) * std::mem::size_of::<layout::Wall>()) as u64),
             ("servo", 0, std::mem::size_of::<layout::Servo>() as u64),
-        ]);
+        ])?;
         let control: Control = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[0]));
         let servo: layout::Servo = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[4]));
         self.control = control;
@@ -154,7 +181,7 @@ impl GpuEngine {
             let (pv, pi) = (p(STAT_ROW - 2), s[2 * STAT_ROW - 1].to_bits());
             if gv > pv || (gv == pv && gi < pi) { (gv, gi) } else { (pv, pi) }
         };
-        let (bridges, liquid_in_bridges, liquid_on_grains) = if self.history.bridge { self.liquid_sums(control.n_pairs as u64) } else { (0, 0.0, 0.0) };
+        let (bridges, liquid_in_bridges, liquid_on_grains, capillary_energy) = self.liquid_sums(control.n_pairs as u64)?;
         let piston = self.piston.map(|w| {
             let wall = &walls[w];
             PistonStats {
@@ -164,12 +191,13 @@ impl GpuEngine {
                 pressure: reaction[w][2] as f64 / wall.piston[1] as f64,
             }
         });
-        Stats {
+        Ok(Stats {
             step: self.step,
             time: self.time,
             ke_translational: g(gr::KE_T),
             ke_rotational: g(gr::KE_R),
             elastic_energy: p(pr::ELASTIC) + g(gr::WALL_ELASTIC),
+            capillary_energy,
             gravity_energy: g(gr::PE_G),
             piston_ke: self.piston.map_or(0.0, |w| 0.5 * walls[w].piston[0] as f64 * (walls[w].velocity[2] as f64).powi(2)),
             external_work: self.piston.map_or(0.0, |w| walls[w].piston[3] as f64) + servo.work as f64 + servo.work_lo as f64,
@@ -206,6 +234,6 @@ impl GpuEngine {
                 })
                 .collect(),
             piston,
-        }
+        })
     }
 }

@@ -33,7 +33,7 @@ fn cpu_history(blocks: &[[f32; 4]], slots: &crate::cpu::HistorySlots) -> Vec<f32
 impl GpuEngine {
     /// Grain-wall contacts re-evaluated on the host from the GPU's state (the CPU twin's
     /// function in f32), given the grain arrays `[pos, vel, omega, ..]` already read.
-    pub(super) fn wall_contact_records(&self, arrays: &[Vec<[f32; 4]>]) -> Vec<crate::engine::WallContactRecord> {
+    pub(super) fn wall_contact_records(&self, arrays: &[Vec<[f32; 4]>]) -> Result<Vec<crate::engine::WallContactRecord>, SimError> {
         use crate::cpu::{wall_contact_records, Body, ForceContext, HistorySlots, Props, WallState};
         use crate::real::Vec3;
         let n_walls = self.wall_names.len();
@@ -42,7 +42,7 @@ impl GpuEngine {
             ("material", 0, 4 * self.n as u64),
             ("walls", 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64),
             ("wall_hist", 0, if blocks > 0 { 16 * (self.n as usize * n_walls * blocks) as u64 } else { 0 }),
-        ]);
+        ])?;
         let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[1]);
         let gpu_hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
         let v3 = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
@@ -70,22 +70,22 @@ impl GpuEngine {
             elapsed: 0.0,
             periodic: crate::periodic::Periodic::default(),
         };
-        wall_contact_records(&body, &prop, &(0..self.n).collect::<Vec<u32>>(), &states, &ctx, &hist)
+        Ok(wall_contact_records(&body, &prop, &(0..self.n).collect::<Vec<u32>>(), &states, &ctx, &hist))
     }
 
     /// The grain state, and the touching pairs and wall contacts with their forces when
     /// `contacts`.
-    pub(super) fn snapshot(&self, contacts: bool) -> Frame {
+    pub(super) fn snapshot(&self, contacts: bool) -> Result<Frame, SimError> {
         let mut names = vec!["pos", "vel", "omega"];
         if self.track_orientation {
             names.push("quat");
         }
-        let arrays = self.read_vec4s(&names);
+        let arrays = self.read_vec4s(&names)?;
         let xyz = |v: &[f32; 4]| [v[0] as f64, v[1] as f64, v[2] as f64];
-        let contact_records = contacts.then(|| {
+        let contact_records = contacts.then(|| -> Result<Vec<ContactRecord>, SimError> {
             let np = self.control.n_pairs as u64;
             let blocks = self.params.hist_blocks as u64;
-            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, 16 * np), ("hist", 0, 16 * np * blocks), ("out_tj", 0, 16 * np)]);
+            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, 16 * np), ("hist", 0, 16 * np * blocks), ("out_tj", 0, 16 * np)])?;
             let (pi, pj): (&[u32], &[u32]) = (&parts[0], &parts[1]);
             let fi: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
             let fj: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
@@ -93,7 +93,7 @@ impl GpuEngine {
             // out_tj.w: the capillary force.
             let f_c: Vec<f32> = bytemuck::cast_slice::<u32, [f32; 4]>(&parts[5]).iter().map(|t| t[3]).collect();
             let pos = &arrays[0];
-            (0..np as usize)
+            Ok((0..np as usize)
                 .filter_map(|k| {
                     let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
                     let d = [(a[0] - b[0]) as f64, (a[1] - b[1]) as f64, (a[2] - b[2]) as f64];
@@ -115,10 +115,17 @@ impl GpuEngine {
                         rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + self.history.tangential as usize]) } else { [0.0; 3] },
                     })
                 })
-                .collect()
+                .collect())
         });
-        let wall_records = (contacts && self.has_walls).then(|| self.wall_contact_records(&arrays)).or(contacts.then(Vec::new));
-        Frame {
+        let contact_records = contact_records.transpose()?;
+        let wall_records = if !contacts {
+            None
+        } else if self.has_walls {
+            Some(self.wall_contact_records(&arrays)?)
+        } else {
+            Some(Vec::new())
+        };
+        Ok(Frame {
             time: self.time,
             id: (0..self.n).collect(),
             position: arrays[0].iter().map(xyz).collect(),
@@ -128,7 +135,7 @@ impl GpuEngine {
             orientation: self.track_orientation.then(|| arrays[3].iter().map(|q| [q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]).collect()),
             contacts: contact_records,
             wall_contacts: wall_records,
-        }
+        })
     }
 
     /// Wets the sample with `volume` (m^3) of liquid, as the CPU twin does.
@@ -139,8 +146,8 @@ impl GpuEngine {
         };
         // The liquid goes to the pairs of the current list.
         self.ensure_loads();
-        let (n, np, blocks) = (self.n as u64, self.read_control().n_pairs as u64, self.params.hist_blocks as u64);
-        let parts = self.read(&[("pos", 0, 16 * n), ("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("hist", 0, 16 * np * blocks), ("liquid", 0, 4 * n)]);
+        let (n, np, blocks) = (self.n as u64, self.read_control()?.n_pairs as u64, self.params.hist_blocks as u64);
+        let parts = self.read(&[("pos", 0, 16 * n), ("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("hist", 0, 16 * np * blocks), ("liquid", 0, 4 * n)])?;
         let pos: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
         let (pi, pj) = (&parts[1], &parts[2]);
         let mut hist: Vec<[f32; 4]> = bytemuck::cast_slice(&parts[3]).to_vec();
@@ -171,20 +178,20 @@ impl GpuEngine {
     }
 
     /// The whole state, for a checkpoint: every buffer but constants and scratch, bit for bit.
-    pub(super) fn save_state(&self) -> Option<crate::engine::EngineState> {
+    pub(super) fn save_state(&self) -> Result<crate::engine::EngineState, SimError> {
         let mut s = crate::engine::EngineState::default();
         let n_pairs = self.control.n_pairs as u64;
         let per_pair: HashMap<&str, u64> = self.pair_buffers().into_iter().collect();
         let mut names: Vec<&'static str> = self.buffers.keys().copied().filter(|name| !NOT_STATE.contains(name)).collect();
         names.sort_unstable();
         let parts: Vec<(&str, u64, u64)> = names.iter().map(|&name| (name, 0, per_pair.get(name).map_or(self.buffers[name].size(), |b| b * n_pairs))).collect();
-        for (name, words) in names.iter().zip(self.read(&parts)) {
+        for (name, words) in names.iter().zip(self.read(&parts)?) {
             // Two 4-byte words per stored integer, the first in the low half.
             s.put_ints(&format!("gpu:{name}"), words.chunks(2).map(|c| c[0] as u64 | (c.get(1).copied().unwrap_or(0) as u64) << 32));
         }
         s.put_ints("counters", [self.step, self.forces_valid as u64, self.params.pair_capacity as u64]);
         s.put_reals("time", [self.time]);
-        Some(s)
+        Ok(s)
     }
 
     /// Restores what [`Self::save_state`] returned, for the same scene.
@@ -206,7 +213,7 @@ impl GpuEngine {
         }
         (self.step, self.forces_valid) = (counters[0], counters[1] != 0);
         self.time = s.reals("time", 1)?[0];
-        self.read_control();
+        self.read_control()?;
         Ok(())
     }
 }
