@@ -3,6 +3,7 @@
 pub mod fit;
 pub mod network;
 pub mod seed000;
+pub mod tail;
 
 use crate::engine::Frame;
 use crate::periodic::Periodic;

@@ -2,6 +2,7 @@
 //! tails, bonds counted by sign, particle stresses and pressures, the macroscopic stress, the
 //! bi-percolation of the positive- and negative-pressure phases, and the fabric anisotropy.
 
+use super::tail::{fit_tail, TailFit};
 use super::{contact_moments, Tensor};
 use crate::engine::Frame;
 use crate::periodic::Periodic;
@@ -10,6 +11,11 @@ use serde::Serialize;
 
 /// Histogram bins of the force and pressure PDFs.
 pub const PDF_BINS: usize = 40;
+/// Where the dry force tail starts (over the mean force), and the other starts its
+/// sensitivity is reported at.
+pub const DRY_TAIL_FROM: (f64, [f64; 3]) = (1.0, [0.5, 1.5, 2.0]);
+/// Where the wet force tails start (over f0, on each side of zero), and the other starts.
+pub const WET_TAIL_FROM: (f64, [f64; 3]) = (0.0, [0.1, 0.2, 0.3]);
 
 /// A probability density on regular bins.
 #[derive(Clone, Debug, Default, Serialize)]
@@ -32,20 +38,6 @@ impl Pdf {
         }
         let n = values.len().max(1) as f64;
         Pdf { x: (0..bins).map(|k| lo + (k as f64 + 0.5) * w).collect(), p: counts.iter().map(|&c| c as f64 / (n * w)).collect() }
-    }
-
-    /// The decay rate `a` of `P ~ exp(-a |x|)` fitted by least squares on `ln P` over the bins
-    /// with `from <= |x|` (and density), on the side `sign` (+1 or -1) of zero.
-    pub fn exponential_tail(&self, from: f64, sign: f64) -> Option<f64> {
-        let pts: Vec<(f64, f64)> = self.x.iter().zip(&self.p).filter(|(x, p)| **p > 0.0 && x.signum() == sign && x.abs() >= from).map(|(x, p)| (x.abs(), p.ln())).collect();
-        if pts.len() < 3 {
-            return None;
-        }
-        let n = pts.len() as f64;
-        let (mx, my) = (pts.iter().map(|q| q.0).sum::<f64>() / n, pts.iter().map(|q| q.1).sum::<f64>() / n);
-        let sxx: f64 = pts.iter().map(|q| (q.0 - mx).powi(2)).sum();
-        let sxy: f64 = pts.iter().map(|q| (q.0 - mx) * (q.1 - my)).sum();
-        Some(-sxy / sxx)
     }
 }
 
@@ -88,10 +80,11 @@ pub struct NetworkAnalysis {
     pub force_scale_is: String,
     /// PDF of the normal forces over the force scale.
     pub force_pdf: Pdf,
-    /// Dry: `beta` of `exp(-beta f/<f>)` above the mean. Wet: `alpha_w` of the compressive side.
-    pub tail_compressive: Option<f64>,
-    /// Wet: `alpha_w` of the tensile side.
-    pub tail_tensile: Option<f64>,
+    /// Dry: `beta` of `exp(-beta f/<f>)` above the mean. Wet: `alpha_w` of the compressive side
+    /// from zero. Maximum likelihood, with its error.
+    pub tail_compressive: Option<TailFit>,
+    /// Wet: `alpha_w` of the tensile side (bounded by f0).
+    pub tail_tensile: Option<TailFit>,
     /// Fraction of compressive forces below their mean.
     pub below_mean: f64,
     /// Bonds per grain.
@@ -102,8 +95,16 @@ pub struct NetworkAnalysis {
     pub macroscopic_stress: Tensor,
     /// Mean particle pressure over the sample (Pa, compression positive).
     pub mean_pressure: f64,
-    /// PDF of the particle pressures over their mean absolute value.
+    /// The pressure scale `p0 = f0 / <d>^2` (wet; the force scale over `<d>^2` when dry) (Pa).
+    pub pressure_scale: f64,
+    /// PDF of the particle pressures over `p0`.
     pub pressure_pdf: Pdf,
+    /// PDF of the particle pressures over their mean absolute value (the earlier view).
+    pub pressure_pdf_mean_abs: Pdf,
+    /// Exponential tails of the pressures over `p0`, from zero: positive side.
+    pub pressure_tail_positive: Option<TailFit>,
+    /// Negative side.
+    pub pressure_tail_negative: Option<TailFit>,
     /// Grains of positive and of negative pressure as two phases over the bond network.
     pub positive_phase: Percolation,
     /// The negative-pressure phase.
@@ -138,8 +139,9 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
     let lo = normalised.iter().copied().fold(0.0, f64::min);
     let force_pdf = Pdf::of(&normalised, lo, hi, PDF_BINS);
     let (tail_compressive, tail_tensile) = match f0 {
-        Some(_) => (force_pdf.exponential_tail(0.0, 1.0), force_pdf.exponential_tail(0.0, -1.0)),
-        None => (force_pdf.exponential_tail(1.0, 1.0), None),
+        // Tensile forces never exceed f0: that side is bounded at 1.
+        Some(_) => (fit_tail(&normalised, 1.0, WET_TAIL_FROM.0, None, &WET_TAIL_FROM.1), fit_tail(&normalised, -1.0, WET_TAIL_FROM.0, Some(1.0), &WET_TAIL_FROM.1)),
+        None => (fit_tail(&normalised, 1.0, DRY_TAIL_FROM.0, None, &DRY_TAIL_FROM.1), None),
     };
     let below_mean = compressive.iter().filter(|f| **f < mean_c).count() as f64 / compressive.len().max(1) as f64;
 
@@ -182,9 +184,15 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
         }
     }
     let mean_pressure = (macro_stress[0][0] + macro_stress[1][1] + macro_stress[2][2]) / 3.0;
-    let p_scale = pressures.iter().map(|p| p.abs()).sum::<f64>() / n.max(1) as f64;
-    let p_norm: Vec<f64> = pressures.iter().map(|p| p / p_scale.max(1e-300)).collect();
-    let pressure_pdf = Pdf::of(&p_norm, p_norm.iter().copied().fold(0.0, f64::min), p_norm.iter().copied().fold(0.0, f64::max).max(1e-12), PDF_BINS);
+    let d_mean = 2.0 * frame.radius.iter().sum::<f64>() / n.max(1) as f64;
+    let pressure_scale = scale / (d_mean * d_mean);
+    let pdf_over = |s: f64| {
+        let x: Vec<f64> = pressures.iter().map(|p| p / s.max(1e-300)).collect();
+        (Pdf::of(&x, x.iter().copied().fold(0.0, f64::min), x.iter().copied().fold(0.0, f64::max).max(1e-12), PDF_BINS), x)
+    };
+    let (pressure_pdf, p_norm) = pdf_over(pressure_scale);
+    let (pressure_pdf_mean_abs, _) = pdf_over(pressures.iter().map(|p| p.abs()).sum::<f64>() / n.max(1) as f64);
+    let pressure_tail = |sign: f64| fit_tail(&p_norm, sign, 0.0, None, &[]);
 
     // Fabric over the bonds.
     let mut fabric = [[0.0; 3]; 3];
@@ -204,7 +212,6 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
             *x /= n_bonds.max(1.0);
         }
     }
-    let d_mean = 2.0 * frame.radius.iter().sum::<f64>() / n.max(1) as f64;
     let phase = |positive: bool| percolation(frame, contacts, &pressures, positive, bounds, d_mean);
     NetworkAnalysis {
         time: frame.time,
@@ -218,7 +225,11 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
         solid_fraction: nu,
         macroscopic_stress: macro_stress,
         mean_pressure,
+        pressure_scale,
         pressure_pdf,
+        pressure_pdf_mean_abs,
+        pressure_tail_positive: pressure_tail(1.0),
+        pressure_tail_negative: pressure_tail(-1.0),
         positive_phase: phase(true),
         negative_phase: phase(false),
         fabric_anisotropy: 5.0 * (fabric[2][2] - 0.5 * (fabric[0][0] + fabric[1][1])),

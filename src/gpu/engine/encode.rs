@@ -106,7 +106,7 @@ impl GpuEngine {
     pub(super) fn encode_plan(&mut self, pass: &mut wgpu::ComputePass, which: usize) {
         for k in 0..self.plans[which].len() {
             self.encode(pass, &self.plans[which][k]);
-            for op in self.plans[which][k].ops.clone() {
+            for &op in &self.plans[which][k].ops {
                 self.trace.record(op);
             }
         }
