@@ -85,7 +85,7 @@ pub fn write<H: Serialize>(path: &Path, header: &H, state: &EngineState) -> anyh
     Ok(())
 }
 
-/// Reads a checkpoint written by [`write`].
+/// Reads a checkpoint written by [`write()`].
 pub fn read<H: for<'de> Deserialize<'de>>(path: &Path) -> anyhow::Result<(H, EngineState)> {
     let file = std::fs::File::open(path).with_context(|| format!("cannot open {}; fix: give the --out directory of a run that wrote a checkpoint", path.display()))?;
     let mut r = BufReader::new(file);

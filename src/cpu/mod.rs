@@ -1,10 +1,11 @@
 //! The CPU engine: the step's kernels as Rust twins, one invocation per grain or pair, mapped
 //! over threads with rayon. Generic over `f32` and `f64` (the reference).
 //!
-//! One step: `[kick] drift -> (rebuild: hash_cells, detect_pairs, remap_history) ->
-//! pair_force -> wall_contacts -> gather -> kick`, repeated per force evaluation of the
-//! integrator. Results are bitwise identical for any thread count: every invocation writes
-//! its own output, and reductions combine fixed chunks in order.
+//! One step runs the operations of [`crate::schedule`]: kicks, drifts (with the walls'
+//! controllers), the rebuild check (`hash_cells`, `detect_pairs`, `remap_history` when a grain
+//! has moved half the skin) and the force evaluations (`update_bridges`, `pair_force`,
+//! `wall_contacts`, `gather`). Results are bitwise identical for any thread count: every
+//! invocation writes its own output, and reductions combine fixed chunks in order.
 
 mod gather;
 mod grid;
@@ -44,9 +45,6 @@ use profile::{Phase, PhaseClock};
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS, PAR_MIN_PAIRS};
 use wall_contacts::wall_block;
-
-
-
 
 /// The CPU engine in precision `T`.
 pub struct CpuEngine<T: Real> {
@@ -442,10 +440,6 @@ impl<T: Real> CpuEngine<T> {
         self.trace.ops()
     }
 
-
-
-
-
     /// One time step of the scene's integrator.
     pub fn step(&mut self) -> Result<(), SimError> {
         if self.schedule.needs_loads {
@@ -521,14 +515,11 @@ fn wall_pass<T: Real>(
     total
 }
 
-
-
 /// Bytes a vector holds allocated.
 #[allow(clippy::ptr_arg)] // the capacity lives on the Vec, not the slice
 fn allocated<X>(v: &Vec<X>) -> u64 {
     (v.capacity() * std::mem::size_of::<X>()) as u64
 }
-
 
 impl<T: Real> Engine for CpuEngine<T> {
     fn backend(&self) -> &'static str {
@@ -552,8 +543,6 @@ impl<T: Real> Engine for CpuEngine<T> {
         }
         Ok(())
     }
-
-
 
     fn set_piston_pressure(&mut self, pressure: f64) {
         if let Some(p) = &mut self.piston {
@@ -627,8 +616,6 @@ impl<T: Real> Engine for CpuEngine<T> {
     fn phase_seconds(&self) -> Vec<(&'static str, f64)> {
         self.clock.totals()
     }
-
-
 
     fn place_piston(&mut self, z: f64) {
         if let Some(p) = self.piston {

@@ -1,5 +1,6 @@
 //! The GPU engine: buffers (structure of arrays, f32), one pipeline per kernel specialised to
-//! the scene's laws by override constants, and the step as a sequence of dispatches. Whether
+//! the scene's laws by override constants, and the step as the dispatches of the schedule's
+//! plan ([`super::plan`]). Whether
 //! a step rebuilds the neighbour list is decided on the GPU (`decide_rebuild` writes the
 //! rebuild kernels' indirect dispatch sizes), so the host only records steps and reads a few
 //! statistics back every `stats_interval` steps.
@@ -57,7 +58,6 @@ pub enum GpuSetupError {
     },
 }
 
-
 /// The GPU engine (f32).
 pub struct GpuEngine {
     gpu: Gpu,
@@ -96,8 +96,6 @@ pub struct GpuEngine {
     /// Dispatches recorded so far.
     dispatches: std::cell::Cell<u64>,
 }
-
-
 
 fn groups_for(n: u64) -> (u32, u32) {
     let g = n.div_ceil(WG as u64);
@@ -492,18 +490,6 @@ impl GpuEngine {
         }
     }
 
-
-
-
-
-
-
-
-
-
-
-
-
     /// The adapter this engine runs on.
     pub fn adapter(&self) -> &wgpu::AdapterInfo {
         &self.gpu.info
@@ -513,12 +499,6 @@ impl GpuEngine {
     pub fn pair_capacity(&self) -> u32 {
         self.params.pair_capacity
     }
-
-
-
-
-
-
 
 }
 
@@ -562,8 +542,6 @@ impl Engine for GpuEngine {
         self.check()
     }
 
-
-
     fn stats(&mut self) -> Result<Stats, SimError> {
         self.statistics()
     }
@@ -597,9 +575,6 @@ impl Engine for GpuEngine {
         self.gpu.queue.write_buffer(buffer, at(std::mem::offset_of!(layout::Servo, strain_rate)), bytemuck::bytes_of(&rate));
         self.gpu.queue.write_buffer(buffer, at(std::mem::offset_of!(layout::Servo, strain)), bytemuck::bytes_of(&strain));
     }
-
-
-
 
     fn memory_bytes(&self) -> u64 {
         self.buffers.values().map(wgpu::Buffer::size).sum()
