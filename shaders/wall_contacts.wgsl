@@ -1,6 +1,6 @@
 // One invocation computes one grain's contacts with every wall (the grain-grain laws with an
 // infinite partner), and each workgroup sums the forces its grains put on each wall (row
-// entries 0..MAX_WALLS: xyz force, w contacts) and, for servo walls (WALL_RESPONSE), their
+// entries 0..MAX_WALLS: xyz force, w contacts as u32 bits) and, for servo walls (WALL_RESPONSE), their
 // contacts' normal tangent stiffness and damping coefficient (entries MAX_WALLS..: x N/m,
 // y N s/m). The w of wall_force and wall_torque count the grain's wall contacts sliding and
 // rolling.
@@ -61,7 +61,7 @@ fn wall_contacts(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
             if (HAS_ROLLING_HISTORY) { wall_hist[b] = vec4<f32>(h.rolling, 0.0); }
             force += f.f_i;
             torque += f.t_i;
-            reaction[lid * MAX_WALLS + w] = vec4<f32>(-f.f_i, 1.0);
+            reaction[lid * MAX_WALLS + w] = vec4<f32>(-f.f_i, bitcast<f32>(1u));
             sliding += select(0.0, 1.0, f.regime == REGIME_SLIDING);
             rolling += select(0.0, 1.0, f.regime == REGIME_ROLLING);
             if (WALL_RESPONSE) {
@@ -87,7 +87,7 @@ fn reduce_walls(lid: u32, at: u32) {
     for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
         if (lid < stride) {
             for (var w = 0u; w < MAX_WALLS; w++) {
-                reaction[lid * MAX_WALLS + w] += reaction[(lid + stride) * MAX_WALLS + w];
+                reaction[lid * MAX_WALLS + w] = add_wall_row(reaction[lid * MAX_WALLS + w], reaction[(lid + stride) * MAX_WALLS + w]);
             }
         }
         workgroupBarrier();

@@ -1,5 +1,5 @@
 // One workgroup sums the per-workgroup wall rows in a fixed order into each wall's totals:
-// entries 0..MAX_WALLS (xyz: force the grains exert, w: contacts), then MAX_WALLS.. (the
+// entries 0..MAX_WALLS (xyz: force the grains exert, w: contacts, u32 bits), then MAX_WALLS.. (the
 // contacts' summed stiffness and damping, for servo walls; zero otherwise).
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> wall_partials: array<vec4<f32>>;
@@ -20,7 +20,7 @@ fn reduce_half(lid: u32, first: u32) {
     for (var w = 0u; w < MAX_WALLS; w++) {
         var s = vec4<f32>(0.0);
         for (var r = lid; r < rows; r += WG) {
-            s += wall_partials[r * row + first + w];
+            s = add_wall_row(s, wall_partials[r * row + first + w]);
         }
         acc[lid * MAX_WALLS + w] = s;
     }
@@ -28,7 +28,7 @@ fn reduce_half(lid: u32, first: u32) {
     for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
         if (lid < stride) {
             for (var w = 0u; w < MAX_WALLS; w++) {
-                acc[lid * MAX_WALLS + w] += acc[(lid + stride) * MAX_WALLS + w];
+                acc[lid * MAX_WALLS + w] = add_wall_row(acc[lid * MAX_WALLS + w], acc[(lid + stride) * MAX_WALLS + w]);
             }
         }
         workgroupBarrier();

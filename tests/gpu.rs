@@ -198,6 +198,7 @@ fn integrate_and_the_reductions_match_the_cpu_twins() {
     assert_eq!((sg.sliding, sg.rolling), (sc.sliding, sc.rolling), "contacts per regime");
     assert_eq!(sg.max_overlap_grain, sc.max_overlap_grain);
     for (a, b) in sg.walls.iter().zip(&sc.walls) {
+        assert_eq!(a.contacts, b.contacts, "{}: contacts (u32 on the GPU)", a.name);
         for k in 0..3 {
             assert!((a.force[k] - b.force[k]).abs() <= F32_LOAD_TOLERANCE * (sc.walls.iter().map(|w| w.force[2].abs()).fold(1e-9, f64::max)), "{}", a.name);
         }

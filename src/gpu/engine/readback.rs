@@ -227,7 +227,7 @@ impl GpuEngine {
                     WallStats {
                         name: self.wall_names[w].clone(),
                         force: [reaction[w][0] as f64, reaction[w][1] as f64, reaction[w][2] as f64],
-                        contacts: reaction[w][3].round() as u64,
+                        contacts: reaction[w][3].to_bits() as u64,
                         position: servo_plane.map(|k| walls[w].point[k / 2] as f64),
                         pressure: servo_plane.map(|k| servo_pressure(walls, reaction, self.servo.expect("a servo plane"), k)),
                     }
