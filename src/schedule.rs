@@ -78,18 +78,6 @@ impl Schedule {
     pub fn ops(&self, step: u64) -> &[Op] {
         if step == 0 { &self.first } else { &self.step }
     }
-
-    /// Every operation the schedule can run, without repeats in first-seen order (what the GPU
-    /// engine keeps a uniform slot for).
-    pub fn distinct(&self) -> Vec<Op> {
-        let mut out: Vec<Op> = Vec::new();
-        for op in self.prologue.iter().chain(&self.first).chain(&self.step) {
-            if !out.contains(op) {
-                out.push(*op);
-            }
-        }
-        out
-    }
 }
 
 impl Op {

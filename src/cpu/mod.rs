@@ -563,15 +563,13 @@ impl<T: Real> Engine for CpuEngine<T> {
         let CohesionLaw::Capillary { theta, .. } = self.model.cohesion else {
             anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
         };
-        let d: Vec<f64> = (0..self.pairs.len())
+        let pairs: Vec<(f64, f64, f64)> = (0..self.pairs.len())
             .map(|k| {
                 let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
-                let (ri, rj) = (self.prop[i].radius.f64(), self.prop[j].radius.f64());
-                2.0 * ri * rj / (ri + rj)
+                (self.prop[i].radius.f64(), self.prop[j].radius.f64(), self.gap(k).f64())
             })
             .collect();
-        let gaps: Vec<f64> = (0..self.pairs.len()).map(|k| self.gap(k).f64()).collect();
-        let (shares, rest) = share_liquid(volume, &d, &gaps, self.bridge_cap.f64(), theta.f64());
+        let (shares, rest) = share_liquid(volume, &pairs, self.bridge_cap.f64(), theta.f64());
         let (stride, b) = (self.slots.stride, self.slots.bridge);
         for (k, v) in shares {
             self.hist[k * stride + b] += T::of(v);

@@ -15,7 +15,7 @@ use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, 
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::kernels::{Access, KERNELS};
 use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness};
-use super::plan::{plan, Dispatch, Entry};
+use super::plan::{Dispatch, Entry, Plans};
 use crate::schedule::{Op, Schedule, Trace};
 use crate::scene::{Scene, WallShape};
 use std::collections::HashMap;
@@ -63,9 +63,8 @@ pub struct GpuEngine {
     gpu: Gpu,
     n: u32,
     params: Params,
-    schedule: Schedule,
-    /// The plans of the schedule's prologue, first step and later steps.
-    plans: [Vec<Entry>; 3],
+    /// How the schedule's prologue, first step and later steps are encoded.
+    plans: Plans,
     /// The phases of the plans, in the order of their uniform slots in `phase`.
     phases: Vec<Phase>,
     /// The operations encoded, when tracing.
@@ -278,10 +277,9 @@ impl GpuEngine {
 
         let phase_stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<Phase>() as u64);
         let dt = scene.time_step.dt;
-        let schedule = Schedule::new(scene.integrator, dt);
-        let plans = [plan(&schedule.prologue), plan(&schedule.first), plan(&schedule.step)];
+        let plans = Plans::of(&Schedule::new(scene.integrator, dt));
         let mut phases: Vec<Phase> = Vec::new();
-        for e in plans.iter().flatten() {
+        for e in plans.entries() {
             if !phases.contains(&e.phase) {
                 phases.push(e.phase);
             }
@@ -325,7 +323,6 @@ impl GpuEngine {
             gpu,
             n: n as u32,
             params,
-            schedule,
             plans,
             phases,
             trace: Trace::default(),
@@ -526,11 +523,11 @@ impl Engine for GpuEngine {
             let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
             {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
-                if self.schedule.needs_loads && !self.forces_valid {
-                    self.encode_plan(&mut pass, 0);
+                if self.plans.needs_loads && !self.forces_valid {
+                    self.encode_plan(&mut pass, None);
                 }
                 for s in 0..chunk {
-                    self.encode_plan(&mut pass, if self.step + s == 0 { 1 } else { 2 });
+                    self.encode_plan(&mut pass, Some(self.step + s));
                 }
             }
             self.gpu.queue.submit([encoder.finish()]);

@@ -4,7 +4,7 @@
 //! them apart, so the step costs fewer dispatches and gives the same bits.
 
 use super::layout::Phase;
-use crate::schedule::Op;
+use crate::schedule::{Op, Schedule};
 
 /// What one entry of a plan encodes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,6 +47,32 @@ pub fn plan(ops: &[Op]) -> Vec<Entry> {
         k += covered;
     }
     out
+}
+
+/// The plans of a schedule: its prologue, its first step and every later step.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Plans {
+    /// Where the loads are not valid yet (see [`Schedule::prologue`]).
+    pub prologue: Vec<Entry>,
+    /// Whether a step needs valid loads before it starts ([`Schedule::needs_loads`]).
+    pub needs_loads: bool,
+    first: Vec<Entry>,
+    later: Vec<Entry>,
+}
+
+impl Plans {
+    /// The plans of `schedule`.
+    pub fn of(schedule: &Schedule) -> Self {
+        Plans { prologue: plan(&schedule.prologue), needs_loads: schedule.needs_loads, first: plan(&schedule.first), later: plan(&schedule.step) }
+    }
+    /// The plan of step number `step` (0 = the first), as [`Schedule::ops`].
+    pub fn step(&self, step: u64) -> &[Entry] {
+        if step == 0 { &self.first } else { &self.later }
+    }
+    /// Every entry of every plan.
+    pub fn entries(&self) -> impl Iterator<Item = &Entry> {
+        self.prologue.iter().chain(&self.first).chain(&self.later)
+    }
 }
 
 #[cfg(test)]

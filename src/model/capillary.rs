@@ -60,12 +60,15 @@ pub fn capillary_potential<T: Real>(kappa: T, theta: T, c: T, r_i: T, r_j: T, v_
 }
 
 /// How a volume of liquid (m^3) wets a sample: pairs within their rupture distance share it
-/// in proportion to their reduced diameter `d` (m), each share capped at `cap` (m^3); pairs
-/// beyond the rupture distance of their share drop out and raise the others' shares, until
-/// none drops. `gaps` (m) are the pairs' surface gaps, `theta` the contact angle (rad).
-/// Returns each wetted pair's `(index, volume)` and the volume left over, which waits on the
-/// grains (seed 001, PHYSICS.md).
-pub fn share_liquid(volume: f64, d: &[f64], gaps: &[f64], cap: f64, theta: f64) -> (Vec<(usize, f64)>, f64) {
+/// in proportion to their reduced diameter `d = 2 R_i R_j / (R_i + R_j)` (m), each share
+/// capped at `cap` (m^3); pairs beyond the rupture distance of their share drop out and raise
+/// the others' shares, until none drops. `pairs` are each pair's radii and surface gap
+/// `(R_i, R_j, gap)` (m), `theta` the contact angle (rad). Returns each wetted pair's
+/// `(index, volume)` and the volume left over, which waits on the grains (seed 001,
+/// PHYSICS.md).
+pub fn share_liquid(volume: f64, pairs: &[(f64, f64, f64)], cap: f64, theta: f64) -> (Vec<(usize, f64)>, f64) {
+    let d: Vec<f64> = pairs.iter().map(|&(ri, rj, _)| 2.0 * ri * rj / (ri + rj)).collect();
+    let gaps: Vec<f64> = pairs.iter().map(|p| p.2).collect();
     let mut eligible: Vec<usize> = (0..d.len()).collect();
     loop {
         let total: f64 = eligible.iter().map(|&k| d[k]).sum();

@@ -14,7 +14,6 @@ use serde::{Deserialize, Serialize};
 /// steps.
 pub const ENERGY_GROWTH_TOLERANCE: f64 = 0.5;
 
-
 /// What a stage did.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StageResult {
@@ -173,7 +172,6 @@ pub fn run_from(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn Recorder, 
         let result = run_stage(scene, stage, engine, rec, &mut progress, &mut clock)?;
         progress.results.push(result);
         progress.next_stage += 1;
-        progress.in_stage = None;
         rec.checkpoint(&progress, engine)?;
         clock.reset();
     }

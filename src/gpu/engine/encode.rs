@@ -101,12 +101,16 @@ impl GpuEngine {
         }
     }
 
-    /// Encodes plan `which` (0 prologue, 1 first step, 2 later steps) and traces its
+    /// Encodes the plan of step number `step`, or the prologue's with `None`, and traces its
     /// operations.
-    pub(super) fn encode_plan(&mut self, pass: &mut wgpu::ComputePass, which: usize) {
-        for k in 0..self.plans[which].len() {
-            self.encode(pass, &self.plans[which][k]);
-            for &op in &self.plans[which][k].ops {
+    pub(super) fn encode_plan(&mut self, pass: &mut wgpu::ComputePass, step: Option<u64>) {
+        let entries = match step {
+            None => &self.plans.prologue,
+            Some(n) => self.plans.step(n),
+        };
+        for e in entries {
+            self.encode(pass, e);
+            for &op in &e.ops {
                 self.trace.record(op);
             }
         }
@@ -121,7 +125,7 @@ impl GpuEngine {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.encode_plan(&mut pass, 0);
+            self.encode_plan(&mut pass, None);
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.forces_valid = true;

@@ -152,17 +152,15 @@ impl GpuEngine {
         let (pi, pj) = (&parts[1], &parts[2]);
         let mut hist: Vec<[f32; 4]> = bytemuck::cast_slice(&parts[3]).to_vec();
         let mut liquid: Vec<f32> = bytemuck::cast_slice(&parts[4]).to_vec();
-        // The CPU twin's reduced diameters and gaps (in f32, as its f32 engine has them).
+        // The CPU twin's radii and gaps (in f32, as its f32 engine has them).
         let v3 = |p: &[f32; 4]| Vec3::new(p[0], p[1], p[2]);
-        let d: Vec<f64> = (0..np as usize).map(|k| {
-            let (ri, rj) = (pos[pi[k] as usize][3] as f64, pos[pj[k] as usize][3] as f64);
-            2.0 * ri * rj / (ri + rj)
-        }).collect();
-        let gaps: Vec<f64> = (0..np as usize).map(|k| {
-            let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
-            (self.periodic.min_image(v3(a) - v3(b)).norm() - a[3] - b[3]) as f64
-        }).collect();
-        let (shares, rest) = crate::model::share_liquid(volume, &d, &gaps, self.params.bridge_cap as f64, theta as f64);
+        let pairs: Vec<(f64, f64, f64)> = (0..np as usize)
+            .map(|k| {
+                let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
+                (a[3] as f64, b[3] as f64, (self.periodic.min_image(v3(a) - v3(b)).norm() - a[3] - b[3]) as f64)
+            })
+            .collect();
+        let (shares, rest) = crate::model::share_liquid(volume, &pairs, self.params.bridge_cap as f64, theta as f64);
         let last = blocks as usize - 1;
         for (k, v) in shares {
             hist[k * blocks as usize + last][0] += v as f32;
