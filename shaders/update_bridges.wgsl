@@ -24,7 +24,7 @@ fn update_bridges() {
         let at = k * params.hist_blocks + last;
         let v = hist[at].x;
         if (v > 0.0) {
-            if (gap > rupture_distance(v)) {
+            if (!within_rupture(v, gap)) {
                 liquid[i] += v * 0.5;
                 liquid[j] += v * 0.5;
                 hist[at] = vec4<f32>(0.0);

@@ -104,6 +104,11 @@ pub enum Command {
     Analyze {
         /// The run's --out directory.
         run: PathBuf,
+        /// Another finished run (with contact forces) whose force PDF is drawn beside this
+        /// run's, over this run's force scale (seed 001's Fig. 7: wet and dry at 100 Pa):
+        /// force_pdf_beside.png.
+        #[arg(long, value_name = "RUN")]
+        beside: Option<PathBuf>,
         /// Print the analysis as one JSON object on stdout.
         #[arg(long)]
         json: bool,

@@ -106,6 +106,9 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 let table = grains::sweep::gather(&sw, &out)?;
                 std::fs::write(out.join("sweep.csv"), table.csv())?;
                 std::fs::write(out.join("sweep.json"), serde_json::to_string_pretty(&table)?)?;
+                if !table.ensemble.is_empty() {
+                    std::fs::write(out.join("ensemble.csv"), grains::analysis::ensemble::csv(&table.ensemble))?;
+                }
                 let fitted: Vec<_> = table.rows.iter().filter_map(|r| Some((r.eta?, r.h_s?))).collect();
                 if !fitted.is_empty() {
                     let title = sweep.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
@@ -125,16 +128,14 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Analyze { run, json } => {
-            let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).with_context(|| format!("{}: no summary.json; fix: give the --out directory of a finished run", run.display()))?)?;
-            let scene_file = summary["file"].as_str().context("summary.json names no scene file")?;
-            let scene = scene::load(Path::new(scene_file))?;
-            let frame = grains::output::mcap::last_frame(&run.join("frames.mcap"))?;
-            if frame.contacts.is_none() {
-                anyhow::bail!("{}: the frames hold no contact forces; fix: set output.contact_forces = true in the scene and run it again", run.display());
-            }
+        Command::Analyze { run, beside, json } => {
+            let (summary, scene, frame) = finished_run(&run)?;
             let stats: grains::engine::Stats = serde_json::from_value(summary["stages"].as_array().and_then(|s| s.last()).map(|s| s["stats"].clone()).context("summary.json has no stages")?)?;
             let a = grains::output::network::write(&scene, &frame, &stats, &run)?;
+            if let Some(other) = &beside {
+                let (_, other_scene, other_frame) = finished_run(other)?;
+                grains::output::network::write_beside(&scene, &a, &other_scene.name, &other_frame, &run)?;
+            }
             if json {
                 println!("{}", serde_json::to_string(&a)?);
             } else {
@@ -208,6 +209,18 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
 }
 
 /// A progress bar on a terminal, not with --json.
+/// A finished run's summary, scene and last frame (which must hold the contact forces).
+fn finished_run(run: &Path) -> anyhow::Result<(serde_json::Value, Scene, grains::engine::Frame)> {
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).with_context(|| format!("{}: no summary.json; fix: give the --out directory of a finished run", run.display()))?)?;
+    let scene_file = summary["file"].as_str().with_context(|| format!("{}: summary.json names no scene file", run.display()))?;
+    let scene = scene::load(Path::new(scene_file))?;
+    let frame = grains::output::mcap::last_frame(&run.join("frames.mcap"))?;
+    if frame.contacts.is_none() {
+        anyhow::bail!("{}: the frames hold no contact forces; fix: set output.contact_forces = true in the scene and run it again", run.display());
+    }
+    Ok((summary, scene, frame))
+}
+
 fn progress_bar(json: bool) -> bool {
     !json && std::io::stderr().is_terminal()
 }

@@ -259,6 +259,9 @@ pub struct ContactRecord {
     /// Rolling spring `psi` (m), zero when the model keeps none.
     #[serde(default)]
     pub rolling_spring: [f64; 3],
+    /// Liquid in the pair's bridge (m^3), zero without one.
+    #[serde(default)]
+    pub bridge_volume: f64,
 }
 
 /// One grain touching one wall. Its force is evaluated from the state of the frame (springs

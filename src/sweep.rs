@@ -1,6 +1,8 @@
 //! Parameter sweeps: one scene run over a grid (or list) of parameter values, each point in
 //! its own directory, resumable, gathered into one table with the power law h_s = a eta^b
-//! across the points (seed 000's Figure 5).
+//! across the points (seed 000's Figure 5) and, for scenes with the force-transmission
+//! analysis (`output.analysis`), each figure's mean and spread over the points (a sweep over
+//! `seed` gives independent samples).
 //!
 //! A sweep file:
 //! ```toml
@@ -12,6 +14,7 @@
 //! A parameter is a dotted path into the scene: tables by key, arrays of tables (`material`,
 //! `generate`, `wall`, `stage`, `grain`) by the `name` of an entry or by index.
 
+use crate::analysis::ensemble::{self, Figure};
 use crate::analysis::fit::{fit_power_law, Estimate, PowerLaw};
 use anyhow::{bail, Context};
 use serde::{Deserialize, Serialize};
@@ -168,6 +171,9 @@ pub struct Table {
     pub rows: Vec<Row>,
     /// h_s = a eta^b (MPa) across the points with a fit, when at least 3 have one.
     pub power_law: Option<PowerLaw>,
+    /// The force-transmission figures over the points with an `analysis.json` (empty when
+    /// none has one).
+    pub ensemble: Vec<Figure>,
 }
 
 impl Table {
@@ -190,19 +196,24 @@ impl Table {
             let vals: Vec<String> = r.point.values.iter().map(|(k, v)| format!("{k} = {v}")).collect();
             match (&r.h_s, &r.eta) {
                 (Some(h), Some(e)) => s.push_str(&format!("point {:>3}: {}: h_s = {} MPa, eta = {}\n", r.point.index, vals.join(", "), h.concise(), e.concise())),
-                _ => s.push_str(&format!("point {:>3}: {}: {}\n", r.point.index, vals.join(", "), r.note.clone().unwrap_or_default())),
+                _ => s.push_str(&format!("point {:>3}: {}: {}\n", r.point.index, vals.join(", "), r.note.as_deref().unwrap_or("finished"))),
             }
         }
         if let Some(l) = &self.power_law {
             s.push_str(&format!("power law across the points: {} (seed 000: {})\n", l.line(), crate::analysis::seed000::POWER_LAW.line()));
         }
+        if !self.ensemble.is_empty() {
+            s.push_str("force transmission over the points:\n");
+            s.push_str(&ensemble::human(&self.ensemble));
+        }
         s
     }
 }
 
-/// Reads every point's summary under `out` into the table.
+/// Reads every point's summary (and analysis, where there is one) under `out` into the table.
 pub fn gather(sweep: &Sweep, out: &Path) -> anyhow::Result<Table> {
     let mut rows = Vec::new();
+    let mut analysed = Vec::new();
     for p in &sweep.points {
         let path = Sweep::point_dir(out, p).join("summary.json");
         let row = match std::fs::read_to_string(&path) {
@@ -220,7 +231,13 @@ pub fn gather(sweep: &Sweep, out: &Path) -> anyhow::Result<Table> {
                     Some(Estimate { value: b["value"].as_f64()? / scale, error: b["error"].as_f64()? / scale })
                 };
                 let (h_s, eta) = (est("h_s", 1e6), est("eta", 1.0));
-                let note = if h_s.is_none() { Some(v["bauer_error"].as_str().unwrap_or("no Bauer fit").to_string()) } else { None };
+                // A scene that records no compression has no Bauer fit to miss.
+                let compresses = v["compression"].as_array().is_some_and(|c| !c.is_empty());
+                let note = if h_s.is_none() && compresses { Some(v["bauer_error"].as_str().unwrap_or("no Bauer fit").to_string()) } else { None };
+                let analysis = Sweep::point_dir(out, p).join("analysis.json");
+                if let Ok(a) = std::fs::read_to_string(&analysis) {
+                    analysed.push((v.clone(), serde_json::from_str(&a).with_context(|| format!("{}: unreadable analysis", analysis.display()))?));
+                }
                 Row { point: p.clone(), e0: v["bauer"]["e0"]["value"].as_f64(), h_s, eta, note }
             }
         };
@@ -228,7 +245,7 @@ pub fn gather(sweep: &Sweep, out: &Path) -> anyhow::Result<Table> {
     }
     let fitted: Vec<(f64, f64)> = rows.iter().filter_map(|r| Some((r.eta?.value, r.h_s?.value))).filter(|(x, y)| *x > 0.0 && *y > 0.0).collect();
     let power_law = if fitted.len() >= 3 { fit_power_law(&fitted).ok() } else { None };
-    Ok(Table { rows, power_law })
+    Ok(Table { rows, power_law, ensemble: ensemble::gather(&analysed) })
 }
 
 /// Whether a point has finished (its summary is written last, after every other output).

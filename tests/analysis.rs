@@ -18,7 +18,7 @@ fn chain() -> Frame {
     let x = |k: f64| [k * (2.0 * r - h), 0.0, 0.0];
     let rec = |i: u32, j: u32, f: f64| {
         // n from j to i; i is left of j, so n = -x; the force on i is f n.
-        ContactRecord { i, j, overlap: h, normal_force: f, force: [-f, 0.0, 0.0], force_j: [f, 0.0, 0.0], tangential_spring: [0.0; 3], rolling_spring: [0.0; 3] }
+        ContactRecord { i, j, overlap: h, normal_force: f, force: [-f, 0.0, 0.0], force_j: [f, 0.0, 0.0], tangential_spring: [0.0; 3], rolling_spring: [0.0; 3], bridge_volume: 0.0 }
     };
     Frame {
         time: 0.0,
@@ -76,7 +76,8 @@ fn particle_stresses_of_a_three_grain_chain() {
 /// The maximum-likelihood tail is an estimate with an honest error: over many independent
 /// samples drawn from a known exponential tail (unbounded, as compressive forces above the
 /// mean; truncated at a bound, as tensile forces below f0), the true rate lies within one
-/// standard error of the estimate in about 68% of them and within two in about 95%.
+/// standard error of the estimate in about 68% of them and within two in about 95%; the
+/// density the fit draws holds the tail's share of the samples.
 #[test]
 fn the_tail_estimator_recovers_a_known_rate_within_its_own_error() {
     /// Binomial spread of the coverage over 400 draws is about 2.3% (one error) and 1.1%
@@ -108,6 +109,11 @@ fn the_tail_estimator_recovers_a_known_rate_within_its_own_error() {
                 .collect();
             let fit = grains::analysis::tail::fit_tail(&values, 1.0, threshold, bound, &[]).unwrap();
             assert_eq!(fit.samples, 300);
+            // The density the fit draws holds the tail's share of the samples.
+            let (end, steps) = (bound.unwrap_or(threshold + 40.0 / rate.abs()), 20_000);
+            let h = (end - threshold) / steps as f64;
+            let held: f64 = (0..steps).map(|k| fit.density_at(threshold + (k as f64 + 0.5) * h) * h).sum();
+            assert!((held / fit.fraction - 1.0).abs() < 1e-6 && (fit.fraction - 0.5).abs() < 1e-12, "the fitted density holds {held} of a fraction {}", fit.fraction);
             mean_error += fit.error / draws as f64;
             for (k, n) in inside.iter_mut().enumerate() {
                 *n += ((fit.rate - rate).abs() <= (k + 1) as f64 * fit.error) as usize;

@@ -1,12 +1,14 @@
 //! Capillary cohesion (seed 001 eqs. 1-8): the law against the formula worked by hand, a wet
 //! pair that a bridge holds together or lets go at its rupture distance as energy says it
-//! should, and liquid conserved while bridges break and form.
+//! should, liquid conserved while bridges break and form, and seed 001's wet preparation
+//! keeping the liquid's books.
 
 mod common;
 
 use grains::cpu::CpuEngine;
-use grains::engine::Engine;
-use grains::model::{capillary_force, capillary_potential, decay_length, rupture_distance};
+use grains::engine::{Engine, Frame, Stats};
+use grains::model::{capillary_force, capillary_potential, decay_length, rupture_distance, CohesionLaw};
+use grains::protocol::{Progress, Recorder, StageResult};
 
 /// The law against its formula: round-off.
 const FORMULA: f64 = 1e-12;
@@ -160,4 +162,85 @@ fn liquid_is_conserved_while_bridges_break_and_form() {
     println!("{} bridges at the start, {} now, {formed_or_broken} net changes seen; liquid {total:.4e} m^3 conserved to {worst:.2e}", s0.bridges, last);
     assert!(s0.bridges > 0 && formed_or_broken > 10, "bridges must break and form");
     assert!(worst < LIQUID_ROUNDOFF);
+}
+
+/// Checks every statistics read and stage-end frame of a wet run for the liquid's books.
+struct LiquidBooks {
+    /// Liquid poured (m^3).
+    poured: f64,
+    /// Largest bridge volume (m^3) and contact angle (rad).
+    cap: f64,
+    theta: f64,
+    /// The last statistics read.
+    last: Option<Stats>,
+    /// Worst relative gap between the liquid poured and that in bridges and on grains.
+    worst: f64,
+    /// Statistics at the first read and at each stage end: (bridges, liquid on grains (m^3)).
+    marks: Vec<(u64, f64)>,
+    /// Bridges checked in the stage-end frames.
+    bridges_seen: usize,
+}
+
+impl Recorder for LiquidBooks {
+    fn stats(&mut self, _: &str, s: &Stats) -> anyhow::Result<()> {
+        self.worst = self.worst.max(((s.liquid_in_bridges + s.liquid_on_grains) / self.poured - 1.0).abs());
+        if self.last.is_none() {
+            self.marks.push((s.bridges, s.liquid_on_grains));
+        }
+        self.last = Some(s.clone());
+        Ok(())
+    }
+    fn frame(&mut self, f: &Frame) -> anyhow::Result<()> {
+        let s = self.last.as_ref().expect("a statistics read before the stage-end frame");
+        let bridged: Vec<_> = f.contacts.as_ref().expect("contact forces are recorded").iter().filter(|c| c.bridge_volume > 0.0).collect();
+        let held: f64 = bridged.iter().map(|c| c.bridge_volume).sum();
+        assert_eq!(bridged.len() as u64, s.bridges, "every bridge shows in the frame");
+        assert!((held / s.liquid_in_bridges - 1.0).abs() < LIQUID_ROUNDOFF, "the frame's bridges hold {held:e} m^3, the statistics count {:e}", s.liquid_in_bridges);
+        for c in &bridged {
+            assert!(c.bridge_volume <= self.cap * (1.0 + LIQUID_ROUNDOFF), "bridge {}-{} holds {:e} m^3 over the cap {:e}", c.i, c.j, c.bridge_volume, self.cap);
+            assert!(-c.overlap <= rupture_distance(self.theta, c.bridge_volume) * (1.0 + FORMULA), "bridge {}-{} stretched past its rupture distance", c.i, c.j);
+            assert!(c.normal_force < 0.0 || c.overlap > 0.0, "an open bridge pulls");
+        }
+        self.bridges_seen += bridged.len();
+        self.marks.push((s.bridges, s.liquid_on_grains));
+        Ok(())
+    }
+    fn stage_end(&mut self, _: &StageResult) -> anyhow::Result<()> {
+        Ok(())
+    }
+    fn progress(&mut self, _: &str, _: u64, _: u64) {}
+    fn checkpoint(&mut self, _: &Progress, _: &dyn Engine) -> anyhow::Result<()> {
+        Ok(())
+    }
+}
+
+/// Seed 001's wet preparation as scenes/wet_iso_0pa.toml runs it (300 grains, stages cut to
+/// 20 ms): liquid poured on the loose gas, the gas compacted at 100 Pa, the walls released.
+/// At every statistics read the liquid in bridges and on grains adds up to what was poured; at
+/// each stage end the frame's bridges hold exactly the liquid the statistics count, none over
+/// the cap or past its rupture distance.
+#[test]
+fn the_wet_preparation_keeps_every_drop_of_liquid_accounted_for() {
+    let scene = common::parse(&common::edit(
+        &std::fs::read_to_string(common::scene_path("wet_iso_0pa.toml")).unwrap(),
+        &[("count = 8000", "count = 300"), ("max = [28.0e-3, 28.0e-3, 28.0e-3]", "max = [9.4e-3, 9.4e-3, 9.4e-3]"), ("duration = 1.0\n", "duration = 2.0e-2\n"), ("analysis = true", "analysis = false")],
+    ));
+    assert!(scene.stages[0].wet_volume.is_some(), "the first stage wets the gas");
+    let CohesionLaw::Capillary { theta, .. } = scene.model.cohesion else { panic!("a capillary scene") };
+    let mut books = LiquidBooks { poured: scene.stages[0].wet_volume.unwrap(), cap: scene.bridges.volume_cap, theta, last: None, worst: 0.0, marks: Vec::new(), bridges_seen: 0 };
+    let mut e: CpuEngine<f64> = common::engine(&scene);
+    let results = grains::protocol::run(&scene, &mut e, &mut books).unwrap();
+    println!(
+        "{} stages ({} steps); (bridges, liquid on grains / poured) at the first read {:?} and the stage ends {:?}; {} bridges checked; liquid conserved to {:.2e}",
+        results.len(),
+        results.iter().map(|r| r.steps).sum::<u64>(),
+        (books.marks[0].0, books.marks[0].1 / books.poured),
+        books.marks[1..].iter().map(|(b, l)| (*b, l / books.poured)).collect::<Vec<_>>(),
+        books.bridges_seen,
+        books.worst
+    );
+    assert!(books.worst < LIQUID_ROUNDOFF);
+    assert_eq!(books.marks.len(), 1 + results.len(), "a frame at each stage end");
+    let (b0, _) = books.marks[0];
+    assert!(b0 as usize >= scene.grains.len() / 2, "the loose gas is wetted: pairs within their rupture distance take the liquid ({b0} bridges)");
 }

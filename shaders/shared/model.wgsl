@@ -87,9 +87,11 @@ fn empty_history() -> History {
     return h;
 }
 
-// Capillary bridges (src/model/capillary.rs): rupture distance (1 + theta/2) V^(1/3) (m).
-fn rupture_distance(v_b: f32) -> f32 {
-    return (1.0 + params.theta * 0.5) * pow(v_b, 1.0 / 3.0);
+// Capillary bridges (src/model/capillary.rs): whether the gap delta (m) lies within the
+// rupture distance (1 + theta/2) V^(1/3) (m), tested on the cubes as the CPU does.
+fn within_rupture(v_b: f32, delta: f32) -> bool {
+    let k = 1.0 + params.theta * 0.5;
+    return delta <= 0.0 || delta * delta * delta <= k * k * k * v_b;
 }
 
 // Decay length of the capillary force across the gap (m), seed 001 eq. 8.
@@ -107,7 +109,7 @@ fn capillary_force(r_i: f32, r_j: f32, v_b: f32, delta: f32) -> f32 {
     if (delta < 0.0) {
         return f0;
     }
-    if (delta <= rupture_distance(v_b)) {
+    if (within_rupture(v_b, delta)) {
         return f0 * exp(-(delta / decay_length(r_i, r_j, v_b)));
     }
     return 0.0;

@@ -1,8 +1,10 @@
 //! Measures of a packing computed from a frame, and the fits of the experiments.
 
+pub mod ensemble;
 pub mod fit;
 pub mod network;
 pub mod seed000;
+pub mod seed001;
 pub mod tail;
 
 use crate::engine::Frame;

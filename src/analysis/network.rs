@@ -118,6 +118,19 @@ pub struct NetworkAnalysis {
     pub pressures: Vec<f64>,
 }
 
+/// The nonzero normal forces of a frame's bonds over `scale` (N).
+pub fn forces_over(frame: &Frame, scale: f64) -> Vec<f64> {
+    frame.contacts.as_deref().unwrap_or(&[]).iter().map(|c| c.normal_force).filter(|f| *f != 0.0).map(|f| f / scale.max(1e-300)).collect()
+}
+
+/// The PDF of normalised forces, on [`PDF_BINS`] bins from the most tensile (or 0) to the
+/// largest (or 1).
+pub fn force_density(normalised: &[f64]) -> Pdf {
+    let hi = normalised.iter().copied().fold(0.0, f64::max).max(1.0);
+    let lo = normalised.iter().copied().fold(0.0, f64::min);
+    Pdf::of(normalised, lo, hi, PDF_BINS)
+}
+
 /// The sample's box: lower and upper corners (m).
 pub type Bounds = ([f64; 3], [f64; 3]);
 
@@ -127,17 +140,15 @@ pub type Bounds = ([f64; 3], [f64; 3]);
 pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Option<f64>) -> NetworkAnalysis {
     let n = frame.radius.len();
     let contacts = frame.contacts.as_deref().unwrap_or(&[]);
-    let forces: Vec<f64> = contacts.iter().map(|c| c.normal_force).filter(|f| *f != 0.0).collect();
+    let forces = forces_over(frame, 1.0);
     let compressive: Vec<f64> = forces.iter().copied().filter(|f| *f > 0.0).collect();
     let mean_c = compressive.iter().sum::<f64>() / compressive.len().max(1) as f64;
     let (scale, scale_is) = match f0 {
         Some(f0) => (f0, "f0 = kappa R_max"),
         None => (mean_c, "mean force"),
     };
-    let normalised: Vec<f64> = forces.iter().map(|f| f / scale.max(1e-300)).collect();
-    let hi = normalised.iter().copied().fold(0.0, f64::max).max(1.0);
-    let lo = normalised.iter().copied().fold(0.0, f64::min);
-    let force_pdf = Pdf::of(&normalised, lo, hi, PDF_BINS);
+    let normalised = forces_over(frame, scale);
+    let force_pdf = force_density(&normalised);
     let (tail_compressive, tail_tensile) = match f0 {
         // Tensile forces never exceed f0: that side is bounded at 1.
         Some(_) => (fit_tail(&normalised, 1.0, WET_TAIL_FROM.0, None, &WET_TAIL_FROM.1), fit_tail(&normalised, -1.0, WET_TAIL_FROM.0, Some(1.0), &WET_TAIL_FROM.1)),

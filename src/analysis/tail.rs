@@ -18,6 +18,8 @@ pub struct TailFit {
     pub error: f64,
     /// Samples beyond the threshold.
     pub samples: usize,
+    /// Their fraction of all the samples (both sides).
+    pub fraction: f64,
     /// `|x|` from which the tail is fitted.
     pub threshold: f64,
     /// Largest `|x|` the variable can take on this side, if bounded.
@@ -69,5 +71,20 @@ pub fn fit_tail(values: &[f64], sign: f64, threshold: f64, bound: Option<f64>, o
     };
     let (rate, error, samples) = fit(threshold)?;
     let sensitivity = other_thresholds.iter().filter_map(|&u| fit(u).map(|(r, e, _)| (u, r, e))).collect();
-    Some(TailFit { rate, error, samples, threshold, bound, sensitivity })
+    Some(TailFit { rate, error, samples, fraction: samples as f64 / values.len() as f64, threshold, bound, sensitivity })
+}
+
+impl TailFit {
+    /// The density (per unit of the normalised variable, over all the samples) that the fit
+    /// gives at `|x| = x_abs` beyond the threshold: `fraction` times the exponential's (or
+    /// truncated exponential's) density of the exceedance.
+    pub fn density_at(&self, x_abs: f64) -> f64 {
+        let y = x_abs - self.threshold;
+        let mass = match self.bound {
+            Some(b) if self.rate != 0.0 => 1.0 - (-self.rate * (b - self.threshold)).exp(),
+            Some(b) => return self.fraction / (b - self.threshold),
+            None => 1.0,
+        };
+        self.fraction * self.rate * (-self.rate * y).exp() / mass
+    }
 }

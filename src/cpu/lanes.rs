@@ -1,25 +1,29 @@
 //! The pair pass of the standard Hertz-Mindlin model (Hertz, restitution damping, Mindlin
-//! tangential spring with one mu; no rolling, twisting or cohesion: LAMMPS' and LIGGGHTS'
-//! default granular model) in lanes that the compiler turns into vector instructions.
+//! tangential spring with one mu; no rolling or twisting: LAMMPS' and LIGGGHTS' default
+//! granular model), with or without capillary bridges, in lanes that the compiler turns into
+//! vector instructions.
 //!
 //! Each lane group is loaded one pair at a time (the scattered reads of the two grains),
 //! then every lane runs the very same `contact_force` as the one-pair pass, with the laws
 //! fixed at compile time and no branch on whether the pair touches (a third of a dense
 //! packing's listed pairs do not, in no order a branch predictor learns): the result of a
-//! pair that does not touch is dropped by a select. Same operations on the same inputs, so
-//! the same bits as `pair_force`; `tests` below check it.
+//! pair that does not touch is dropped by a select. A bridge adds its contact force `f0` by a
+//! select too; the few open pairs that hold a bridge take its force across the gap one at a
+//! time afterwards. Same operations on the same inputs, so the same bits as `pair_force`;
+//! `tests` below check it.
 
 use super::pair_force::ForceContext;
 use super::pairs::PairList;
 use super::state::{Body, Props};
-use crate::model::{contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, Regime, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+use crate::model::{capillary_force, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, Regime, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
 use crate::real::{Real, Vec3};
 
 /// Pairs per lane group.
 const LANES: usize = 32;
 
 /// `model` rebuilt with its laws as compile-time constants when it is the standard
-/// Hertz-Mindlin model, so that the composed `contact_force` folds to straight-line code.
+/// Hertz-Mindlin model (with any cohesion), so that the composed `contact_force` folds to
+/// straight-line code; the lanes add the cohesion themselves.
 #[inline(always)]
 pub fn hertz_mindlin<T: Real>(model: &ContactModel<T>) -> Option<ContactModel<T>> {
     let TangentialLaw::Mindlin { damping_ratio, .. } = model.tangential else { return None };
@@ -29,9 +33,9 @@ pub fn hertz_mindlin<T: Real>(model: &ContactModel<T>) -> Option<ContactModel<T>
         tangential: TangentialLaw::Mindlin { damping_ratio, stiffness: TangentialStiffness::Mindlin },
         rolling: RollingLaw::None,
         twisting: TwistingLaw::None,
-        cohesion: CohesionLaw::None,
+        cohesion: model.cohesion,
     };
-    (*model == fixed).then_some(fixed)
+    (*model == fixed).then_some(ContactModel { cohesion: CohesionLaw::None, ..fixed })
 }
 
 /// Three lanes of reals, one per component.
@@ -74,6 +78,8 @@ struct Inputs<T> {
     mu_s: [T; LANES],
     beta: [T; LANES],
     xi: V3s<T>,
+    /// Bridge volume (m^3), zero without cohesion.
+    v_b: [T; LANES],
 }
 
 /// What one lane group writes.
@@ -83,15 +89,23 @@ struct Outputs<T> {
     t_i: V3s<T>,
     t_j: V3s<T>,
     f_n: [T; LANES],
+    f_c: [T; LANES],
     clamped: [bool; LANES],
     sliding: [bool; LANES],
     xi: V3s<T>,
 }
 
 /// The pair pass for pairs `first..first + out.len()` under `model` (from [`hertz_mindlin`]);
-/// `hist` holds their tangential springs, three reals per pair.
+/// `hist` holds their tangential springs and, in capillary scenes, their bridge volumes
+/// (`ctx.slots.stride` reals per pair).
 #[inline(always)]
 pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
+    let (stride, xi0) = (ctx.slots.stride, ctx.slots.tangential);
+    let bridge = ctx.slots.layout.bridge.then_some(ctx.slots.bridge);
+    let capillary = match ctx.model.cohesion {
+        CohesionLaw::Capillary { kappa, theta, c } => Some((kappa, theta, c)),
+        CohesionLaw::None => None,
+    };
     let mut inp = Inputs {
         d: V3s::ZERO,
         r_i: [T::ZERO; LANES],
@@ -107,9 +121,10 @@ pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: 
         mu_s: [T::ZERO; LANES],
         beta: [T::ZERO; LANES],
         xi: V3s::ZERO,
+        v_b: [T::ZERO; LANES],
     };
-    let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], clamped: [false; LANES], sliding: [false; LANES], xi: V3s::ZERO };
-    for (g, (out, hist)) in out.chunks_mut(LANES).zip(hist.chunks_mut(3 * LANES)).enumerate() {
+    let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], f_c: [T::ZERO; LANES], clamped: [false; LANES], sliding: [false; LANES], xi: V3s::ZERO };
+    for (g, (out, hist)) in out.chunks_mut(LANES).zip(hist.chunks_mut(stride * LANES)).enumerate() {
         let base = first + g * LANES;
         // Load: the scattered reads, one pair at a time.
         for m in 0..out.len() {
@@ -124,7 +139,9 @@ pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: 
             inp.w_j.set(m, bj.omega);
             let c = &ctx.coeffs[pi.material as usize * ctx.n_materials + pj.material as usize];
             (inp.v_eff[m], inp.g_eff[m], inp.mu_s[m], inp.beta[m]) = (c.v_eff, c.g_eff, c.mu_s, c.beta);
-            inp.xi.set(m, Vec3::new(hist[3 * m], hist[3 * m + 1], hist[3 * m + 2]));
+            let h = &hist[stride * m..stride * (m + 1)];
+            inp.xi.set(m, Vec3::new(h[xi0], h[xi0 + 1], h[xi0 + 2]));
+            inp.v_b[m] = bridge.map_or(T::ZERO, |b| h[b]);
         }
         // Compute: every lane, touching or not, with no branch the compiler cannot turn into
         // a select (lanes past the end of a short last group recompute stale inputs, unstored).
@@ -138,21 +155,43 @@ pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: 
             let c = PairCoeffs { v_eff: inp.v_eff[m], g_eff: inp.g_eff[m], mu_s: inp.mu_s[m], beta: inp.beta[m], ..Default::default() };
             let mut h = History { tangential: inp.xi.get(m), ..Default::default() };
             let f = contact_force(model, &c, &geo, &kin, &Bodies::default(), &mut h, ctx.elapsed);
-            let f = if touching { f } else { ContactForce::default() };
+            let mut f = if touching { f } else { ContactForce::default() };
+            // A touching bridge pulls with f0 = -kappa sqrt(R_i R_j), added after the contact
+            // force as `contact_force` adds it.
+            if let Some((kappa, _, _)) = capillary {
+                let f_c = if touching && inp.v_b[m] > T::ZERO { -kappa * (inp.r_i[m] * inp.r_j[m]).sqrt() } else { T::ZERO };
+                f.f_c = f_c;
+                f.f_i += geo.n * f_c;
+                f.f_j -= geo.n * f_c;
+            }
             res.f_i.set(m, f.f_i);
             res.f_j.set(m, f.f_j);
             res.t_i.set(m, f.t_i);
             res.t_j.set(m, f.t_j);
             res.f_n[m] = f.f_n;
+            res.f_c[m] = f.f_c;
             res.clamped[m] = f.clamped;
             res.sliding[m] = f.regime == Regime::Sliding;
             res.xi.set(m, if touching { h.tangential } else { Vec3::ZERO });
         }
         // Store.
         for (m, o) in out.iter_mut().enumerate() {
-            *o = ContactForce { f_i: res.f_i.get(m), f_j: res.f_j.get(m), t_i: res.t_i.get(m), t_j: res.t_j.get(m), f_n: res.f_n[m], f_c: T::ZERO, clamped: res.clamped[m], regime: if res.sliding[m] { Regime::Sliding } else { Regime::Static } };
+            *o = ContactForce { f_i: res.f_i.get(m), f_j: res.f_j.get(m), t_i: res.t_i.get(m), t_j: res.t_j.get(m), f_n: res.f_n[m], f_c: res.f_c[m], clamped: res.clamped[m], regime: if res.sliding[m] { Regime::Sliding } else { Regime::Static } };
             let xi = res.xi.get(m);
-            hist[3 * m..3 * m + 3].copy_from_slice(&[xi.x, xi.y, xi.z]);
+            hist[stride * m + xi0..stride * m + xi0 + 3].copy_from_slice(&[xi.x, xi.y, xi.z]);
+        }
+        // Open pairs that hold a bridge: its force across the gap, as `pair_force` gives it.
+        if let Some((kappa, theta, c)) = capillary {
+            for (m, o) in out.iter_mut().enumerate() {
+                let d = inp.d.get(m);
+                let (dist2, reach) = (d.norm2(), inp.r_i[m] + inp.r_j[m]);
+                if dist2 >= reach * reach && inp.v_b[m] > T::ZERO {
+                    let dist = dist2.sqrt();
+                    let f_c = capillary_force(kappa, theta, c, inp.r_i[m], inp.r_j[m], inp.v_b[m], dist - reach);
+                    let n = d * (T::ONE / dist);
+                    *o = ContactForce { f_i: n * f_c, f_j: n * (-f_c), f_c, ..Default::default() };
+                }
+            }
         }
     }
 }
@@ -160,7 +199,8 @@ pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: 
 #[cfg(test)]
 mod tests {
     //! The lane kernel against the one-pair pass, bit for bit, on a dense, shaken,
-    //! periodic Hertz-Mindlin gas (touching and open pairs, sticking and slipping springs).
+    //! periodic Hertz-Mindlin gas (touching and open pairs, sticking and slipping springs),
+    //! dry and wet (bridges in contact and across gaps).
     use super::*;
     use crate::cpu::pair_force::pair_force;
     use crate::cpu::CpuEngine;
@@ -199,24 +239,32 @@ kind = "run"
 duration = 1.0e-3
 "#;
 
-    fn check<T: Real>() {
-        let mut scene = crate::scene::parse(std::path::Path::new("lanes_test.toml"), SCENE).unwrap();
+    /// The lane kernel against the one-pair pass on `SCENE` (wetted with its water content
+    /// first when `wet`), bit for bit.
+    fn check<T: Real>(wet: bool) {
+        let text = if wet { SCENE.replace("[[stage]]", "[[stage]]\nwater_content = 0.007").replace("[model]", "[model]\ncohesion = \"capillary\"") } else { SCENE.to_string() };
+        let mut scene = crate::scene::parse(std::path::Path::new("lanes_test.toml"), &text).unwrap();
         // Grown 10% after placement: a dense, jostling gas.
         scene.grains.radius.iter_mut().for_each(|r| *r *= 1.1);
         let mut e = CpuEngine::<T>::new(&scene).unwrap();
+        if let Some(v) = scene.stages[0].wet_volume {
+            e.wet(v).unwrap();
+        }
         e.advance(400).unwrap();
         let model = hertz_mindlin(&e.model).expect("the scene's model is Hertz-Mindlin");
         let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), periodic: e.periodic };
-        let n = e.pairs.len();
+        let (n, stride) = (e.pairs.len(), e.slots.stride);
         let (mut hist_one, mut hist_lanes) = (e.hist.clone(), e.hist.clone());
-        let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[3 * k..3 * k + 3])).collect();
+        let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[stride * k..stride * (k + 1)])).collect();
         let mut lanes = vec![ContactForce::default(); n];
         hertz_mindlin_block(&model, 0, &mut lanes, &mut hist_lanes, &e.pairs, &e.body, &e.prop, &ctx);
         let touching = one.iter().filter(|f| f.f_n > T::ZERO).count();
-        let springs = e.hist.chunks(3).filter(|s| s.iter().any(|x| *x != T::ZERO)).count();
-        println!("{}: {n} pairs, {touching} pushing, {springs} springs", T::NAME);
+        let springs = e.hist.chunks(stride).filter(|s| s[..3].iter().any(|x| *x != T::ZERO)).count();
+        let open_bridges = one.iter().filter(|f| f.f_n == T::ZERO && f.f_c < T::ZERO).count();
+        println!("{}: {n} pairs, {touching} pushing, {springs} springs, {open_bridges} bridges across a gap", T::NAME);
         assert!(touching > 100 && touching < n, "the gas must hold touching and open pairs");
         assert!(springs > 100, "the springs must have grown");
+        assert!(!wet || open_bridges > 10, "the wet gas must hold bridges across gaps");
         let bits = |f: &ContactForce<T>| [f.f_i, f.f_j, f.t_i, f.t_j].iter().flat_map(|v| [v.x, v.y, v.z]).chain([f.f_n, f.f_c]).map(|x| x.f64().to_bits()).chain([f.clamped as u64, f.regime as u64]).collect::<Vec<_>>();
         let first = (0..n).find(|&k| bits(&one[k]) != bits(&lanes[k]));
         assert_eq!(first, None, "forces differ at pair {first:?}");
@@ -226,11 +274,17 @@ duration = 1.0e-3
 
     #[test]
     fn lanes_give_the_one_pair_pass_bits_in_f64() {
-        check::<f64>();
+        check::<f64>(false);
     }
 
     #[test]
     fn lanes_give_the_one_pair_pass_bits_in_f32() {
-        check::<f32>();
+        check::<f32>(false);
+    }
+
+    #[test]
+    fn lanes_give_the_one_pair_pass_bits_with_liquid_bridges() {
+        check::<f64>(true);
+        check::<f32>(true);
     }
 }

@@ -41,7 +41,7 @@ pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &
     if dist2 >= reach * reach {
         ctx.slots.clear_springs(hist);
         return match ctx.model.cohesion {
-            CohesionLaw::Capillary { kappa, theta, c } if ctx.slots.layout.bridge => {
+            CohesionLaw::Capillary { kappa, theta, c } if ctx.slots.layout.bridge && hist[ctx.slots.bridge] > T::ZERO => {
                 let dist = dist2.sqrt();
                 let f_c = capillary_force(kappa, theta, c, pi.radius, pj.radius, hist[ctx.slots.bridge], dist - reach);
                 let n = d * (T::ONE / dist);
@@ -74,7 +74,7 @@ super::simd::dispatch! {
 fn pair_block_portable<T: Real>(first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
     let stride = ctx.slots.stride;
     if let Some(model) = super::lanes::hertz_mindlin(ctx.model) {
-        debug_assert!(stride == 3 && ctx.slots.tangential == 0, "Hertz-Mindlin keeps one spring per pair");
+        debug_assert!(!ctx.slots.layout.sliding && !ctx.slots.layout.rolling, "Hertz-Mindlin keeps one spring per pair");
         return super::lanes::hertz_mindlin_block(&model, first, out, hist, pairs, body, prop, ctx);
     }
     for (m, o) in out.iter_mut().enumerate() {

@@ -29,6 +29,7 @@ impl<T: Real> CpuEngine<T> {
                                 force_j: self.out[k].f_j.f64(),
                                 tangential_spring: springs.tangential.f64(),
                                 rolling_spring: springs.rolling.f64(),
+                                bridge_volume: springs.bridge.f64(),
                             }
                         })
                     })

@@ -11,6 +11,16 @@ pub fn rupture_distance<T: Real>(theta: T, v_b: T) -> T {
     (T::ONE + theta * T::of(0.5)) * v_b.powf(T::of(1.0 / 3.0))
 }
 
+/// Whether a gap `delta` (m) lies within the rupture distance of a bridge of volume `v_b`
+/// (m^3) at contact angle `theta` (rad): `delta <= delta_max`, tested as `delta^3 <=
+/// (1 + theta/2)^3 V_b` so that the check, made for every bridge at every evaluation, needs no
+/// cube root.
+#[inline(always)]
+pub fn within_rupture<T: Real>(theta: T, v_b: T, delta: T) -> bool {
+    let k = T::ONE + theta * T::of(0.5);
+    delta <= T::ZERO || delta * delta * delta <= k * k * k * v_b
+}
+
 /// `lambda = c / sqrt(2) sqrt((1/R_i + 1/R_j) / max(R_i/R_j, R_j/R_i) V_b)` (m), the decay
 /// length of the force across the gap (seed 001 eq. 8).
 #[inline(always)]
@@ -31,7 +41,7 @@ pub fn capillary_force<T: Real>(kappa: T, theta: T, c: T, r_i: T, r_j: T, v_b: T
     let f0 = -kappa * (r_i * r_j).sqrt();
     if delta < T::ZERO {
         f0
-    } else if delta <= rupture_distance(theta, v_b) {
+    } else if within_rupture(theta, v_b, delta) {
         f0 * (-(delta / decay_length(c, r_i, r_j, v_b))).exp()
     } else {
         T::ZERO
@@ -74,7 +84,7 @@ pub fn share_liquid(volume: f64, pairs: &[(f64, f64, f64)], cap: f64, theta: f64
         let total: f64 = eligible.iter().map(|&k| d[k]).sum();
         let share = |k: usize| (volume * d[k] / total).min(cap);
         let before = eligible.len();
-        eligible.retain(|&k| gaps[k] <= rupture_distance(theta, share(k)));
+        eligible.retain(|&k| within_rupture(theta, share(k), gaps[k]));
         if eligible.len() == before || eligible.is_empty() {
             break;
         }

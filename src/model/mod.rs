@@ -16,7 +16,7 @@ mod rolling;
 mod tangential;
 mod twisting;
 
-pub use capillary::{capillary_force, capillary_potential, decay_length, rupture_distance, share_liquid};
+pub use capillary::{capillary_force, capillary_potential, decay_length, rupture_distance, share_liquid, within_rupture};
 pub use geometry::{Bodies, Geometry, Kinematics};
 pub use normal::{normal_damping, normal_elastic, normal_force, normal_stiffness, restitution_beta};
 pub use rolling::rolling_sds;

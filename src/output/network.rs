@@ -1,9 +1,12 @@
 //! The force-transmission report of a packing: `analysis.json` and its pictures.
 
-use crate::analysis::network::{analyze, NetworkAnalysis};
+use crate::analysis::network::{analyze, force_density, forces_over, NetworkAnalysis};
+use crate::analysis::seed001;
+use crate::analysis::tail::TailFit;
 use crate::analysis::sample_bounds;
 use crate::engine::{Frame, Stats};
 use crate::model::CohesionLaw;
+use crate::output::plot::{self, Density, Tail};
 use crate::periodic::Periodic;
 use crate::scene::Scene;
 use anyhow::Context;
@@ -21,25 +24,46 @@ pub fn write(scene: &Scene, frame: &Frame, stats: &Stats, dir: &Path) -> anyhow:
     let path = dir.join("analysis.json");
     std::fs::write(&path, serde_json::to_string_pretty(&a)?).with_context(|| format!("cannot write {}", path.display()))?;
     let x_label = format!("normal force / ({})", a.force_scale_is);
-    // Tails drawn through the density at their start.
-    let density_at = |x: f64| a.force_pdf.x.iter().zip(&a.force_pdf.p).min_by(|p, q| (p.0 - x).abs().total_cmp(&(q.0 - x).abs())).map_or(1.0, |(_, p)| *p);
-    let mut tails = Vec::new();
-    let start = if f0.is_some() { 0.0 } else { 1.0 };
-    if let Some(t) = &a.tail_compressive {
-        tails.push((start, t.rate, density_at(start) * (t.rate * start).exp()));
-    }
-    if let Some(t) = &a.tail_tensile {
-        tails.push((-0.0, t.rate, density_at(-0.01)));
-    }
+    let tails = force_tails(&a, f0.is_some());
+    let densities = [Density { label: format!("{} (ours)", scene.name), pdf: &a.force_pdf }];
+    let pressures = [Density { label: format!("{} (ours)", scene.name), pdf: &a.pressure_pdf }];
     let drawn = [
-        crate::output::plot::pdf(&dir.join("force_pdf"), &format!("{}: normal forces", scene.name), &x_label, &a.force_pdf, &tails),
-        crate::output::plot::pdf(&dir.join("pressure_pdf"), &format!("{}: particle pressures", scene.name), "particle pressure / p0 = f0 / <d>^2", &a.pressure_pdf, &[]),
-        crate::output::plot::slices(&dir.join("force_network"), &dir.join("pressure_map"), &scene.name, frame, &a.pressures),
+        plot::pdf(&dir.join("force_pdf"), &format!("{}: normal forces", scene.name), &x_label, &densities, &tails),
+        plot::pdf(&dir.join("pressure_pdf"), &format!("{}: particle pressures", scene.name), "particle pressure / p0 = f0 / <d>^2", &pressures, &[]),
+        plot::slices(&dir.join("force_network"), &dir.join("pressure_map"), &scene.name, frame, &a.pressures),
     ];
     for e in drawn.into_iter().filter_map(Result::err) {
         eprintln!("warning: {e:#}");
     }
     Ok(a)
+}
+
+/// The fitted tails of a force PDF at the densities their fits give, and the paper's (seed
+/// 001: `beta` above the mean when dry, `alpha_w` on both sides of zero when wet) through the
+/// same points at the thresholds.
+fn force_tails(a: &NetworkAnalysis, wet: bool) -> Vec<Tail> {
+    let mut tails = Vec::new();
+    let sides: [(&Option<TailFit>, f64, &str); 2] = [(&a.tail_compressive, 1.0, "f > 0"), (&a.tail_tensile, -1.0, "f < 0")];
+    for (k, (fit, sign, side)) in sides.into_iter().enumerate() {
+        let Some(t) = fit else { continue };
+        let start = sign * t.threshold;
+        tails.push(Tail { start, rate: t.rate, amplitude: t.density_at(0.0), label: Some(format!("{side}: exp(-{:.2} |x|), fitted", t.rate)), published: false });
+        let rate = if wet { seed001::ALPHA_W } else { seed001::BETA };
+        // One legend entry for the paper's lines.
+        let label = (k == 0).then(|| format!("exp(-{rate} |x|), seed 001"));
+        tails.push(Tail { start, rate, amplitude: t.density_at(t.threshold) * (rate * t.threshold).exp(), label, published: true });
+    }
+    tails
+}
+
+/// Seed 001's Fig. 7: the force PDF of this run and of `other` (named `other_name`, its
+/// frame taken with contacts), both over this run's force scale, as `force_pdf_beside.png`
+/// and `.svg` in `dir`.
+pub fn write_beside(scene: &Scene, a: &NetworkAnalysis, other_name: &str, other: &Frame, dir: &Path) -> anyhow::Result<()> {
+    let theirs = force_density(&forces_over(other, a.force_scale));
+    let densities = [Density { label: scene.name.clone(), pdf: &a.force_pdf }, Density { label: other_name.to_string(), pdf: &theirs }];
+    let tails: Vec<Tail> = force_tails(a, scene.model.cohesion != CohesionLaw::None).into_iter().filter(|t| !t.published).collect();
+    plot::pdf(&dir.join("force_pdf_beside"), &format!("{} and {}: normal forces", scene.name, other_name), &format!("normal force / ({} of {})", a.force_scale_is, scene.name), &densities, &tails)
 }
 
 /// A few lines for a person.

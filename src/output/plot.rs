@@ -188,18 +188,49 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
     both(stem, (900, 640), |r| draw(r, title, points, law, paper), |r| draw(r, title, points, law, paper))
 }
 
-/// A PDF on a log-linear scale, with the fitted exponential tails drawn as lines.
-pub fn pdf(stem: &Path, title: &str, x_label: &str, pdf: &crate::analysis::network::Pdf, tails: &[(f64, f64, f64)]) -> anyhow::Result<()> {
-    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, x_label: &str, pdf: &crate::analysis::network::Pdf, tails: &[(f64, f64, f64)]) -> anyhow::Result<()>
+/// One probability density drawn by [`pdf`]: markers in its colour, labelled.
+pub struct Density<'a> {
+    /// Legend text.
+    pub label: String,
+    /// The density.
+    pub pdf: &'a crate::analysis::network::Pdf,
+}
+
+/// An exponential `P = amplitude exp(-rate |x|)` from `x = start` outward on the sign of
+/// `start` (`-0.0` for the negative side), drawn by [`pdf`]: solid for a fit, dashed for a
+/// published value.
+pub struct Tail {
+    /// Where it starts (in the normalised variable).
+    pub start: f64,
+    /// Its rate.
+    pub rate: f64,
+    /// Its density at `|x| = 0`.
+    pub amplitude: f64,
+    /// Legend text, if it has an entry.
+    pub label: Option<String>,
+    /// A published value rather than a fit.
+    pub published: bool,
+}
+
+/// Marker colours of the densities, in order.
+const DENSITY_COLOURS: [RGBColor; 3] = [BLACK, RED, MAGENTA];
+
+/// Probability densities on a log scale with exponential tails through them: `<stem>.png`,
+/// `<stem>.svg`.
+pub fn pdf(stem: &Path, title: &str, x_label: &str, densities: &[Density], tails: &[Tail]) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, x_label: &str, densities: &[Density], tails: &[Tail]) -> anyhow::Result<()>
     where
         DB::ErrorType: 'static,
     {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
         root.fill(&WHITE).map_err(err)?;
-        let pts: Vec<(f64, f64)> = pdf.x.iter().zip(&pdf.p).filter(|(_, p)| **p > 0.0).map(|(x, p)| (*x, *p)).collect();
-        let (x_lo, x_hi) = (pdf.x.first().copied().unwrap_or(0.0), pdf.x.last().copied().unwrap_or(1.0));
-        let p_hi = pts.iter().map(|q| q.1).fold(1e-3, f64::max) * 2.0;
-        let p_lo = pts.iter().map(|q| q.1).fold(f64::INFINITY, f64::min).min(p_hi / 10.0) / 2.0;
+        let points: Vec<Vec<(f64, f64)>> = densities.iter().map(|d| d.pdf.x.iter().zip(&d.pdf.p).filter(|(_, p)| **p > 0.0).map(|(x, p)| (*x, *p)).collect()).collect();
+        let all = || points.iter().flatten();
+        let x_lo = densities.iter().filter_map(|d| d.pdf.x.first().copied()).fold(f64::INFINITY, f64::min);
+        let x_hi = densities.iter().filter_map(|d| d.pdf.x.last().copied()).fold(f64::NEG_INFINITY, f64::max);
+        let (x_lo, x_hi) = if x_lo < x_hi { (x_lo, x_hi) } else { (0.0, 1.0) };
+        let p_hi = all().map(|q| q.1).fold(1e-3, f64::max) * 2.0;
+        let p_lo = all().map(|q| q.1).fold(f64::INFINITY, f64::min).min(p_hi / 10.0) / 2.0;
         let mut chart = ChartBuilder::on(root)
             .caption(title, ("sans-serif", 18))
             .margin(12)
@@ -208,19 +239,27 @@ pub fn pdf(stem: &Path, title: &str, x_label: &str, pdf: &crate::analysis::netwo
             .build_cartesian_2d(x_lo..x_hi, (p_lo..p_hi).log_scale())
             .map_err(err)?;
         chart.configure_mesh().x_desc(x_label).y_desc("probability density").draw().map_err(err)?;
-        chart.draw_series(pts.iter().map(|&(x, p)| Circle::new((x, p), 4, BLACK.filled()))).map_err(err)?;
-        // Each tail: P = amplitude exp(-rate |x|) from |x| = start on the sign of start.
-        for &(start, rate, amplitude) in tails {
-            let end = if start >= 0.0 { x_hi } else { x_lo };
-            let line: Vec<(f64, f64)> = (0..=50).map(|k| start + (end - start) * k as f64 / 50.0).map(|x| (x, amplitude * (-rate * x.abs()).exp())).filter(|q| q.1 > p_lo).collect();
-            chart.draw_series(LineSeries::new(line, &BLUE)).map_err(err)?.label(format!("exp(-{rate:.2} |x|)")).legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], BLUE));
+        for (k, (d, pts)) in densities.iter().zip(&points).enumerate() {
+            let colour = DENSITY_COLOURS[k % DENSITY_COLOURS.len()];
+            chart
+                .draw_series(pts.iter().map(|&(x, p)| Circle::new((x, p), 4, colour.filled())))
+                .map_err(err)?
+                .label(d.label.clone())
+                .legend(move |(x, y)| Circle::new((x + 8, y), 4, colour.filled()));
         }
-        if !tails.is_empty() {
-            chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
+        for t in tails {
+            let end = if t.start.is_sign_positive() { x_hi } else { x_lo };
+            let line: Vec<(f64, f64)> = (0..=50).map(|k| t.start + (end - t.start) * k as f64 / 50.0).map(|x| (x, t.amplitude * (-t.rate * x.abs()).exp())).filter(|q| q.1 > p_lo).collect();
+            let colour = if t.published { RGBColor(110, 110, 110) } else { BLUE };
+            let drawn = if t.published { chart.draw_series(DashedLineSeries::new(line, 6, 4, colour.into())) } else { chart.draw_series(LineSeries::new(line, colour)) }.map_err(err)?;
+            if let Some(label) = &t.label {
+                drawn.label(label.clone()).legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], colour));
+            }
         }
+        chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(err)?;
         Ok(())
     }
-    both(stem, (800, 600), |r| draw(r, title, x_label, pdf, tails), |r| draw(r, title, x_label, pdf, tails))
+    both(stem, (800, 600), |r| draw(r, title, x_label, densities, tails), |r| draw(r, title, x_label, densities, tails))
 }
 
 /// A slice of the packing, about three diameters thick across y through the middle, seen

@@ -113,6 +113,7 @@ impl GpuEngine {
                         force_j: xyz(&fj[k]),
                         tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
                         rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + self.history.tangential as usize]) } else { [0.0; 3] },
+                        bridge_volume: if self.history.bridge { hist[k * blocks as usize + self.history.tangential as usize + self.history.rolling as usize][0] as f64 } else { 0.0 },
                     })
                 })
                 .collect())
