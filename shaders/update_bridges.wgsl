@@ -1,12 +1,12 @@
-// One invocation walks the pair list in order (the CPU's update_bridges, serial so that a
-// grain forming several bridges in one evaluation gives its liquid out in a fixed order): a
-// bridge stretched beyond its rupture distance gives its liquid back to its two grains in
-// halves; a new contact takes half of each grain's liquid, capped at the largest bridge.
-// Liquid is conserved to round-off.
+// One invocation walks the pairs in order (the CPU's update_bridges, serial so that a grain
+// forming several bridges in one evaluation gives its liquid out in a fixed order), acting
+// only where find_bridge_events marked the pair: a bridge stretched beyond its rupture
+// distance gives its liquid back to its two grains in halves; a new contact takes half of
+// each grain's liquid, capped at the largest bridge. Liquid is conserved to round-off.
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> pair_i: array<u32>;
-@group(0) @binding(3) var<storage, read> pair_j: array<u32>;
+@group(0) @binding(1) var<storage, read> pair_i: array<u32>;
+@group(0) @binding(2) var<storage, read> pair_j: array<u32>;
+@group(0) @binding(3) var<storage, read> bridge_event: array<u32>;
 @group(0) @binding(4) var<storage, read_write> hist: array<vec4<f32>>;
 @group(0) @binding(5) var<storage, read_write> liquid: array<f32>;
 @group(0) @binding(6) var<storage, read> control: Control;
@@ -16,20 +16,19 @@ fn update_bridges() {
     // The bridge block is a contact's last.
     let last = params.hist_blocks - 1u;
     for (var k = 0u; k < control.n_pairs; k++) {
+        let event = bridge_event[k];
+        if (event == 0u) {
+            continue;
+        }
         let i = pair_i[k];
         let j = pair_j[k];
-        let d = min_image(pos[i].xyz - pos[j].xyz);
-        // The CPU's |d| - r_i - r_j, summed in its order.
-        let gap = sqrt(d.x * d.x + d.y * d.y + d.z * d.z) - pos[i].w - pos[j].w;
         let at = k * params.hist_blocks + last;
-        let v = hist[at].x;
-        if (v > 0.0) {
-            if (!within_rupture(v, gap)) {
-                liquid[i] += v * 0.5;
-                liquid[j] += v * 0.5;
-                hist[at] = vec4<f32>(0.0);
-            }
-        } else if (gap < 0.0 && (liquid[i] > 0.0 || liquid[j] > 0.0)) {
+        if (event == BRIDGE_RUPTURE) {
+            let v = hist[at].x;
+            liquid[i] += v * 0.5;
+            liquid[j] += v * 0.5;
+            hist[at] = vec4<f32>(0.0);
+        } else if (liquid[i] > 0.0 || liquid[j] > 0.0) {
             var a = liquid[i] * 0.5;
             var c = liquid[j] * 0.5;
             if (a + c > params.bridge_cap) {

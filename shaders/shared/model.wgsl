@@ -87,6 +87,11 @@ fn empty_history() -> History {
     return h;
 }
 
+// What update_bridges does at a pair (find_bridge_events marks it): its bridge ruptures, or
+// it touches without one and one forms if its grains hold liquid.
+const BRIDGE_RUPTURE: u32 = 1u;
+const BRIDGE_TOUCH: u32 = 2u;
+
 // Capillary bridges (src/model/capillary.rs): whether the gap delta (m) lies within the
 // rupture distance (1 + theta/2) V^(1/3) (m), tested on the cubes as the CPU does.
 fn within_rupture(v_b: f32, delta: f32) -> bool {

@@ -32,10 +32,10 @@ pub const STEPS_PER_SUBMIT: u64 = 16;
 
 /// Buffers a checkpoint leaves out: the scene's constants (set up again from the scene) and
 /// scratch space every step or statistics read rewrites before reading it.
-const NOT_STATE: [&str; 19] = [
+const NOT_STATE: [&str; 20] = [
     "params", "phase", "material", "coeffs", // constants
     "cell_of", "cell_grains", "cell_count", "cell_fill", "hash_sums", "grain_sums", "spare_sum", // the hash grid
-    "old_start", "old_j", "old_hist", "rev_fill", // rebuild scratch
+    "old_start", "old_j", "old_hist", "rev_fill", "bridge_event", // rebuild and bridge scratch
     "wall_partials", "grain_rows", "pair_rows", "stats", // reductions
 ];
 
@@ -355,9 +355,10 @@ impl GpuEngine {
     }
 
     /// The per-pair buffers and their bytes per pair.
-    fn pair_buffers(&self) -> [(&'static str, u64); 10] {
+    fn pair_buffers(&self) -> [(&'static str, u64); 11] {
         let blocks = self.params.hist_blocks as u64;
         [
+            ("bridge_event", if self.history.bridge { 4 } else { 0 }),
             ("pair_i", 4),
             ("pair_j", 4),
             ("old_j", 4),

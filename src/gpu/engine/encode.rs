@@ -73,10 +73,11 @@ impl GpuEngine {
         self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
     }
 
-    /// `update_bridges` (capillary scenes), `pair_force`, `wall_contacts` (+ `wall_reduce`),
+    /// `find_bridge_events` and `update_bridges` (capillary scenes), `pair_force`, `wall_contacts` (+ `wall_reduce`),
     /// `gather` (and the kick after it), with the durations of `phase`.
     pub(super) fn encode_forces(&self, pass: &mut wgpu::ComputePass, phase: Phase) {
         if self.history.bridge {
+            self.run(pass, "find_bridge_events", Size::Indirect(args::PAIRS), None);
             self.run(pass, "update_bridges", Size::One, None);
         }
         self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(phase));
