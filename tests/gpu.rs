@@ -219,8 +219,9 @@ fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
         "dry_iso_100pa.toml",
         "dry_triaxial.toml",
         "wet_iso_0pa.toml",
-        "wet_iso_0pa_wetted_packed.toml",
+        "wet_iso_0pa_wetted_loose.toml",
         "wet_iso_100pa.toml",
+        "wet_iso_100pa_wetted_loose.toml",
     ] {
         let scene = common::shipped(name);
         let Some(mut g) = common::gpu_engine(&scene) else { return };
@@ -327,40 +328,42 @@ fn liquid_bridges_on_the_gpu_form_and_break_as_on_the_cpu() {
     assert!(worst_x / d_mean < CAPILLARY_POSITION_TOLERANCE);
 }
 
-/// Seed 001's wet protocol through the host loop on both engines: 300 grains wetted loose,
-/// compacted by the servo box, released as the walls back off, then compacted again (every
-/// stage cut to 3 ms). At each stage end the GPU holds the same bridges as the CPU f32
+/// Seed 001's wet protocol through the host loop on both engines, in both preparations: 300
+/// grains compacted by the servo box and wetted as the walls back off, or wetted loose,
+/// compacted and released; then compacted again (every stage cut to 3 ms). At each stage end the GPU holds the same bridges as the CPU f32
 /// twin, the same liquid, and walls and energies within the f32 tolerances.
 #[test]
 fn the_wet_protocol_runs_on_the_gpu_as_on_the_cpu() {
     /// Wall positions after 3000 steps of servo control and capillary forces whose pow and exp
     /// differ by ulps between the backends, over the mean diameter.
     const WET_WALL_TOLERANCE: f64 = 1e-4;
-    let scene = common::parse(&common::edit(
-        &std::fs::read_to_string(common::scene_path("wet_iso_100pa.toml")).unwrap(),
-        &[("count = 8000", "count = 300"), ("max = [28.0e-3, 28.0e-3, 28.0e-3]", "max = [9.4e-3, 9.4e-3, 9.4e-3]"), ("duration = 1.0\n", "duration = 3.0e-3\n"), ("analysis = true", "analysis = false")],
-    ));
-    let Some(mut g) = common::gpu_engine(&scene) else { return };
-    let mut c: CpuEngine<f32> = common::engine(&scene);
-    let run = |e: &mut dyn Engine| grains::protocol::run(&scene, e, &mut grains::output::RunRecorder::new(None, false).unwrap()).unwrap();
-    let (rg, rc) = (run(&mut g), run(&mut c));
-    let d_mean = 2.0 * scene.grains.radius.iter().sum::<f64>() / scene.grains.len() as f64;
-    let wetting = scene.stages.iter().position(|s| s.wet_volume.is_some()).expect("a stage wets the sample");
-    let poured = scene.stages[wetting].wet_volume.unwrap();
-    for (k, (a, b)) in rg.iter().zip(&rc).enumerate() {
-        let (sa, sb) = (&a.stats, &b.stats);
-        let walls = sa.walls.iter().zip(&sb.walls).map(|(x, y)| (x.position.unwrap() - y.position.unwrap()).abs()).fold(0.0, f64::max);
-        println!(
-            "{}: {} / {} steps; bridges gpu {} cpu {}; liquid gpu {:.6e} cpu {:.6e} m^3; Z gpu {:.3} cpu {:.3}; walls differ by {:.2e} d; KE gpu {:.4e} cpu {:.4e}",
-            a.name, a.steps, b.steps, sa.bridges, sb.bridges, sa.liquid_in_bridges + sa.liquid_on_grains, sb.liquid_in_bridges + sb.liquid_on_grains,
-            sa.coordination, sb.coordination, walls / d_mean, sa.kinetic_energy(), sb.kinetic_energy()
-        );
-        assert_eq!(a.steps, b.steps, "{}", a.name);
-        assert_eq!(sa.bridges, sb.bridges, "{}: bridges", a.name);
-        assert!(walls / d_mean < WET_WALL_TOLERANCE, "{}: walls", a.name);
-        if k >= wetting {
-            assert!(sa.bridges > 0, "the sample is wet");
-            assert!(((sa.liquid_in_bridges + sa.liquid_on_grains) / poured - 1.0).abs() < 1e-6, "{}: liquid", a.name);
+    for name in ["wet_iso_100pa.toml", "wet_iso_100pa_wetted_loose.toml"] {
+        let scene = common::parse(&common::edit(
+            &std::fs::read_to_string(common::scene_path(name)).unwrap(),
+            &[("count = 8000", "count = 300"), ("max = [28.0e-3, 28.0e-3, 28.0e-3]", "max = [9.4e-3, 9.4e-3, 9.4e-3]"), ("duration = 1.0\n", "duration = 3.0e-3\n"), ("analysis = true", "analysis = false")],
+        ));
+        let Some(mut g) = common::gpu_engine(&scene) else { return };
+        let mut c: CpuEngine<f32> = common::engine(&scene);
+        let run = |e: &mut dyn Engine| grains::protocol::run(&scene, e, &mut grains::output::RunRecorder::new(None, false).unwrap()).unwrap();
+        let (rg, rc) = (run(&mut g), run(&mut c));
+        let d_mean = 2.0 * scene.grains.radius.iter().sum::<f64>() / scene.grains.len() as f64;
+        let wetting = scene.stages.iter().position(|s| s.wet_volume.is_some()).expect("a stage wets the sample");
+        let poured = scene.stages[wetting].wet_volume.unwrap();
+        for (k, (a, b)) in rg.iter().zip(&rc).enumerate() {
+            let (sa, sb) = (&a.stats, &b.stats);
+            let walls = sa.walls.iter().zip(&sb.walls).map(|(x, y)| (x.position.unwrap() - y.position.unwrap()).abs()).fold(0.0, f64::max);
+            println!(
+                "{name} {}: {} / {} steps; bridges gpu {} cpu {}; liquid gpu {:.6e} cpu {:.6e} m^3; Z gpu {:.3} cpu {:.3}; walls differ by {:.2e} d; KE gpu {:.4e} cpu {:.4e}",
+                a.name, a.steps, b.steps, sa.bridges, sb.bridges, sa.liquid_in_bridges + sa.liquid_on_grains, sb.liquid_in_bridges + sb.liquid_on_grains,
+                sa.coordination, sb.coordination, walls / d_mean, sa.kinetic_energy(), sb.kinetic_energy()
+            );
+            assert_eq!(a.steps, b.steps, "{name} {}", a.name);
+            assert_eq!(sa.bridges, sb.bridges, "{name} {}: bridges", a.name);
+            assert!(walls / d_mean < WET_WALL_TOLERANCE, "{name} {}: walls", a.name);
+            if k >= wetting {
+                assert!(sa.bridges > 0, "the sample is wet");
+                assert!(((sa.liquid_in_bridges + sa.liquid_on_grains) / poured - 1.0).abs() < 1e-6, "{name} {}: liquid", a.name);
+            }
         }
     }
 }
