@@ -47,16 +47,26 @@ pub const FIGURES: &[(&str, Reader)] = &[
     ("Z without rattlers", |_, a| a["coordination"]["without_rattlers"].as_f64()),
     ("rattler fraction", |_, a| a["coordination"]["rattlers"].as_f64()),
     ("solid fraction", |_, a| a["solid_fraction"].as_f64()),
+    ("liquid bridges per grain", |s, _| Some(last_stage(s)?["stats"]["bridges"].as_f64()? / s["grains"].as_f64()?)),
+    ("compressive forces below their mean", |_, a| a["below_mean"].as_f64()),
     ("compressive tail rate (beta or alpha_w)", |_, a| a["tail_compressive"]["rate"].as_f64()),
+    ("its maximum-likelihood standard error", |_, a| a["tail_compressive"]["error"].as_f64()),
     ("tensile tail rate alpha_w", |_, a| a["tail_tensile"]["rate"].as_f64()),
+    ("its maximum-likelihood standard error (tensile)", |_, a| a["tail_tensile"]["error"].as_f64()),
     ("positive pressure tail rate", |_, a| a["pressure_tail_positive"]["rate"].as_f64()),
     ("negative pressure tail rate", |_, a| a["pressure_tail_negative"]["rate"].as_f64()),
     ("mean pressure over p0", |_, a| Some(a["mean_pressure"].as_f64()? / a["pressure_scale"].as_f64()?)),
     ("positive phase percolates (x, y and z)", |_, a| percolates(&a["positive_phase"])),
     ("negative phase percolates (x, y and z)", |_, a| percolates(&a["negative_phase"])),
     ("fabric anisotropy", |_, a| a["fabric_anisotropy"].as_f64()),
+    ("last stage settled", |s, _| Some(if last_stage(s)?["settled"].as_bool()? { 1.0 } else { 0.0 })),
     ("wall time (s)", |s, _| s["wall_seconds"].as_f64()),
 ];
+
+/// The last stage's record in a summary.
+fn last_stage(summary: &Value) -> Option<&Value> {
+    summary["stages"].as_array()?.last()
+}
 
 /// The figures of the samples whose runs are given as `(summary, analysis)`; a figure no
 /// sample has is left out.
@@ -105,7 +115,7 @@ mod tests {
                 "mean_pressure": 50.0, "pressure_scale": 200.0,
                 "positive_phase": { "spans": spans },
             });
-            (serde_json::json!({ "wall_seconds": 10.0 * z }), analysis)
+            (serde_json::json!({ "wall_seconds": 10.0 * z, "grains": 100, "stages": [{ "settled": true, "stats": { "bridges": 150 } }] }), analysis)
         };
         let figures = gather(&[run(4.0, Some(2.0), [true; 3]), run(6.0, None, [true, false, true])]);
         let get = |name: &str| figures.iter().find(|f| f.name.starts_with(name)).unwrap_or_else(|| panic!("{name} gathered"));
@@ -114,6 +124,8 @@ mod tests {
         assert_eq!(get("mean pressure over p0").mean, 0.25);
         assert_eq!(get("positive phase percolates").values, vec![1.0, 0.0]);
         assert_eq!(get("wall time").mean, 50.0);
+        assert_eq!(get("liquid bridges per grain").values, vec![1.5, 1.5]);
+        assert_eq!(get("last stage settled").mean, 1.0);
         assert!(figures.iter().all(|f| !f.name.starts_with("negative phase")), "a figure no sample has is left out");
     }
 }
