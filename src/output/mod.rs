@@ -19,7 +19,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 /// The header of `stats.csv` and `stages.csv`, before the per-wall force columns.
-const STATS_COLUMNS: &str = "stage,step,time_s,ke_translational_J,ke_rotational_J,elastic_energy_J,gravity_energy_J,external_work_J,contacts,wall_contacts,coordination,clamped,sliding,rolling,max_overlap,unbalanced_force,rebuilds,piston_z_m,piston_pressure_Pa";
+const STATS_COLUMNS: &str = "stage,step,time_s,ke_translational_J,ke_rotational_J,elastic_energy_J,gravity_energy_J,external_work_J,contacts,wall_contacts,coordination,clamped,sliding,rolling,max_overlap,unbalanced_force,rebuilds,piston_z_m,piston_pressure_Pa,capillary_energy_J,bridges,liquid_in_bridges_m3,liquid_on_grains_m3";
 
 fn stats_header(s: &Stats) -> String {
     let mut h = STATS_COLUMNS.to_string();
@@ -34,7 +34,7 @@ fn stats_header(s: &Stats) -> String {
 fn stats_row(stage: &str, s: &Stats) -> String {
     let (pz, pp) = s.piston.as_ref().map_or((String::new(), String::new()), |p| (format!("{:e}", p.z), format!("{:e}", p.pressure)));
     let mut row = format!(
-        "{stage},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{:e},{},{pz},{pp}",
+        "{stage},{},{:e},{:e},{:e},{:e},{:e},{:e},{},{},{},{},{},{},{:e},{:e},{},{pz},{pp},{:e},{},{:e},{:e}",
         s.step,
         s.time,
         s.ke_translational,
@@ -50,7 +50,11 @@ fn stats_row(stage: &str, s: &Stats) -> String {
         s.rolling,
         s.max_overlap,
         s.unbalanced_force,
-        s.rebuilds
+        s.rebuilds,
+        s.capillary_energy,
+        s.bridges,
+        s.liquid_in_bridges,
+        s.liquid_on_grains
     );
     for w in &s.walls {
         row.push_str(&format!(",{:e},{:e},{:e}", w.force[0], w.force[1], w.force[2]));
