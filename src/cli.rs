@@ -164,6 +164,9 @@ pub enum Command {
         /// Write an sbatch job-array script (one task per point) into the out directory.
         #[arg(long)]
         emit_slurm: bool,
+        /// Run nothing: gather the points finished so far.
+        #[arg(long, conflicts_with_all = ["only", "emit_slurm"])]
+        gather: bool,
         /// Points run at once (default: all cores, one thread each).
         #[arg(long)]
         jobs: Option<usize>,

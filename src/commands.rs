@@ -78,7 +78,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Sweep { sweep, out, only, emit_slurm, jobs, threads, precision, json } => {
+        Command::Sweep { sweep, out, only, emit_slurm, gather, jobs, threads, precision, json } => {
             let sw = grains::sweep::load(&sweep)?;
             let out = out.unwrap_or_else(|| {
                 let stem = sweep.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "sweep".into());
@@ -97,6 +97,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             let points: Vec<usize> = match only {
                 Some(k) if k >= sw.points.len() => anyhow::bail!("--only {k}: the sweep has points 0 to {}; fix: give one of those", sw.points.len() - 1),
                 Some(k) => vec![k],
+                None if gather => Vec::new(),
                 None => sw.points.iter().filter(|p| !grains::sweep::done(&out, p)).map(|p| p.index).collect(),
             };
             let threads = threads.unwrap_or(if only.is_some() { cores } else { 1 });

@@ -1,5 +1,5 @@
 //! Sweeps: points run separately (`--only K`, as a cluster's job array would) are gathered by
-//! a plain `grains sweep`, which runs only what is missing; the table holds each point's
+//! `--gather` as they stand and by a plain `grains sweep`, which runs only what is missing; the table holds each point's
 //! parameters and fit; the Slurm script names one task per point.
 
 mod common;
@@ -46,6 +46,12 @@ fn points_run_apart_are_gathered_and_only_the_missing_one_runs() {
     assert!(!out.join("sweep.csv").exists(), "--only runs one point and gathers nothing");
     let stamp = |k: usize| std::fs::metadata(out.join(format!("point-{k:03}/summary.json"))).unwrap().modified().unwrap();
     let (t0, t2) = (stamp(0), stamp(2));
+
+    let only_gather = grains(&["sweep", s, "--out", o, "--gather", "--json"]);
+    assert!(only_gather.status.success(), "{}", String::from_utf8_lossy(&only_gather.stderr));
+    let partial: serde_json::Value = serde_json::from_slice(&only_gather.stdout).unwrap();
+    assert_eq!(partial["rows"][1]["note"].as_str(), Some("not run yet"), "--gather runs nothing: {}", partial["rows"][1]);
+    assert!(partial["rows"][0]["eta"]["value"].as_f64().is_some() && !out.join("point-001/summary.json").exists());
 
     let g = grains(&["sweep", s, "--out", o, "--json"]);
     assert!(g.status.success(), "{}", String::from_utf8_lossy(&g.stderr));
