@@ -29,6 +29,10 @@ pub struct TailFit {
     pub sensitivity: Vec<(f64, f64, f64)>,
 }
 
+/// `a l` beyond which a truncated exponential is fitted as a plain one (its truncation then
+/// moves the mean by less than `e^-700`), and the bracket of the truncated fit.
+const STEEP_IN_LENGTHS: f64 = 700.0;
+
 /// The rate and its standard error for the exceedances `y` (all >= 0) of an exponential, or of
 /// one truncated at `length` (`y <= length`).
 fn rate_of(y: &[f64], length: Option<f64>) -> Option<(f64, f64)> {
@@ -47,7 +51,12 @@ fn rate_of(y: &[f64], length: Option<f64>) -> Option<(f64, f64)> {
             if !(target > 0.0 && target < 1.0) {
                 return None;
             }
-            let (mut lo, mut hi) = (-700.0f64, 700.0f64);
+            // A tail that falls off within a small part of its length does not feel the
+            // bound: the plain exponential's estimate (h(t) -> 1/t).
+            if target < 1.0 / STEEP_IN_LENGTHS {
+                return rate_of(y, None);
+            }
+            let (mut lo, mut hi) = (-STEEP_IN_LENGTHS, STEEP_IN_LENGTHS);
             for _ in 0..200 {
                 let mid = 0.5 * (lo + hi);
                 if h(mid) > target { lo = mid } else { hi = mid }
