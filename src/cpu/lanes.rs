@@ -145,7 +145,7 @@ fn lanes<T: Real, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>
     for (w, (out, hist)) in out.chunks_mut(WINDOW).zip(hist.chunks_mut(STRIDE * WINDOW)).enumerate() {
         let base = first + w * WINDOW;
         let mut n_listed = 0;
-        for m in 0..out.len() {
+        for (m, is_open) in open[..out.len()].iter_mut().enumerate() {
             let keep = if SORT {
                 let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
                 let d = ctx.periodic.min_image(body[i].pos - body[j].pos);
@@ -156,7 +156,7 @@ fn lanes<T: Real, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>
             };
             listed[n_listed] = m as u16;
             n_listed += keep as usize;
-            open[m] = !keep;
+            *is_open = !keep;
         }
         if SORT {
             for m in (0..out.len()).filter(|&m| open[m]) {
