@@ -83,6 +83,10 @@ pub enum Command {
         /// Print one JSON summary object on stdout (and nothing else).
         #[arg(long)]
         json: bool,
+        /// Also write every frame as VTK files for ParaView into OUT/vtk (as
+        /// `output.vtk = true` does): open OUT/vtk/grains.pvd.
+        #[arg(long, requires = "out")]
+        vtk: bool,
         /// Worker threads (default: all cores). Results do not depend on it.
         #[arg(long)]
         threads: Option<usize>,

@@ -14,7 +14,7 @@ use std::path::Path;
 /// Runs one command.
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Run { scene, resume, backend, adapter, precision, out, json, threads, force } => {
+        Command::Run { scene, resume, backend, adapter, precision, out, json, vtk, threads, force } => {
             // The whole run happens on a worker of the pool, so that the CPU kernels' parallel
             // loops split work among workers instead of waking them from outside every time.
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start the worker threads")?;
@@ -25,7 +25,8 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 }
                 None => {
                     let path = scene.expect("clap requires a scene without --resume");
-                    let scene = scene::load(&path)?;
+                    let mut scene = scene::load(&path)?;
+                    scene.output.vtk |= vtk;
                     if !force {
                         scene.check_practical()?;
                     }

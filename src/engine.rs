@@ -236,6 +236,10 @@ pub struct Frame {
     /// Grain-wall contacts with their forces, when contacts are asked for.
     #[serde(default)]
     pub wall_contacts: Option<Vec<WallContactRecord>>,
+    /// Every wall's surface where it stands at this instant, in the scene's wall order (servo
+    /// walls and the piston move). Not recorded in MCAP frames.
+    #[serde(skip)]
+    pub walls: Vec<crate::walls::WallGeom<f64>>,
 }
 
 /// One touching pair.

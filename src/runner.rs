@@ -49,7 +49,7 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
         _ => RunRecorder::new(out, progress_bar)?,
     };
     let mut rec = match out {
-        Some(dir) => rec.with_checkpoints(dir, identity),
+        Some(dir) => rec.with_checkpoints(dir, identity).with_vtk(dir, scene, resumed_from.map(|_| engine.time()))?,
         None => rec,
     };
     let started = Instant::now();
@@ -105,7 +105,9 @@ pub fn resume(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, ad
     let (header, state): (CheckpointHeader, EngineState) = crate::checkpoint::read(&dir.join(crate::checkpoint::FILE))?;
     let id = &header.identity;
     let path = scene_file.map(Path::to_path_buf).unwrap_or_else(|| id.scene_file.clone().into());
-    let scene = scene::load(&path)?;
+    let mut scene = scene::load(&path)?;
+    // A run that wrote VTK files (`grains run --vtk`) goes on writing them.
+    scene.output.vtk |= dir.join(crate::output::vtk::DIR).join("grains.pvd").exists();
     let text = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
     if crate::checkpoint::fnv1a(&text) != id.scene_hash {
         anyhow::bail!("{}: the scene differs from the one the checkpoint in {} was written for; fix: restore the scene or start the run afresh", path.display(), dir.display());

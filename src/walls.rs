@@ -34,6 +34,15 @@ pub enum WallGeom<T> {
 }
 
 impl<T: Real> WallGeom<T> {
+    /// The same surface in `f64`, for frames.
+    pub fn f64(&self) -> WallGeom<f64> {
+        match *self {
+            WallGeom::Plane { point, normal } => WallGeom::Plane { point: Vec3::of(point.f64()), normal: Vec3::of(normal.f64()) },
+            WallGeom::Cylinder { cx, cy, radius } => WallGeom::Cylinder { cx: cx.f64(), cy: cy.f64(), radius: radius.f64() },
+            WallGeom::Piston { z } => WallGeom::Piston { z: z.f64() },
+        }
+    }
+
     /// The surface of a scene wall at its initial position.
     pub fn of(shape: &WallShape) -> Self {
         match *shape {

@@ -30,6 +30,7 @@ fn chain() -> Frame {
         orientation: None,
         contacts: Some(vec![rec(0, 1, 2.0), rec(1, 2, -0.5)]),
         wall_contacts: Some(vec![]),
+        walls: Vec::new(),
     }
 }
 

@@ -134,6 +134,30 @@ pub fn force_density(normalised: &[f64]) -> Pdf {
 /// The sample's box: lower and upper corners (m).
 pub type Bounds = ([f64; 3], [f64; 3]);
 
+/// The grains' particle stresses in a sample.
+pub struct ParticleStresses {
+    /// Each grain's sum of force (x) contact vector over its contacts (N m).
+    pub moments: Vec<Tensor>,
+    /// The sample's volume (m^3).
+    pub volume: f64,
+    /// Solid fraction of the sample (-).
+    pub solid_fraction: f64,
+    /// Each grain's pressure (Pa, compression positive): `-tr(sigma_i) / 3`, with
+    /// `sigma_i = moments_i / V_i` over the free volume `V_i = pi d^3 / (6 nu)`.
+    pub pressures: Vec<f64>,
+}
+
+/// Particle stresses of a frame taken with contacts, in the sample box `bounds`.
+pub fn particle_stresses(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds) -> ParticleStresses {
+    let (lo, hi) = bounds;
+    let volume: f64 = (0..3).map(|a| hi[a] - lo[a]).product();
+    let ball = |r: f64| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
+    let solid_fraction = frame.radius.iter().map(|&r| ball(r)).sum::<f64>() / volume;
+    let moments = contact_moments(frame, periodic);
+    let pressures = moments.iter().zip(&frame.radius).map(|(m, &r)| -(m[0][0] + m[1][1] + m[2][2]) / (3.0 * (ball(r) / solid_fraction))).collect();
+    ParticleStresses { moments, volume, solid_fraction, pressures }
+}
+
 /// Analyses a frame taken with contacts. `f0` is the largest capillary force `kappa R_max` of
 /// a wet packing (forces are then normalised by it), `None` for a dry one; `bounds` is the
 /// sample's box.
@@ -174,18 +198,7 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
         rattlers: rattlers as f64 / n as f64,
     };
 
-    // Particle stresses: sigma_i = moments_i / V_i with the free volume V_i = pi d^3 / (6 nu).
-    let (lo_b, hi_b) = bounds;
-    let volume: f64 = (0..3).map(|a| hi_b[a] - lo_b[a]).product();
-    let solid: f64 = frame.radius.iter().map(|r| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3)).sum();
-    let nu = solid / volume;
-    let moments = contact_moments(frame, periodic);
-    let pressures: Vec<f64> = (0..n)
-        .map(|i| {
-            let v_i = 4.0 / 3.0 * std::f64::consts::PI * frame.radius[i].powi(3) / nu;
-            -(moments[i][0][0] + moments[i][1][1] + moments[i][2][2]) / (3.0 * v_i)
-        })
-        .collect();
+    let ParticleStresses { moments, volume, solid_fraction: nu, pressures } = particle_stresses(frame, periodic, bounds);
     let mut macro_stress = [[0.0; 3]; 3];
     for m in &moments {
         for a in 0..3 {

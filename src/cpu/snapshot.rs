@@ -39,6 +39,7 @@ impl<T: Real> CpuEngine<T> {
                 let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic };
                 wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_hist)
             }),
+            walls: self.walls.iter().map(|w| w.geom.f64()).collect(),
         }
     }
 

@@ -6,6 +6,7 @@ pub mod mcap;
 pub mod network;
 pub mod plot;
 mod summary;
+pub mod vtk;
 
 pub use summary::{check_report, Summary, ESTIMATE_PAIRS_PER_GRAIN, PROFILE_POINTS};
 
@@ -104,6 +105,9 @@ pub struct RunRecorder {
     stats: Option<Csv>,
     stages: Option<Csv>,
     frames: Option<mcap::McapRecorder>,
+    /// Whether the MCAP frames keep the contacts the engine's frames carry.
+    mcap_contacts: bool,
+    vtk: Option<vtk::VtkRecorder>,
     bar: ProgressBar,
     bar_stage: String,
     /// Where checkpoints go and what they belong to.
@@ -127,7 +131,7 @@ impl RunRecorder {
             }
             None => (None, None, None),
         };
-        Ok(RunRecorder { stats, stages, frames, bar, bar_stage: String::new(), checkpoint: None })
+        Ok(RunRecorder { stats, stages, frames, mcap_contacts: true, vtk: None, bar, bar_stage: String::new(), checkpoint: None })
     }
 
     /// Continues the files of a run resumed from the checkpoint `header`: the CSV files are cut
@@ -153,6 +157,20 @@ impl RunRecorder {
         Ok(r)
     }
 
+    /// Also writes the frames of `scene` as VTK files under `dir/vtk` (continuing those of a run
+    /// resumed at simulated time `resumed_at`, s), when the scene asks for them; MCAP frames
+    /// keep contacts only when the scene asks for those.
+    pub fn with_vtk(mut self, dir: &Path, scene: &crate::scene::Scene, resumed_at: Option<f64>) -> anyhow::Result<Self> {
+        self.mcap_contacts = scene.output.contact_forces;
+        if scene.output.vtk {
+            self.vtk = Some(match resumed_at {
+                Some(t) => vtk::VtkRecorder::resume(dir, scene, t)?,
+                None => vtk::VtkRecorder::create(dir, scene)?,
+            });
+        }
+        Ok(self)
+    }
+
     /// Writes a checkpoint into `dir` whenever the host loop offers one.
     pub fn with_checkpoints(mut self, dir: &Path, identity: RunIdentity) -> Self {
         self.checkpoint = Some((dir.join(crate::checkpoint::FILE), identity));
@@ -174,13 +192,22 @@ impl RunRecorder {
 
 impl Recorder for RunRecorder {
     fn stats(&mut self, stage: &str, s: &Stats) -> anyhow::Result<()> {
+        if let Some(v) = &mut self.vtk {
+            v.stats(s);
+        }
         match &mut self.stats {
             Some(csv) => csv.row(stage, s),
             None => Ok(()),
         }
     }
     fn frame(&mut self, f: &Frame) -> anyhow::Result<()> {
+        if let Some(v) = &mut self.vtk {
+            v.write(f)?;
+        }
         match &mut self.frames {
+            Some(m) if !self.mcap_contacts && (f.contacts.is_some() || f.wall_contacts.is_some()) => {
+                m.write(&Frame { contacts: None, wall_contacts: None, ..f.clone() })
+            }
             Some(m) => m.write(f),
             None => Ok(()),
         }

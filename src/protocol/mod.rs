@@ -225,7 +225,7 @@ fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dy
         rec.stats(&stage.name, &stats)?;
         rec.progress(&stage.name, done, total);
         if let Some(t) = progress.next_frame.as_mut().filter(|t| engine.time() >= **t) {
-            rec.frame(&engine.frame(scene.output.contact_forces)?)?;
+            rec.frame(&engine.frame(scene.output.frames_with_contacts())?)?;
             *t += scene.output.frame_interval;
         }
         let pressure_reached = match (stage.piston_pressure, &stats.piston) {
@@ -253,7 +253,7 @@ fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dy
         }
     }
     if progress.next_frame.is_none() {
-        rec.frame(&engine.frame(scene.output.contact_forces)?)?;
+        rec.frame(&engine.frame(scene.output.frames_with_contacts())?)?;
     }
     let compression = if stage.records_compression { Some(CompressionPoint { seating: stage.seating, ..compression_point(scene, engine, &stats, settled)? }) } else { None };
     let result = StageResult {

@@ -130,6 +130,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         frame_interval: non_negative(&c, "output.frame_interval", f.output.frame_interval, "give seconds, or 0 for a frame per stage")?,
         contact_forces: f.output.contact_forces,
         analysis: f.output.analysis,
+        vtk: f.output.vtk,
         checkpoint_interval: non_negative(&c, "output.checkpoint_interval", f.output.checkpoint_interval.unwrap_or(DEFAULT_CHECKPOINT_INTERVAL), "give wall-clock seconds, or 0 for checkpoints at stage ends only")?,
     };
     let name = f.name.clone().unwrap_or_else(|| path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default());

@@ -431,6 +431,10 @@ pub struct OutputSpec {
     /// particle stresses, percolation, fabric) into `analysis.json` and pictures. Default false.
     #[serde(default)]
     pub analysis: bool,
+    /// Write every frame as VTK files for ParaView under `DIR/vtk` (grains, contacts and walls,
+    /// with a `.pvd` collection of each). Default false; `grains run --vtk` sets it too.
+    #[serde(default)]
+    pub vtk: bool,
     /// Wall-clock seconds between checkpoints inside a stage (besides the one at every stage
     /// end) when the run has `--out`; 0 checkpoints at stage ends only. Default
     /// [`crate::scene::DEFAULT_CHECKPOINT_INTERVAL`].

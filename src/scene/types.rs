@@ -204,6 +204,8 @@ pub struct Output {
     pub contact_forces: bool,
     /// Analyse the force transmission at the end of the run.
     pub analysis: bool,
+    /// Write frames as VTK files (`DIR/vtk`).
+    pub vtk: bool,
     /// Wall-clock seconds between checkpoints inside a stage; 0 for stage ends only.
     pub checkpoint_interval: f64,
 }
@@ -216,6 +218,14 @@ pub const DEFAULT_CHECKPOINT_INTERVAL: f64 = 600.0;
 /// thousand grains on a fast machine) a billion steps take 28 hours. `grains run` refuses
 /// more without `--force`.
 pub const PRACTICAL_STEPS: u64 = 1_000_000_000;
+
+impl Output {
+    /// Whether frames are taken with their contacts: for the MCAP recording when asked for,
+    /// and always for VTK files (their contact network and per-grain forces).
+    pub fn frames_with_contacts(&self) -> bool {
+        self.contact_forces || self.vtk
+    }
+}
 
 impl Stage {
     /// The stage's longest run in steps of `dt` (s).

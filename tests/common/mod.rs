@@ -75,3 +75,17 @@ pub fn wet_gas() -> Scene {
         ],
     ))
 }
+
+/// Whether an outside program the tests read files back with runs (`program args` exits 0).
+/// Without it CI fails (`.ci/run` installs it) and a developer machine skips the test with a
+/// visible message naming the package.
+pub fn reader(program: &str, args: &[&str], package: &str) -> bool {
+    let ok = std::process::Command::new(program).args(args).output().is_ok_and(|o| o.status.success());
+    if !ok {
+        if std::env::var_os("CI").is_some() {
+            panic!("CI must have {program} (Debian package {package}); .ci/run installs it");
+        }
+        eprintln!("SKIPPED ({program} from the Debian package {package} is not installed)");
+    }
+    ok
+}

@@ -30,6 +30,16 @@ fn cpu_history(blocks: &[[f32; 4]], slots: &crate::cpu::HistorySlots) -> Vec<f32
     out
 }
 
+/// A wall's surface as the GPU holds it.
+fn wall_geom(w: &layout::Wall) -> crate::walls::WallGeom<f32> {
+    let v3 = |a: [f32; 4]| crate::real::Vec3::new(a[0], a[1], a[2]);
+    match w.kind {
+        layout::wall_kind::PLANE => crate::walls::WallGeom::Plane { point: v3(w.point), normal: v3(w.normal) },
+        layout::wall_kind::CYLINDER => crate::walls::WallGeom::Cylinder { cx: w.point[0], cy: w.point[1], radius: w.normal[3] },
+        _ => crate::walls::WallGeom::Piston { z: w.point[2] },
+    }
+}
+
 impl GpuEngine {
     /// Grain-wall contacts re-evaluated on the host from the GPU's state (the CPU twin's
     /// function in f32), given the grain arrays `[pos, vel, omega, ..]` already read.
@@ -51,11 +61,7 @@ impl GpuEngine {
         let states: Vec<WallState<f32>> = walls
             .iter()
             .map(|w| WallState {
-                geom: match w.kind {
-                    layout::wall_kind::PLANE => crate::walls::WallGeom::Plane { point: v3(w.point), normal: v3(w.normal) },
-                    layout::wall_kind::CYLINDER => crate::walls::WallGeom::Cylinder { cx: w.point[0], cy: w.point[1], radius: w.normal[3] },
-                    _ => crate::walls::WallGeom::Piston { z: w.point[2] },
-                },
+                geom: wall_geom(w),
                 velocity: v3(w.velocity),
                 material: w.material,
             })
@@ -136,7 +142,18 @@ impl GpuEngine {
             orientation: self.track_orientation.then(|| arrays[3].iter().map(|q| [q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]).collect()),
             contacts: contact_records,
             wall_contacts: wall_records,
+            walls: self.walls_now()?,
         })
+    }
+
+    /// Every wall's surface where it stands now.
+    fn walls_now(&self) -> Result<Vec<crate::walls::WallGeom<f64>>, SimError> {
+        let n_walls = self.wall_names.len();
+        if n_walls == 0 {
+            return Ok(Vec::new());
+        }
+        let parts = self.read(&[("walls", 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64)])?;
+        Ok(bytemuck::cast_slice::<u32, layout::Wall>(&parts[0]).iter().map(|w| wall_geom(w).f64()).collect())
     }
 
     /// Wets the sample with `volume` (m^3) of liquid, as the CPU twin does.
