@@ -56,6 +56,15 @@ pub enum BenchPart {
     All,
 }
 
+/// Formats of `grains export`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ExportFormat {
+    /// LAMMPS data file, atom_style sphere (Atoms and Velocities sections).
+    LammpsData,
+    /// LAMMPS / LIGGGHTS dump custom text snapshot.
+    LammpsDump,
+}
+
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
@@ -101,6 +110,19 @@ pub enum Command {
     },
     /// List the GPU adapters with their backend and limits.
     Devices,
+    /// Write a finished run's last frame as a LAMMPS / LIGGGHTS file (SI units, `units si`):
+    /// a data file of atom_style sphere for read_data, or a dump custom text snapshot. Atom id
+    /// = grain id + 1, atom type = material index + 1 (the scene's [[material]] order).
+    Export {
+        /// The run's --out directory.
+        run: PathBuf,
+        /// File format.
+        #[arg(long, value_enum)]
+        format: ExportFormat,
+        /// The file to write (default: RUN/grains.data or RUN/grains.dump).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Analyse the force transmission of a finished run's last frame (recorded with
     /// `output.contact_forces = true`): force and pressure PDFs with their exponential tails,
     /// bonds by sign, particle stresses, bi-percolation, fabric; writes analysis.json and
@@ -120,6 +142,10 @@ pub enum Command {
     /// Measure: throughput on the peers' dense bed (poured once and cached, tiled in x-y for
     /// larger sizes) on each backend and precision, and speed against error on fixed scenes.
     Bench {
+        /// A scene whose grains are the bed instead of the pour, e.g. benches/bench_bed_lammps.toml
+        /// (LAMMPS' settled bed, read by `[[read]]`).
+        #[arg(long, value_name = "SCENE")]
+        bed: Option<PathBuf>,
         /// Grain counts of the throughput runs (multiples of 10,000), comma-separated.
         #[arg(long, value_delimiter = ',', default_values_t = [10_000usize, 100_000, 1_000_000])]
         sizes: Vec<usize>,

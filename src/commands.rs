@@ -1,6 +1,6 @@
 //! The subcommands' bodies.
 
-use crate::cli::{Backend, BenchBackend, BenchPart, Cli, Command, E0Choice, FitLaw, Precision};
+use crate::cli::{Backend, BenchBackend, BenchPart, Cli, Command, E0Choice, ExportFormat, FitLaw, Precision};
 use anyhow::Context;
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
@@ -44,6 +44,18 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                     report(&summary, json)
                 }
             }
+        }
+        Command::Export { run, format, out } => {
+            let (scene, frame) = run_and_last_frame(&run)?;
+            let atoms = grains::output::lammps::atoms(&scene, &frame);
+            let (text, default) = match format {
+                ExportFormat::LammpsData => (grains::lammps::data::write(&atoms, &format!("{} at t = {:e} s", scene.name, frame.time)), "grains.data"),
+                ExportFormat::LammpsDump => (grains::lammps::dump::write(&atoms), "grains.dump"),
+            };
+            let path = out.unwrap_or_else(|| run.join(default));
+            std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))?;
+            println!("wrote {}: {} atoms of {} types at t = {:e} s (time step {})", path.display(), atoms.len(), scene.materials.len(), frame.time, atoms.timestep);
+            Ok(())
         }
         Command::Check { scene } => {
             let scene = scene::load(&scene)?;
@@ -145,7 +157,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Bench { sizes, backend, adapter, precision, threads, work, repeats, part, cache, out, json } => {
+        Command::Bench { sizes, backend, adapter, precision, threads, work, repeats, part, cache, bed, out, json } => {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             let mut threads = if threads.is_empty() { vec![1, cores] } else { threads };
             threads.dedup();
@@ -168,6 +180,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 ladder: matches!(part, BenchPart::Ladder | BenchPart::All),
                 small: part == BenchPart::Small,
                 cache: cache.unwrap_or_else(grains::bench::bed::default_cache),
+                bed,
                 adapter,
                 progress: !json,
             };
@@ -211,12 +224,24 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
 }
 
 /// A progress bar on a terminal, not with --json.
-/// A finished run's summary, scene and last frame (which must hold the contact forces).
-fn finished_run(run: &Path) -> anyhow::Result<(serde_json::Value, Scene, grains::engine::Frame)> {
+/// A finished run's summary, scene and last frame.
+fn run_summary(run: &Path) -> anyhow::Result<(serde_json::Value, Scene, grains::engine::Frame)> {
     let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).with_context(|| format!("{}: no summary.json; fix: give the --out directory of a finished run", run.display()))?)?;
     let scene_file = summary["file"].as_str().with_context(|| format!("{}: summary.json names no scene file", run.display()))?;
     let scene = scene::load(Path::new(scene_file))?;
     let frame = grains::output::mcap::last_frame(&run.join("frames.mcap"))?;
+    Ok((summary, scene, frame))
+}
+
+/// A finished run's scene and last frame.
+fn run_and_last_frame(run: &Path) -> anyhow::Result<(Scene, grains::engine::Frame)> {
+    let (_, scene, frame) = run_summary(run)?;
+    Ok((scene, frame))
+}
+
+/// A finished run's summary, scene and last frame (which must hold the contact forces).
+fn finished_run(run: &Path) -> anyhow::Result<(serde_json::Value, Scene, grains::engine::Frame)> {
+    let (summary, scene, frame) = run_summary(run)?;
     if frame.contacts.is_none() {
         anyhow::bail!("{}: the frames hold no contact forces; fix: set output.contact_forces = true in the scene and run it again", run.display());
     }

@@ -12,6 +12,7 @@ pub mod cpu;
 pub mod engine;
 pub mod gpu;
 pub mod kernels;
+pub mod lammps;
 pub mod model;
 pub mod output;
 pub mod periodic;

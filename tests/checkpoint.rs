@@ -165,26 +165,28 @@ fn a_resumed_gpu_run_ends_bitwise_where_the_uninterrupted_one_does() {
 
 /// A run stopped inside a stage, with a statistics row written after its checkpoint (as a run
 /// killed between two checkpoints leaves), resumed from the command line: the same summary as
-/// the uninterrupted run, and the same `stats.csv` row for row.
+/// the uninterrupted run, the same `stats.csv` row for row, and (frames at an interval, with
+/// `--vtk`) the same VTK collection, whose last frame is the same bytes.
 #[test]
 fn grains_run_resume_continues_a_stopped_run_to_the_same_summary() {
-    let text = checkpointing_within_stages();
+    let text = format!("{}frame_interval = 2.5e-4\n", checkpointing_within_stages());
     let dir = tempfile::tempdir().unwrap();
     let scene_path = dir.path().join("scene.toml");
     std::fs::write(&scene_path, &text).unwrap();
     let grains = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_grains")).args(args).env("RUST_BACKTRACE", "0").output().unwrap();
     let whole = dir.path().join("whole");
-    let o = grains(&["run", scene_path.to_str().unwrap(), "--out", whole.to_str().unwrap(), "--json"]);
+    let o = grains(&["run", scene_path.to_str().unwrap(), "--out", whole.to_str().unwrap(), "--json", "--vtk"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let full: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
 
     // The library run, recording where the command line expects it, stopped at a checkpoint
     // inside the second stage.
     let cut = dir.path().join("cut");
-    let scene = grains::scene::load(&scene_path).unwrap();
+    let mut scene = grains::scene::load(&scene_path).unwrap();
+    scene.output.vtk = true;
     let mut e: CpuEngine<f64> = CpuEngine::new(&scene).unwrap();
     let id = RunIdentity { scene_file: scene_path.display().to_string(), scene_hash: grains::checkpoint::fnv1a(text.as_bytes()), backend: "cpu".into(), precision: "f64".into() };
-    let mut stopper = StopAt::new(RunRecorder::new(Some(&cut), false).unwrap().with_checkpoints(&cut, id), 28);
+    let mut stopper = StopAt::new(RunRecorder::new(Some(&cut), false).unwrap().with_checkpoints(&cut, id).with_vtk(&cut, &scene, None).unwrap(), 28);
     let err = protocol::run(&scene, &mut e, &mut stopper).unwrap_err();
     assert!(err.to_string().contains("stage 1, inside it: true"), "{err}");
     stopper.inner.finish().unwrap();
@@ -201,6 +203,20 @@ fn grains_run_resume_continues_a_stopped_run_to_the_same_summary() {
     let rows = |d: &std::path::Path| std::fs::read_to_string(d.join("stats.csv")).unwrap();
     assert_eq!(rows(&whole), rows(&cut), "the resumed CSV continues the stopped one row for row");
     assert!(cut.join(format!("frames-from-stage1-step{}.mcap", e.steps())).exists(), "frames after the resume go to their own file");
+    let collection = |d: &std::path::Path| {
+        let text = std::fs::read_to_string(d.join("vtk/grains.pvd")).unwrap();
+        let entries: Vec<(String, String)> = text
+            .lines()
+            .filter_map(|l| Some((l.split("timestep=\"").nth(1)?.split('"').next()?.to_string(), l.split("file=\"").nth(1)?.split('"').next()?.to_string())))
+            .collect();
+        entries
+    };
+    let (a, b) = (collection(&whole), collection(&cut));
+    assert!(a.len() >= 20, "{} frames", a.len());
+    let times = |c: &[(String, String)]| c.iter().map(|e| e.0.clone()).collect::<Vec<_>>();
+    assert_eq!(times(&a), times(&b), "the resumed collection lists the uninterrupted run's frame times");
+    let last = |d: &std::path::Path, c: &[(String, String)]| std::fs::read(d.join("vtk").join(&c.last().unwrap().1)).unwrap();
+    assert!(last(&whole, &a) == last(&cut, &b), "the last frame's grain file is the same bytes");
 
     // A changed scene is refused.
     std::fs::write(&scene_path, text.replace("seed = 21", "seed = 22")).unwrap();

@@ -277,6 +277,15 @@ fn servo_walls_on_the_gpu_follow_the_cpu_twin() {
         assert!(worst_p < SERVO_PRESSURE_TOLERANCE, "{leg}: wall pressures");
         assert!((sg.external_work - sc.external_work).abs() <= F32_STATS_TOLERANCE * sc.external_work.abs(), "{leg}: the walls' work");
         assert!((sg.kinetic_energy() - sc.kinetic_energy()).abs() <= F32_STATS_TOLERANCE * sc.kinetic_energy(), "{leg}: kinetic energy");
+        // The frames (what the VTK files draw) hold each servo plane where the statistics put it.
+        for (e, stats) in [(&*g as &dyn Engine, &sg), (&*c, &sc)] {
+            let frame = e.frame(false).unwrap();
+            for (w, s) in frame.walls.iter().zip(&stats.walls) {
+                let (grains::walls::WallGeom::Plane { point, normal }, Some(at)) = (w, s.position) else { continue };
+                let along = point.x * normal.x.abs() + point.y * normal.y.abs() + point.z * normal.z.abs();
+                assert_eq!(along, at, "{leg}: {} in the {} frame", s.name, e.backend());
+            }
+        }
     };
     for e in [&mut g as &mut dyn Engine, &mut c] {
         e.set_servo(Some(100.0), None);

@@ -33,6 +33,9 @@ pub struct BedInfo {
     pub coordination: f64,
     /// Wall seconds the pour took.
     pub wall_seconds: f64,
+    /// The scene file the bed was read from (`grains bench --bed`), or empty for the pour.
+    #[serde(default)]
+    pub source: String,
 }
 
 /// The default cache folder: `$XDG_CACHE_HOME/grains`, else `$HOME/.cache/grains`, else
@@ -82,6 +85,7 @@ pub fn settled_bed(cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedIn
         ke_per_grain: last.ke_per_grain,
         coordination: last.stats.coordination,
         wall_seconds: started.elapsed().as_secs_f64(),
+        source: String::new(),
     };
     let periodic = Periodic::<f64>::of(&scene.periodic);
     let body = engine.bodies();
@@ -96,6 +100,26 @@ pub fn settled_bed(cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedIn
     std::fs::create_dir_all(cache).with_context(|| format!("cannot create the cache folder {}", cache.display()))?;
     checkpoint::write(&path, &info, &state)?;
     scene.grains = in_cell_order(&scene.grains);
+    Ok((scene, info))
+}
+
+/// A bed given as a scene file (e.g. one whose `[[read]]` takes LAMMPS' settled bed), renumbered
+/// in cell order as the poured bed is: its contacts per grain at the start, from one
+/// statistics read of a CPU f64 engine.
+pub fn given_bed(path: &Path) -> anyhow::Result<(Scene, BedInfo)> {
+    let mut scene = scene::load(path)?;
+    scene.grains = in_cell_order(&scene.grains);
+    let stats = crate::engine::Engine::stats(&mut CpuEngine::<f64>::new(&scene)?)?;
+    let n = scene.grains.len() as f64;
+    let info = BedInfo {
+        scene_hash: checkpoint::fnv1a(&std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?),
+        time: 0.0,
+        settled: true,
+        ke_per_grain: stats.ke_translational / n,
+        coordination: stats.coordination,
+        wall_seconds: 0.0,
+        source: path.display().to_string(),
+    };
     Ok((scene, info))
 }
 

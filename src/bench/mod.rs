@@ -39,6 +39,9 @@ pub struct BenchOptions {
     pub small: bool,
     /// Where the poured bed is cached.
     pub cache: PathBuf,
+    /// A scene whose grains are the bed, in place of the pour (e.g. LAMMPS' settled bed read
+    /// by `[[read]]`).
+    pub bed: Option<PathBuf>,
     /// GPU adapter name (substring); the best one when absent.
     pub adapter: Option<String>,
     /// Print progress on stderr.
@@ -108,7 +111,10 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
         }
     };
     let all = pool(0)?;
-    let (base, bed) = all.install(|| bed::settled_bed(&opts.cache, opts.progress))?;
+    let (base, bed) = match &opts.bed {
+        Some(path) => all.install(|| bed::given_bed(path))?,
+        None => all.install(|| bed::settled_bed(&opts.cache, opts.progress))?,
+    };
     let machine = machine();
     let mut rows = Vec::new();
     if opts.throughput {
@@ -182,13 +188,17 @@ impl BenchReport {
     pub fn human(&self) -> String {
         let m = &self.machine;
         let mut s = format!("machine: {} ({} cores; build features: {}; hot loops at level {})\n", m.cpu, m.cores, if m.build_features.is_empty() { "baseline".to_string() } else { m.build_features.join(", ") }, m.simd_level);
-        s.push_str(&format!(
-            "bed: the peers' pour, {:.3} s simulated ({}), Z = {:.3} at the end, poured in {:.0} s once and cached\n",
-            self.bed.time,
-            if self.bed.settled { "settled" } else { "not settled" },
-            self.bed.coordination,
-            self.bed.wall_seconds
-        ));
+        if self.bed.source.is_empty() {
+            s.push_str(&format!(
+                "bed: the peers' pour, {:.3} s simulated ({}), Z = {:.3} at the end, poured in {:.0} s once and cached\n",
+                self.bed.time,
+                if self.bed.settled { "settled" } else { "not settled" },
+                self.bed.coordination,
+                self.bed.wall_seconds
+            ));
+        } else {
+            s.push_str(&format!("bed: the grains of {}, Z = {:.3} as read\n", self.bed.source, self.bed.coordination));
+        }
         if !self.throughput.is_empty() {
             s.push_str("\nthroughput (dense settled bed, Hertz-Mindlin, dt = 2e-6 s)\n");
             s.push_str("backend prec thr    grains  particle-steps/s  spread  ns/p-step     Z  pairs/grain  B/grain  peak RSS MiB  time shares\n");

@@ -2,6 +2,7 @@
 //! `frames.mcap` (see [`mcap`]), `summary.json` (the `--json` object), and a progress bar
 //! on a terminal.
 
+pub mod lammps;
 pub mod mcap;
 pub mod network;
 pub mod plot;

@@ -25,6 +25,16 @@ pub enum SceneError {
         /// How to fix it.
         fix: String,
     },
+    /// A grain file named by `[[read]]` was refused.
+    #[error("{file}: {key}: {source}")]
+    GrainFile {
+        /// Scene file.
+        file: PathBuf,
+        /// The `[[read]]` table, e.g. `read[0].file`.
+        key: String,
+        /// What is wrong in the grain file.
+        source: Box<crate::lammps::FileError>,
+    },
     /// A value is out of range or inconsistent with the rest of the scene.
     #[error("{file}: {key} = {value}: {problem}; fix: {fix}")]
     Invalid {

@@ -3,6 +3,7 @@
 
 mod error;
 mod generate;
+mod read;
 pub mod schema;
 pub mod types;
 
@@ -77,20 +78,27 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         let w = finite3(&c, &key("angular_velocity"), g.angular_velocity)?;
         grains.push(r, sphere_mass(r, rho), p, v, w, m);
     }
+    let mut origins = Origins { listed: grains.len(), blocks: Vec::new() };
+    for (k, spec) in f.reads.iter().enumerate() {
+        let n = read::grains(&c, k, spec, &materials, &material_of, &mut grains, &mut warnings)?;
+        origins.blocks.push((format!("read[{k}]"), n, true));
+    }
     let walls = validate_walls(&c, &f, &material_of)?;
     for (k, spec) in f.generators.iter().enumerate() {
         let key = |s: &str| format!("generate[{k}].{s}");
         let m = material_of(key("material"), &spec.material)?;
         let rho = grain_density(key("material"), m)?;
+        let before = grains.len();
         generate::place(&c, k, spec, m, rho, seed, &periodic, &mut grains)?;
+        origins.blocks.push((format!("generate[{k}]"), grains.len() - before, false));
     }
     if grains.is_empty() {
         return Err(c.invalid("grain", "[]", "the scene has no grains", "add [[grain]] or [[generate]] tables"));
     }
     let servo = servo_box(&walls);
     let walls = finish_walls(&c, walls, &grains, &periodic)?;
-    check_overlaps(&c, &f, &grains, &walls)?;
-    check_periodic(&c, &f, &grains, &periodic, f.simulation.skin)?;
+    check_overlaps(&c, &origins, &grains, &walls)?;
+    check_periodic(&c, &origins, &grains, &periodic, f.simulation.skin)?;
 
     let model = validate_model(&c, &f.model, &materials, &grains, &walls)?;
     let sim = &f.simulation;
@@ -427,7 +435,7 @@ fn validate_periodic(c: &Complainer, f: &SceneFile) -> Result<[Option<[f64; 2]>;
 
 /// A periodic axis must hold its grains and be long enough that a pair within reach has one
 /// image only: period > 2 (2 R_max + skin).
-fn check_periodic(c: &Complainer, f: &SceneFile, grains: &Grains, periodic: &[Option<[f64; 2]>; 3], skin: Option<f64>) -> Result<(), SceneError> {
+fn check_periodic(c: &Complainer, origins: &Origins, grains: &Grains, periodic: &[Option<[f64; 2]>; 3], skin: Option<f64>) -> Result<(), SceneError> {
     let r_max = grains.radius.iter().copied().fold(0.0, f64::max);
     let d_mean = 2.0 * grains.radius.iter().sum::<f64>() / grains.len() as f64;
     let reach = 2.0 * r_max + skin.unwrap_or(0.1 * d_mean);
@@ -437,34 +445,64 @@ fn check_periodic(c: &Complainer, f: &SceneFile, grains: &Grains, periodic: &[Op
             return Err(c.invalid(format!("periodic.{name}"), format!("[{lo}, {hi}]"), format!("a period of {:.4e} m is too short for contacts of reach {reach:.4e} m", hi - lo), format!("make the period longer than {:.4e} m", 2.0 * reach)));
         }
         if let Some(i) = (0..grains.len()).find(|&i| !(grains.position[i][a] >= lo && grains.position[i][a] < hi)) {
-            let key = if i < f.grains.len() { format!("grain[{i}].position") } else { "generate.region".to_string() };
-            return Err(c.invalid(key, format!("{:?}", grains.position[i]), format!("lies outside periodic.{name} = [{lo}, {hi})"), "place grains inside the periodic interval"));
+            return Err(c.invalid(origins.name(i), format!("{:?}", grains.position[i]), format!("lies outside periodic.{name} = [{lo}, {hi})"), "place grains inside the periodic interval"));
         }
     }
     Ok(())
 }
 
-/// Grains may not start overlapping a wall or (listed grains) each other: the first step
-/// would release the stored energy at once.
-fn check_overlaps(c: &Complainer, f: &SceneFile, grains: &Grains, walls: &[Wall]) -> Result<(), SceneError> {
-    let listed = f.grains.len();
-    let origin = |i: usize| {
-        if i < listed {
-            format!("grain[{i}].position")
-        } else {
-            let mut k = i - listed;
-            let mut g = 0;
-            while k >= f.generators[g].count {
-                k -= f.generators[g].count;
-                g += 1;
-            }
-            format!("generate[{g}] grain {k}")
+/// Where each grain of a scene came from, for messages: the `[[grain]]` tables first, then
+/// blocks of `[[read]]` and `[[generate]]` grains.
+struct Origins {
+    /// Grains listed one by one.
+    listed: usize,
+    /// (table, grains, read from a file) in order.
+    blocks: Vec<(String, usize, bool)>,
+}
+
+impl Origins {
+    /// `grain[3].position`, `read[0] grain 41` or `generate[1] grain 7`.
+    fn name(&self, i: usize) -> String {
+        if i < self.listed {
+            return format!("grain[{i}].position");
         }
-    };
+        let mut k = i - self.listed;
+        for (table, n, _) in &self.blocks {
+            if k < *n {
+                return format!("{table} grain {k}");
+            }
+            k -= n;
+        }
+        format!("grain {i}")
+    }
+
+    /// Whether grain `i` was read from a file (a packing that may rest on its walls).
+    fn read(&self, i: usize) -> bool {
+        let mut k = i.saturating_sub(self.listed);
+        i >= self.listed
+            && self.blocks.iter().any(|(_, n, read)| {
+                let here = k < *n;
+                k = k.saturating_sub(*n);
+                here && *read
+            })
+    }
+}
+
+/// Overlap with a wall (fraction of the radius) that a grain read from a file may start with:
+/// a settled packing rests on its floor with overlaps of about 1e-3 of a radius.
+const READ_WALL_OVERLAP: f64 = 0.01;
+
+/// Grains may not start overlapping a wall (grains read from a file: by more than
+/// [`READ_WALL_OVERLAP`]) or (listed grains) each other: the first step would release the
+/// stored energy at once.
+fn check_overlaps(c: &Complainer, origins: &Origins, grains: &Grains, walls: &[Wall]) -> Result<(), SceneError> {
+    let listed = origins.listed;
+    let origin = |i: usize| origins.name(i);
     for i in 0..grains.len() {
         for w in walls {
             let d = wall_distance(&w.shape, grains.position[i]);
-            if d < grains.radius[i] {
+            let allowed = if origins.read(i) { READ_WALL_OVERLAP * grains.radius[i] } else { 0.0 };
+            if d < grains.radius[i] - allowed {
                 return Err(c.invalid(
                     origin(i),
                     format!("{:?}", grains.position[i]),

@@ -21,6 +21,9 @@ pub struct SceneFile {
     /// `[[grain]]` tables: grains given one by one.
     #[serde(default, rename = "grain")]
     pub grains: Vec<GrainSpec>,
+    /// `[[read]]` tables: grains read from a LAMMPS / LIGGGHTS file.
+    #[serde(default, rename = "read")]
+    pub reads: Vec<ReadSpec>,
     /// `[[generate]]` tables: grains placed at random.
     #[serde(default, rename = "generate")]
     pub generators: Vec<GeneratorSpec>,
@@ -91,6 +94,21 @@ pub struct GrainSpec {
     /// Angular velocity (rad/s). Default 0.
     #[serde(default)]
     pub angular_velocity: [f64; 3],
+}
+
+/// `[[read]]`: grains from a LAMMPS data file (`atom_style sphere`) or a LAMMPS / LIGGGHTS
+/// text dump (`dump custom`), in SI units (`units si`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReadSpec {
+    /// The file, relative to the scene file's folder.
+    pub file: String,
+    /// "lammps-data" or "lammps-dump".
+    pub format: String,
+    /// Material name of each atom type, e.g. `{ 1 = "sand", 2 = "glass" }`.
+    pub types: std::collections::BTreeMap<String, String>,
+    /// "lammps-dump": the time step whose snapshot to read. Default: the last.
+    pub step: Option<u64>,
 }
 
 /// `[[generate]]`: grains of one material placed at random without overlap in a region.

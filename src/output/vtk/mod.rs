@@ -22,6 +22,8 @@
 mod walls;
 pub mod xml;
 
+pub use walls::domain;
+
 use crate::analysis::network::particle_stresses;
 use crate::analysis::sample_bounds;
 use crate::engine::{Frame, Stats};

@@ -13,7 +13,7 @@ const CIRCLE_SIDES: usize = 64;
 
 /// The domain's box (lower, upper corner, m): the grains' extent, the periodic intervals, the
 /// axis-aligned planes and the cylinder's footprint.
-fn domain(scene: &Scene, f: &Frame) -> ([f64; 3], [f64; 3]) {
+pub fn domain(scene: &Scene, f: &Frame) -> ([f64; 3], [f64; 3]) {
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     let mut include = |a: usize, x: f64| {
         lo[a] = lo[a].min(x);
