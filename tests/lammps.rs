@@ -5,6 +5,8 @@
 //! * grains exports a run (`grains export`) as a data file and a dump; LAMMPS reads them
 //!   (`read_data`, then `read_dump` over displaced atoms) and writes what it holds
 //!   (`write_data`), which equals the frame to the bit.
+//! * LIGGGHTS (Debian's `liggghts`) reads the exported data file and its dump reads back as
+//!   the frame's grains, to the bit.
 //! * Malformed files get one line naming the file, the line and the column.
 
 mod common;
@@ -157,13 +159,8 @@ fn lammps_wrote(path: &Path) -> grains::lammps::Atoms {
     grains::lammps::data::read(path).unwrap_or_else(|e| panic!("{e}"))
 }
 
-#[test]
-fn lammps_reads_back_the_data_file_and_the_dump_grains_exports() {
-    if !has_lammps() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let d = dir.path();
+/// Runs [`RUN`] in `d` and exports its last frame as `ours.data` and `ours.dump`.
+fn exported_run(d: &Path) -> (Scene, grains::engine::Frame) {
     std::fs::write(d.join("run.toml"), RUN).unwrap();
     let grains = |args: &[&str]| {
         let o = Command::new(env!("CARGO_BIN_EXE_grains")).args(args).current_dir(d).output().unwrap();
@@ -172,8 +169,19 @@ fn lammps_reads_back_the_data_file_and_the_dump_grains_exports() {
     grains(&["run", "run.toml", "--out", "out"]);
     grains(&["export", "out", "--format", "lammps-data", "--out", "ours.data"]);
     grains(&["export", "out", "--format", "lammps-dump", "--out", "ours.dump"]);
-    let scene = scene::load(&d.join("run.toml")).unwrap();
     let frame = grains::output::mcap::last_frame(&d.join("out/frames.mcap")).unwrap();
+    assert!(frame.velocity.iter().any(|v| v.iter().any(|x| *x != 0.0)), "the frame holds motion to compare");
+    (scene::load(&d.join("run.toml")).unwrap(), frame)
+}
+
+#[test]
+fn lammps_reads_back_the_data_file_and_the_dump_grains_exports() {
+    if !has_lammps() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (scene, frame) = exported_run(d);
     let step = (frame.time / scene.time_step.dt).round() as u64;
     // LAMMPS reads our data file and writes what it holds; then, with every atom moved and
     // stopped, reads our dump's positions and velocities back over them and writes again.
@@ -210,7 +218,39 @@ fn lammps_reads_back_the_data_file_and_the_dump_grains_exports() {
         assert_eq!(b.position[kb], frame.position[i], "grain {g}: position after read_dump");
         assert_eq!(b.velocity[kb], frame.velocity[i], "grain {g}: velocity after read_dump");
     }
-    assert!(frame.velocity.iter().any(|v| v.iter().any(|x| *x != 0.0)), "the frame holds motion to compare");
+}
+
+/// LIGGGHTS (Debian's `liggghts`) reads the data file grains exports as `atom_style
+/// granular` and dumps it (`dump custom`, 17 digits); grains reads that dump back as the
+/// frame's grains, to the bit.
+#[test]
+fn liggghts_reads_our_data_file_and_its_dump_reads_back_as_our_grains() {
+    if !common::reader("liggghts", &["-h"], "liggghts") {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (scene, frame) = exported_run(d);
+    std::fs::write(
+        d.join("in.liggghts"),
+        "atom_style granular\natom_modify map array sort 0 0.0\nboundary p p f\nnewton off\ncommunicate single vel yes\nunits si\nread_data ours.data\n\
+         dump d all custom 1 theirs.dump id type x y z radius mass vx vy vz omegax omegay omegaz\n\
+         dump_modify d format \"%d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g\"\nrun 0\n",
+    )
+    .unwrap();
+    let o = Command::new("liggghts").args(["-in", "in.liggghts", "-log", "log.liggghts", "-screen", "none"]).current_dir(d).output().unwrap();
+    let log = std::fs::read_to_string(d.join("log.liggghts")).unwrap_or_default();
+    assert!(o.status.success() && !log.contains("ERROR"), "LIGGGHTS failed:\n{}", log.lines().rev().take(5).collect::<Vec<_>>().join("\n"));
+    let back = reading(d, "theirs.toml", "theirs.dump", "lammps-dump");
+    let g = &back.grains;
+    for (i, &grain) in frame.id.iter().enumerate() {
+        let k = grain as usize;
+        assert_eq!(g.position[k], frame.position[i], "grain {k}: position");
+        assert_eq!(g.velocity[k], frame.velocity[i], "grain {k}: velocity");
+        assert_eq!(g.angular_velocity[k], frame.angular_velocity[i], "grain {k}: angular velocity");
+        assert_eq!(g.radius[k], frame.radius[i], "grain {k}: radius");
+        assert!(((g.mass[k] - scene.grains.mass[k]) / scene.grains.mass[k]).abs() <= MASS_ROUNDING, "grain {k}: LIGGGHTS' mass {:e} kg, ours {:e} kg", g.mass[k], scene.grains.mass[k]);
+    }
 }
 
 /// The scene error `text`'s grain file gives, as one line.
