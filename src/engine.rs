@@ -364,6 +364,11 @@ pub trait Engine {
     fn dispatches(&self) -> Option<u64> {
         None
     }
+    /// Bytes each phase of a step that keeps its neighbour list moves to and from memory,
+    /// counted from the arrays it reads and writes (empty where the engine does not count).
+    fn step_traffic(&self) -> Vec<(&'static str, u64)> {
+        Vec::new()
+    }
     /// Seconds spent in each phase while profiling, by phase name; empty where the backend
     /// does not time its phases.
     fn phase_seconds(&self) -> Vec<(&'static str, f64)> {

@@ -2,6 +2,7 @@
 //! and precision, and speed against error on fixed scenes. Headless; `--json` prints one
 //! [`BenchReport`].
 
+pub mod bandwidth;
 pub mod bed;
 pub mod ladder;
 pub mod memory;
@@ -76,6 +77,17 @@ pub struct BenchReport {
     pub ladder: Option<Ladder>,
     /// Small scenes.
     pub small: Vec<small::SmallScene>,
+    /// This machine's memory bandwidth at each CPU thread count of the throughput runs.
+    pub memory_bandwidth: Vec<Bandwidth>,
+}
+
+/// The STREAM triad's bandwidth on some threads ([`bandwidth::triad`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct Bandwidth {
+    /// Worker threads.
+    pub threads: usize,
+    /// Bytes per second.
+    pub triad_bytes_per_second: f64,
 }
 
 /// This machine.
@@ -117,6 +129,13 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
     };
     let machine = machine();
     let mut rows = Vec::new();
+    let mut memory_bandwidth = Vec::new();
+    if opts.throughput && opts.backends.iter().any(|b| b == "cpu") {
+        for &threads in &opts.threads {
+            say(&format!("memory bandwidth (STREAM triad), {threads} thread(s)"));
+            memory_bandwidth.push(Bandwidth { threads, triad_bytes_per_second: pool(threads)?.install(bandwidth::triad) });
+        }
+    }
     if opts.throughput {
         for &n in &opts.sizes {
             for backend in &opts.backends {
@@ -180,7 +199,7 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
             }
         }
     }
-    Ok(BenchReport { machine, bed, throughput: rows, ladder, small: small_rows })
+    Ok(BenchReport { machine, bed, throughput: rows, ladder, small: small_rows, memory_bandwidth })
 }
 
 impl BenchReport {
@@ -201,13 +220,22 @@ impl BenchReport {
         }
         if !self.throughput.is_empty() {
             s.push_str("\nthroughput (dense settled bed, Hertz-Mindlin, dt = 2e-6 s)\n");
-            s.push_str("backend prec thr    grains  particle-steps/s  spread  ns/p-step     Z  pairs/grain  B/grain  peak RSS MiB  time shares\n");
+            for b in &self.memory_bandwidth {
+                s.push_str(&format!("memory bandwidth (STREAM triad), {} thread(s): {:.2} GB/s\n", b.threads, b.triad_bytes_per_second / 1e9));
+            }
+            s.push_str("backend prec thr    grains  particle-steps/s  spread  ns/p-step     Z  pairs/grain  B/grain  B/p-step  GB/s (of triad)  peak RSS MiB  time shares\n");
             for r in &self.throughput {
                 let mut phases = r.phases.clone();
                 phases.sort_by(|a, b| b.share.total_cmp(&a.share));
                 let shares: Vec<String> = phases.iter().filter(|p| p.share >= 0.005).map(|p| format!("{} {:.0}%", p.phase, 100.0 * p.share)).collect();
+                let triad = self.memory_bandwidth.iter().find(|b| b.threads == r.threads && r.backend == "cpu").map(|b| b.triad_bytes_per_second);
+                let traffic = match (r.traffic_bytes_per_second, triad) {
+                    (Some(t), Some(peak)) => format!("{:.2} ({:.0}%)", t / 1e9, 100.0 * t / peak),
+                    (Some(t), None) => format!("{:.2}", t / 1e9),
+                    _ => "-".to_string(),
+                };
                 s.push_str(&format!(
-                    "{:<7} {:<4} {:>3} {:>9} {:>17.3e} {:>6.1}% {:>10.1} {:>5.2} {:>12.2} {:>8.0} {:>13} {}\n",
+                    "{:<7} {:<4} {:>3} {:>9} {:>17.3e} {:>6.1}% {:>10.1} {:>5.2} {:>12.2} {:>8.0} {:>9} {:>16} {:>13} {}\n",
                     r.backend,
                     r.precision,
                     r.threads,
@@ -218,6 +246,8 @@ impl BenchReport {
                     r.contacts_per_grain,
                     r.pairs_per_grain,
                     r.bytes_per_grain,
+                    r.bytes_per_particle_step.map_or("-".to_string(), |b| format!("{b:.0}")),
+                    traffic,
                     r.peak_rss_bytes.map_or("-".to_string(), |b| format!("{:.0}", b as f64 / (1 << 20) as f64)),
                     shares.join(", ")
                 ));

@@ -59,6 +59,12 @@ pub struct Throughput {
     pub peak_rss_bytes: Option<u64>,
     /// Time per phase (CPU backend).
     pub phases: Vec<PhaseShare>,
+    /// Bytes a step that keeps its neighbour list moves to and from memory, per grain
+    /// (`Engine::step_traffic`); absent where the engine does not count them.
+    pub bytes_per_particle_step: Option<f64>,
+    /// Those bytes at the measured speed (bytes/s): what the step draws of the memory's
+    /// bandwidth.
+    pub traffic_bytes_per_second: Option<f64>,
 }
 
 impl Throughput {
@@ -98,6 +104,8 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u6
         .map(|(phase, s)| PhaseShare { phase: phase.to_string(), share: if phase_total > 0.0 { s / phase_total } else { 0.0 }, ns_per_particle_step: s * 1e9 / work_all })
         .collect();
     let engine_bytes = engine.memory_bytes();
+    let traffic: u64 = engine.step_traffic().iter().map(|(_, b)| b).sum();
+    let bytes_per_particle_step = (traffic > 0).then(|| traffic as f64 / n as f64);
     Ok(Throughput {
         backend: engine.backend().to_string(),
         device: device.to_string(),
@@ -118,5 +126,7 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u6
         bytes_per_grain: engine_bytes as f64 / n as f64,
         peak_rss_bytes: if peak_reset { memory::peak_rss() } else { None },
         phases,
+        bytes_per_particle_step,
+        traffic_bytes_per_second: bytes_per_particle_step.map(|b| b * work / seconds),
     })
 }

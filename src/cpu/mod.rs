@@ -20,6 +20,7 @@ mod snapshot;
 pub mod simd;
 mod state;
 mod stats;
+mod traffic;
 mod wall_contacts;
 
 pub use integrate::rotate;
@@ -643,6 +644,10 @@ impl<T: Real> Engine for CpuEngine<T> {
 
     fn phase_seconds(&self) -> Vec<(&'static str, f64)> {
         self.clock.totals()
+    }
+
+    fn step_traffic(&self) -> Vec<(&'static str, u64)> {
+        self.traffic()
     }
 
     fn place_piston(&mut self, z: f64) {

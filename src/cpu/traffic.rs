@@ -1,0 +1,46 @@
+//! The bytes a step moves to and from memory, counted from the arrays each pass reads and
+//! writes (each array streamed once per pass, a read and a write counted apart; the random
+//! reads of a partner's grain counted as if its record were streamed once): the traffic a
+//! step could not do with less, which `grains bench` sets beside the time to show how close
+//! to the memory's bandwidth the step runs.
+
+use super::*;
+
+/// Bytes of a slice.
+fn bytes<X>(v: &[X]) -> u64 {
+    std::mem::size_of_val(v) as u64
+}
+
+impl<T: Real> CpuEngine<T> {
+    /// Bytes each phase of a step that keeps its neighbour list moves (`kick`, `drift`,
+    /// `force`, `walls`, `gather`), in the order of the schedule's later steps.
+    pub(super) fn traffic(&self) -> Vec<(&'static str, u64)> {
+        let l = &self.pairs;
+        let (body, prop) = (bytes(&self.body), bytes(&self.prop));
+        let orientation = self.orientation.as_deref().map_or(0, bytes);
+        let kick = 2 * body + bytes(&self.load) + prop;
+        let drift = 2 * body + bytes(&self.built_at) + 2 * orientation;
+        let force = bytes(&l.owner) + bytes(&l.partner) + body + prop + 2 * bytes(&self.hist) + bytes(&self.out);
+        let walls = if self.walls.is_empty() { 0 } else { body + prop + bytes(&self.wall_load) + 2 * bytes(&self.wall_hist) };
+        let gather = bytes(&self.out) + bytes(&l.owner_start) + bytes(&l.rev_start) + bytes(&l.rev_pair) + if self.walls.is_empty() { 0 } else { bytes(&self.wall_load) } + prop + bytes(&self.load);
+        let mut out: Vec<(&'static str, u64)> = Vec::new();
+        let mut add = |name: &'static str, b: u64| match out.iter_mut().find(|e| e.0 == name) {
+            Some(e) => e.1 += b,
+            None => out.push((name, b)),
+        };
+        for op in &self.schedule.step {
+            match op {
+                Op::Kick { .. } => add("kick", kick),
+                Op::Drift { .. } => add("drift", drift),
+                Op::RebuildIfNeeded => {}
+                Op::Forces { .. } => {
+                    add("force", force);
+                    add("walls", walls);
+                    add("gather", gather);
+                }
+            }
+        }
+        out.retain(|e| e.1 > 0);
+        out
+    }
+}
