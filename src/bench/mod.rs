@@ -253,6 +253,19 @@ impl BenchReport {
                 ));
             }
         }
+        for r in self.throughput.iter().filter(|r| !r.projected.is_empty()) {
+            let each: Vec<String> = r.projected.iter().map(|p| format!("{} {:.3e}", p.gpu, p.particle_steps_per_second)).collect();
+            let kernels: Vec<String> = r.traffic.iter().map(|k| format!("{} {:.0}", k.phase, k.bytes_per_particle_step)).collect();
+            s.push_str(&format!(
+                "gpu {} grains: {:.0} B per particle-step ({}) and {:.1} dispatches per step; projected particle-steps/s ({:.0} us per dispatch): {}\n",
+                r.grains,
+                r.bytes_per_particle_step.unwrap_or(0.0),
+                kernels.join(", "),
+                r.dispatches_per_step.unwrap_or(0.0),
+                throughput::DISPATCH_SECONDS * 1e6,
+                each.join(", ")
+            ));
+        }
         if !self.small.is_empty() {
             s.push_str("\nsmall scenes (from their initial state; the GPU's dispatches per step include the rebuild kernels, empty on steps that keep the list)\n");
             s.push_str("scene                grains backend prec  steps/s  spread  dispatches/step\n");

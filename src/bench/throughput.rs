@@ -17,6 +17,15 @@ pub struct PhaseShare {
     pub ns_per_particle_step: f64,
 }
 
+/// Bytes one phase or kernel of a step moves, per grain.
+#[derive(Clone, Debug, Serialize)]
+pub struct PhaseBytes {
+    /// Phase (CPU) or kernel (GPU).
+    pub phase: String,
+    /// Bytes per particle-step.
+    pub bytes_per_particle_step: f64,
+}
+
 /// One throughput measurement.
 #[derive(Clone, Debug, Serialize)]
 pub struct Throughput {
@@ -62,9 +71,43 @@ pub struct Throughput {
     /// Bytes a step that keeps its neighbour list moves to and from memory, per grain
     /// (`Engine::step_traffic`); absent where the engine does not count them.
     pub bytes_per_particle_step: Option<f64>,
+    /// Those bytes per grain by phase (CPU) or kernel (GPU).
+    pub traffic: Vec<PhaseBytes>,
     /// Those bytes at the measured speed (bytes/s): what the step draws of the memory's
     /// bandwidth.
     pub traffic_bytes_per_second: Option<f64>,
+    /// Kernel dispatches per timed step (GPU), the rebuild kernels' empty ones included.
+    pub dispatches_per_step: Option<f64>,
+    /// GPU rows: the speed this step would reach on the GPUs of [`PROJECTED_GPUS`], from its
+    /// bytes and dispatches ([`projected`]).
+    pub projected: Vec<Projection>,
+}
+
+/// Memory bandwidths (bytes/s) of the GPUs the GPU rows are projected to (their data sheets).
+pub const PROJECTED_GPUS: [(&str, f64); 2] = [("H100 SXM, 3.35 TB/s", 3.35e12), ("H200, 4.8 TB/s", 4.8e12)];
+
+/// Seconds a dispatch costs beyond its memory traffic in the projection: an assumption (a few
+/// microseconds per dependent dispatch on current GPUs), to be replaced by a measurement on a
+/// lent GPU.
+pub const DISPATCH_SECONDS: f64 = 2e-6;
+
+/// A projected speed.
+#[derive(Clone, Debug, Serialize)]
+pub struct Projection {
+    /// The GPU.
+    pub gpu: String,
+    /// Its memory bandwidth (bytes/s).
+    pub bandwidth: f64,
+    /// Particle-steps per second: `N / (N b / bandwidth + d DISPATCH_SECONDS)` for `b` bytes
+    /// per particle-step and `d` dispatches per step.
+    pub particle_steps_per_second: f64,
+}
+
+/// The speed of a step of `grains` grains moving `bytes_per_particle_step` each in
+/// `dispatches` dispatches, on a GPU of `bandwidth` bytes/s.
+pub fn projected(grains: usize, bytes_per_particle_step: f64, dispatches: f64, bandwidth: f64) -> f64 {
+    let n = grains as f64;
+    n / (n * bytes_per_particle_step / bandwidth + dispatches * DISPATCH_SECONDS)
 }
 
 impl Throughput {
@@ -80,6 +123,7 @@ impl Throughput {
 pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u64, steps: u64, repeats: usize, peak_reset: bool) -> anyhow::Result<Throughput> {
     engine.advance(warmup)?;
     let before = engine.stats()?;
+    let dispatches_before = engine.dispatches();
     engine.set_profiling(true);
     let mut seconds_each = Vec::with_capacity(repeats);
     let mut after = before.clone();
@@ -104,8 +148,16 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u6
         .map(|(phase, s)| PhaseShare { phase: phase.to_string(), share: if phase_total > 0.0 { s / phase_total } else { 0.0 }, ns_per_particle_step: s * 1e9 / work_all })
         .collect();
     let engine_bytes = engine.memory_bytes();
-    let traffic: u64 = engine.step_traffic().iter().map(|(_, b)| b).sum();
+    let by_phase = engine.step_traffic();
+    let traffic: u64 = by_phase.iter().map(|(_, b)| b).sum();
     let bytes_per_particle_step = (traffic > 0).then(|| traffic as f64 / n as f64);
+    let traffic = by_phase.into_iter().map(|(phase, b)| PhaseBytes { phase: phase.to_string(), bytes_per_particle_step: b as f64 / n as f64 }).collect();
+    let timed_steps = (steps * seconds_each.len() as u64) as f64;
+    let dispatches_per_step = dispatches_before.zip(engine.dispatches()).map(|(a, b)| (b - a) as f64 / timed_steps);
+    let projected = match (bytes_per_particle_step, dispatches_per_step) {
+        (Some(b), Some(d)) => PROJECTED_GPUS.iter().map(|&(gpu, bandwidth)| Projection { gpu: gpu.to_string(), bandwidth, particle_steps_per_second: projected(n, b, d, bandwidth) }).collect(),
+        _ => Vec::new(),
+    };
     Ok(Throughput {
         backend: engine.backend().to_string(),
         device: device.to_string(),
@@ -127,6 +179,9 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u6
         peak_rss_bytes: if peak_reset { memory::peak_rss() } else { None },
         phases,
         bytes_per_particle_step,
+        traffic,
         traffic_bytes_per_second: bytes_per_particle_step.map(|b| b * work / seconds),
+        dispatches_per_step,
+        projected,
     })
 }

@@ -8,6 +8,7 @@
 mod encode;
 mod readback;
 mod snapshot;
+mod traffic;
 
 use super::device::Gpu;
 use encode::Size;
@@ -580,6 +581,10 @@ impl Engine for GpuEngine {
 
     fn dispatches(&self) -> Option<u64> {
         Some(self.dispatches.get())
+    }
+
+    fn step_traffic(&self) -> Vec<(&'static str, u64)> {
+        self.traffic()
     }
 
     fn place_piston(&mut self, z: f64) {

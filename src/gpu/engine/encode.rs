@@ -73,32 +73,44 @@ impl GpuEngine {
         self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
     }
 
-    /// `find_bridge_events` and `update_bridges` (capillary scenes), `pair_force`, `wall_contacts` (+ `wall_reduce`),
-    /// `gather` (and the kick after it), with the durations of `phase`.
-    pub(super) fn encode_forces(&self, pass: &mut wgpu::ComputePass, phase: Phase) {
-        if self.history.bridge {
-            self.run(pass, "find_bridge_events", Size::Indirect(args::PAIRS), None);
-            self.run(pass, "update_bridges", Size::One, None);
+    /// The kernels of a plan entry other than the rebuild check, with their sizes and phases:
+    /// `integrate` (then `servo_move` after a drift in servo scenes); or
+    /// `find_bridge_events` and `update_bridges` (capillary scenes), `pair_force`,
+    /// `wall_contacts` (+ `wall_reduce`), `gather` (and the kick after it).
+    pub(super) fn kernels_of(&self, e: &Entry) -> Vec<(&'static str, Size, Option<Phase>)> {
+        let phase = Some(e.phase);
+        let mut k = Vec::new();
+        match e.dispatch {
+            Dispatch::Integrate => {
+                k.push(("integrate", Size::Grains, phase));
+                if self.servo.is_some() && e.phase.drift > 0.0 {
+                    k.push(("servo_move", Size::One, phase));
+                }
+            }
+            Dispatch::RebuildIfNeeded => {}
+            Dispatch::Forces => {
+                if self.history.bridge {
+                    k.push(("find_bridge_events", Size::Indirect(args::PAIRS), None));
+                    k.push(("update_bridges", Size::One, None));
+                }
+                k.push(("pair_force", Size::Indirect(args::PAIRS), phase));
+                if self.has_walls {
+                    k.push(("wall_contacts", Size::Grains, phase));
+                    k.push(("wall_reduce", Size::One, None));
+                }
+                k.push(("gather", Size::Grains, phase));
+            }
         }
-        self.run(pass, "pair_force", Size::Indirect(args::PAIRS), Some(phase));
-        if self.has_walls {
-            self.run(pass, "wall_contacts", Size::Grains, Some(phase));
-            self.run(pass, "wall_reduce", Size::One, None);
-        }
-        self.run(pass, "gather", Size::Grains, Some(phase));
+        k
     }
 
     /// Encodes one entry of a plan.
     pub(super) fn encode(&self, pass: &mut wgpu::ComputePass, e: &Entry) {
-        match e.dispatch {
-            Dispatch::Integrate => {
-                self.run(pass, "integrate", Size::Grains, Some(e.phase));
-                if self.servo.is_some() && e.phase.drift > 0.0 {
-                    self.run(pass, "servo_move", Size::One, Some(e.phase));
-                }
-            }
-            Dispatch::RebuildIfNeeded => self.encode_rebuild_if_needed(pass),
-            Dispatch::Forces => self.encode_forces(pass, e.phase),
+        if e.dispatch == Dispatch::RebuildIfNeeded {
+            return self.encode_rebuild_if_needed(pass);
+        }
+        for (name, size, phase) in self.kernels_of(e) {
+            self.run(pass, name, size, phase);
         }
     }
 

@@ -1,0 +1,42 @@
+//! The bytes a step that keeps its neighbour list moves to and from the GPU's memory, counted
+//! from the kernel table: each kernel the plan dispatches with work (the rebuild kernels run
+//! with zero workgroups on such steps; `decide_rebuild` runs) streams each storage buffer it
+//! binds once, a read-only one read and a read-write one read and written (an upper bound
+//! where a kernel only writes one), the per-pair buffers at the live pair count.
+
+use super::*;
+use crate::kernels::{kernel, Access};
+
+impl GpuEngine {
+    /// Bytes each kernel of a later step moves, by kernel, in dispatch order.
+    pub(super) fn traffic(&self) -> Vec<(&'static str, u64)> {
+        let pairs = self.control.n_pairs as u64;
+        let per_pair = self.pair_buffers();
+        let used = |name: &str| match per_pair.iter().find(|p| p.0 == name) {
+            Some(&(_, bytes)) => bytes * pairs,
+            None => self.buffers.get(name).map_or(0, wgpu::Buffer::size),
+        };
+        let moved = |name: &str| -> u64 {
+            kernel(name)
+                .bindings
+                .iter()
+                .map(|&(buffer, access)| match access {
+                    Access::Read => used(buffer),
+                    Access::ReadWrite => 2 * used(buffer),
+                    Access::Uniform | Access::Phase => 0,
+                })
+                .sum()
+        };
+        let mut out: Vec<(&'static str, u64)> = Vec::new();
+        for e in self.plans.step(1) {
+            let names: Vec<&'static str> = if e.dispatch == Dispatch::RebuildIfNeeded { vec!["decide_rebuild"] } else { self.kernels_of(e).into_iter().map(|k| k.0).collect() };
+            for name in names {
+                match out.iter_mut().find(|x| x.0 == name) {
+                    Some(x) => x.1 += moved(name),
+                    None => out.push((name, moved(name))),
+                }
+            }
+        }
+        out
+    }
+}
