@@ -46,7 +46,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
         }
         Command::Export { run, format, out } => {
-            let (scene, frame) = run_and_last_frame(&run)?;
+            let (_, scene, frame) = run_summary(&run)?;
             let atoms = grains::output::lammps::atoms(&scene, &frame);
             let (text, default) = match format {
                 ExportFormat::LammpsData => (grains::lammps::data::write(&atoms, &format!("{} at t = {:e} s", scene.name, frame.time)), "grains.data"),
@@ -231,12 +231,6 @@ fn run_summary(run: &Path) -> anyhow::Result<(serde_json::Value, Scene, grains::
     let scene = scene::load(Path::new(scene_file))?;
     let frame = grains::output::mcap::last_frame(&run.join("frames.mcap"))?;
     Ok((summary, scene, frame))
-}
-
-/// A finished run's scene and last frame.
-fn run_and_last_frame(run: &Path) -> anyhow::Result<(Scene, grains::engine::Frame)> {
-    let (_, scene, frame) = run_summary(run)?;
-    Ok((scene, frame))
 }
 
 /// A finished run's summary, scene and last frame (which must hold the contact forces).

@@ -20,7 +20,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Atoms, FileError> {
     let mut count: Option<usize> = None;
     let mut bounds: [Option<[f64; 2]>; 3] = [None; 3];
     let mut section: Option<String> = None;
-    let mut velocity_of: HashMap<u64, usize> = HashMap::new();
+    let mut index_of: HashMap<u64, usize> = HashMap::new();
     let mut velocities = 0usize;
     let mut density = Vec::new();
     // The first line is the title.
@@ -66,7 +66,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Atoms, FileError> {
                 if !(rho > 0.0) {
                     return Err(FileError { file: path.to_path_buf(), line: Some(line), column: Some((4, "density".into())), problem: format!("density {rho} is not positive"), fix: "give the mass density in kg/m^3".into() });
                 }
-                if velocity_of.insert(id, atoms.len()).is_some() {
+                if index_of.insert(id, atoms.len()).is_some() {
                     return Err(FileError { file: path.to_path_buf(), line: Some(line), column: Some((1, "atom-ID".into())), problem: format!("atom {id} appears twice"), fix: "give every atom its own id".into() });
                 }
                 atoms.id.push(id);
@@ -79,7 +79,7 @@ pub fn parse(path: &Path, text: &str) -> Result<Atoms, FileError> {
             }
             Some("Velocities") => {
                 let id: u64 = r.number(line, &words, 0, "atom-ID")?;
-                let Some(&i) = velocity_of.get(&id) else {
+                let Some(&i) = index_of.get(&id) else {
                     return Err(FileError { file: path.to_path_buf(), line: Some(line), column: Some((1, "atom-ID".into())), problem: format!("atom {id} has a velocity but is not in the Atoms section"), fix: "put the Atoms section first and give velocities of its atoms only".into() });
                 };
                 atoms.velocity[i] = r.triple(line, &words, 1, ["vx", "vy", "vz"])?;

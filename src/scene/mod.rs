@@ -478,13 +478,14 @@ impl Origins {
 
     /// Whether grain `i` was read from a file (a packing that may rest on its walls).
     fn read(&self, i: usize) -> bool {
-        let mut k = i.saturating_sub(self.listed);
-        i >= self.listed
-            && self.blocks.iter().any(|(_, n, read)| {
-                let here = k < *n;
-                k = k.saturating_sub(*n);
-                here && *read
-            })
+        let mut end = self.listed;
+        for &(_, n, read) in &self.blocks {
+            end += n;
+            if i < end {
+                return read && i >= self.listed;
+            }
+        }
+        false
     }
 }
 

@@ -110,13 +110,12 @@ struct Appended {
 
 impl Appended {
     fn array(&mut self, name: &str, components: usize, values: &Values) -> anyhow::Result<()> {
-        writeln!(
-            self.xml,
-            r#"        <DataArray type="{}" Name="{name}" NumberOfComponents="{components}" format="appended" offset="{}"/>"#,
-            values.type_name(),
-            self.data.len()
-        )?;
-        let raw = values.bytes();
+        self.raw_array(name, components, values.type_name(), values.bytes())
+    }
+
+    /// An array of `raw` bytes of VTK type `type_name`.
+    fn raw_array(&mut self, name: &str, components: usize, type_name: &str, raw: &[u8]) -> anyhow::Result<()> {
+        writeln!(self.xml, r#"        <DataArray type="{type_name}" Name="{name}" NumberOfComponents="{components}" format="appended" offset="{}"/>"#, self.data.len())?;
         let blocks: Vec<&[u8]> = if raw.is_empty() { Vec::new() } else { raw.chunks(BLOCK).collect() };
         let mut compressed = Vec::with_capacity(blocks.len());
         for b in &blocks {
@@ -149,8 +148,8 @@ impl Appended {
             return Ok(());
         }
         writeln!(self.xml, "      <{tag}>")?;
-        self.array("connectivity", 1, &Values::I32(c.connectivity.clone()))?;
-        self.array("offsets", 1, &Values::I32(c.offsets.clone()))?;
+        self.raw_array("connectivity", 1, "Int32", bytemuck::cast_slice(&c.connectivity))?;
+        self.raw_array("offsets", 1, "Int32", bytemuck::cast_slice(&c.offsets))?;
         writeln!(self.xml, "      </{tag}>")?;
         Ok(())
     }
