@@ -225,7 +225,7 @@ fn lammps_reads_back_the_data_file_and_the_dump_grains_exports() {
 /// frame's grains, to the bit.
 #[test]
 fn liggghts_reads_our_data_file_and_its_dump_reads_back_as_our_grains() {
-    if !common::reader("liggghts", &["-h"], "liggghts") {
+    if !common::reader("liggghts", &["-in", "/dev/null", "-log", "none", "-screen", "none"], "liggghts") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();
