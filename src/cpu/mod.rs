@@ -27,12 +27,12 @@ pub use integrate::rotate;
 pub use pairs::PairList;
 pub use pair_force::ForceContext;
 pub use profile::PHASE_NAMES;
-pub use state::{Body, HistorySlots, Load, Props};
+pub use state::{Body, HistorySlots, Load, PairReport, Props};
 pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::engine::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
-use crate::model::{capillary_potential, normal_potential, share_liquid, within_rupture, CohesionLaw, ContactForce, ContactModel, PairCoeffs, Regime};
+use crate::model::{capillary_potential, normal_potential, share_liquid, within_rupture, CohesionLaw, ContactModel, PairCoeffs, Regime};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 use crate::schedule::{Op, Schedule, Trace};
@@ -41,7 +41,7 @@ use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
 use gather::gather_block;
 use grid::{hash_cells, CellGrid};
-use pair_force::pair_block;
+use pair_force::{owner_block, OwnerBlock};
 use profile::{Phase, PhaseClock};
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS, PAR_MIN_PAIRS};
@@ -99,7 +99,14 @@ pub struct CpuEngine<T: Real> {
     grid: CellGrid<T>,
     pairs: PairList,
     hist: Vec<T>,
-    out: Vec<ContactForce<T>>,
+    /// The partner's share of each pair's force and torque at the last evaluation (the
+    /// owner's went straight into its load).
+    share: Vec<Load<T>>,
+    /// What the statistics and frames read of each pair's last evaluation.
+    report: Vec<PairReport<T>>,
+    /// Each pair's force on its owner (N), for the laws whose force on the owner is not the
+    /// partner's reversed ([`pair_force::keeps_owner_force`]); empty otherwise.
+    force_i: Vec<Vec3<T>>,
     // Clocks.
     /// Largest squared displacement of a grain since the last build (m^2), as of the last drift.
     max_moved2: T,
@@ -187,7 +194,9 @@ impl<T: Real> CpuEngine<T> {
             grid: CellGrid::default(),
             pairs: PairList::default(),
             hist: Vec::new(),
-            out: Vec::new(),
+            share: Vec::new(),
+            report: Vec::new(),
+            force_i: Vec::new(),
             max_moved2: T::ZERO,
             forces_valid: false,
             step: 0,
@@ -225,9 +234,10 @@ impl<T: Real> CpuEngine<T> {
         let t = self.clock.start();
         self.hist = pairs::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
         self.pairs = pairs;
-        self.out.clear();
-        self.out.reserve_exact(self.pairs.len());
-        self.out.resize(self.pairs.len(), ContactForce::default());
+        let n_pairs = self.pairs.len();
+        renew(&mut self.share, n_pairs);
+        renew(&mut self.report, n_pairs);
+        renew(&mut self.force_i, if pair_force::keeps_owner_force(&self.model) { n_pairs } else { 0 });
         for (b, at) in self.body.iter().zip(self.built_at.iter_mut()) {
             *at = b.pos;
         }
@@ -350,19 +360,10 @@ impl<T: Real> CpuEngine<T> {
             elapsed,
             periodic: self.periodic,
         };
-        let (pairs, body, prop) = (&self.pairs, &self.body, &self.prop);
-        let stride = self.slots.stride;
-        let min_blocks = PAR_MIN_PAIRS / pair_force::BLOCK;
-        if stride == 0 {
-            self.out.par_chunks_mut(pair_force::BLOCK).with_min_len(min_blocks).enumerate().for_each(|(b, o)| pair_block(b * pair_force::BLOCK, o, &mut [], pairs, body, prop, &ctx));
-        } else {
-            self.out
-                .par_chunks_mut(pair_force::BLOCK)
-                .zip(self.hist.par_chunks_mut(pair_force::BLOCK * stride))
-                .with_min_len(min_blocks)
-                .enumerate()
-                .for_each(|(b, (o, h))| pair_block(b * pair_force::BLOCK, o, h, pairs, body, prop, &ctx));
-        }
+        let (pairs, body, prop, gravity) = (&self.pairs, &self.body, &self.prop, self.gravity);
+        let blocks = owner_blocks(pairs, self.slots.stride, &mut self.load, &mut self.share, &mut self.report, &mut self.force_i, &mut self.hist);
+        let min_blocks = (PAR_MIN_PAIRS * blocks.len()).div_ceil(pairs.len().max(1));
+        blocks.into_par_iter().with_min_len(min_blocks.max(1)).for_each_init(Vec::new, |scratch, b| owner_block(b, scratch, pairs, body, prop, &ctx, gravity));
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
         if !self.walls.is_empty() {
@@ -374,8 +375,8 @@ impl<T: Real> CpuEngine<T> {
         }
         self.clock.stop(Phase::Walls, t);
         let t = self.clock.start();
-        let (out, wall_load, gravity) = (&self.out, &self.wall_load, self.gravity);
-        self.load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().for_each(|(c, l)| gather_block(c * CHUNK, l, pairs, out, wall_load, prop, gravity));
+        let (share, wall_load) = (&self.share, &self.wall_load);
+        self.load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().for_each(|(c, l)| gather_block(c * CHUNK, l, pairs, share, wall_load));
         self.forces_valid = true;
         self.clock.stop(Phase::Gather, t);
     }
@@ -476,6 +477,15 @@ impl<T: Real> CpuEngine<T> {
         Ok(())
     }
 
+    /// The force pair `k` exerted on its owner at the last evaluation (N).
+    fn owner_force(&self, k: usize) -> Vec3<T> {
+        if self.force_i.is_empty() {
+            -self.share[k].force
+        } else {
+            self.force_i[k]
+        }
+    }
+
     /// Overlap (m) and smaller radius (m) of pair `k`.
     fn pair_overlap(&self, k: usize) -> (T, T) {
         let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
@@ -544,6 +554,47 @@ fn wall_pass<T: Real>(
         total.regimes.add(p.regimes);
     }
     total
+}
+
+/// Splits the pair pass's outputs into the tasks of [`owner_block`]: [`pair_force::OWNERS`]
+/// owner grains each, with the pairs they own.
+fn owner_blocks<'a, T: Real>(
+    pairs: &PairList,
+    stride: usize,
+    mut load: &'a mut [Load<T>],
+    mut share: &'a mut [Load<T>],
+    mut report: &'a mut [PairReport<T>],
+    mut force_i: &'a mut [Vec3<T>],
+    mut hist: &'a mut [T],
+) -> Vec<OwnerBlock<'a, T>> {
+    let n = load.len();
+    let keep_fi = !force_i.is_empty();
+    let mut blocks = Vec::with_capacity(n.div_ceil(pair_force::OWNERS));
+    for first in (0..n).step_by(pair_force::OWNERS) {
+        let end = (first + pair_force::OWNERS).min(n);
+        let count = (pairs.owner_start[end] - pairs.owner_start[first]) as usize;
+        let l;
+        (l, load) = std::mem::take(&mut load).split_at_mut(end - first);
+        let sh;
+        (sh, share) = std::mem::take(&mut share).split_at_mut(count);
+        let r;
+        (r, report) = std::mem::take(&mut report).split_at_mut(count);
+        let fi;
+        (fi, force_i) = std::mem::take(&mut force_i).split_at_mut(if keep_fi { count } else { 0 });
+        let h;
+        (h, hist) = std::mem::take(&mut hist).split_at_mut(count * stride);
+        blocks.push(OwnerBlock { first, load: l, share: sh, report: r, force_i: fi, hist: h });
+    }
+    blocks
+}
+
+/// Resizes `v` to `n` default values with no growth slack (a pair array of 10^6 grains is tens
+/// of megabytes).
+fn renew<X: Clone + Default>(v: &mut Vec<X>, n: usize) {
+    v.clear();
+    v.shrink_to(n);
+    v.reserve_exact(n);
+    v.resize(n, X::default());
 }
 
 /// Bytes a vector holds allocated.
@@ -634,7 +685,7 @@ impl<T: Real> Engine for CpuEngine<T> {
         let l = &self.pairs;
         let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.body) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
         let walls = allocated(&self.wall_hist) + allocated(&self.wall_load) + self.orientation.as_ref().map_or(0, allocated);
-        let pairs = allocated(&self.hist) + allocated(&self.out) + allocated(&l.owner_start) + allocated(&l.owner) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
+        let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.owner) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
         grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)
     }
 

@@ -1,15 +1,18 @@
 //! `pair_force`: one invocation computes the force of one listed pair, once, in canonical
 //! order (owner = lower permanent id = i), and reads and writes its history.
 //!
-//! The pass runs in blocks of [`BLOCK`] pairs, each compiled for the widest instruction set
-//! the CPU has (see `simd`); under the standard Hertz-Mindlin model a block runs in vector
-//! lanes (see `lanes`), with the same bits.
+//! The pass runs in tasks of [`OWNERS`] owner grains, each compiled for the widest instruction
+//! set the CPU has (see `simd`); under the standard Hertz-Mindlin model their pairs run
+//! [`BLOCK`] at a time in vector lanes (see `lanes`), with the same bits, into a scratch record
+//! that stays in cache, and otherwise one at a time. Of each pair's force only the partner's share and
+//! a small report go back to memory: the owner's share is summed into the owner's load on the
+//! spot, in the order the gather used to sum it.
 
 use super::pairs::PairList;
-use super::state::{Body, HistorySlots, Props};
-use crate::model::{capillary_force, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs};
+use super::state::{Body, HistorySlots, Load, PairReport, Props};
+use crate::model::{capillary_force, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs, TangentialLaw};
 use crate::periodic::Periodic;
-use crate::real::Real;
+use crate::real::{Real, Vec3};
 
 /// What every invocation of a force pass shares.
 #[derive(Clone, Copy, Debug)]
@@ -60,24 +63,94 @@ pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &
     f
 }
 
-/// Pairs per block of the pair pass.
+/// Pairs the lane kernel computes at a time into a task's scratch record, before each is split
+/// into the owner's share (summed into its load), the partner's share and the report.
 pub const BLOCK: usize = 256;
 
-super::simd::dispatch! {
-    /// `pair_force` for pairs `first..first + out.len()`; `hist` holds their history slots
-    /// (empty when the model keeps none).
-    pub fn pair_block<T: Real>(first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) => pair_block_portable
+/// Owner grains per task of the pair pass: a task takes every pair these grains own, so each
+/// owner's share is summed within one task, in pair order.
+pub const OWNERS: usize = 64;
+
+/// What one task of the pair pass writes, for the owner grains `first..first + load.len()`
+/// and the pairs they own (`pairs.owner_start[first]..`).
+pub struct OwnerBlock<'a, T> {
+    /// First owner grain.
+    pub first: usize,
+    /// The owners' loads: gravity plus the owner's share of each pair it owns, summed in
+    /// pair order (the gather adds the partners' shares and the walls' afterwards).
+    pub load: &'a mut [Load<T>],
+    /// The partner's share of each pair: force (N) and torque (N m) on the partner.
+    pub share: &'a mut [Load<T>],
+    /// What the statistics and frames read of each pair.
+    pub report: &'a mut [PairReport<T>],
+    /// The force on the owner of each pair (N), kept only where it is not the partner's
+    /// force reversed (see [`keeps_owner_force`]); empty otherwise.
+    pub force_i: &'a mut [Vec3<T>],
+    /// The pairs' history slots (empty when the model keeps none).
+    pub hist: &'a mut [T],
 }
 
-/// [`pair_block`] for whatever instruction set the caller is compiled for.
+/// True when a pair's force on its owner is not always its force on the partner reversed,
+/// bit for bit, so that it must be kept per pair: seed 000's rolling regime moves both grains
+/// along their own rolling directions. Every other law applies `f` to i and `-f` to j.
+pub fn keeps_owner_force<T>(model: &ContactModel<T>) -> bool {
+    matches!(model.tangential, TangentialLaw::Oquendo(_))
+}
+
+super::simd::dispatch! {
+    /// `pair_force` for every pair the grains of `block` own, with each owner's share summed
+    /// into its load from `gravity * m` in pair order: the bits the gather got when it read
+    /// whole per-pair records, with a third of the bytes.
+    /// `scratch` is the lane kernel's output, reused from task to task (grown to [`BLOCK`]
+    /// records when first needed; its contents are overwritten).
+    pub fn owner_block<T: Real>(block: OwnerBlock<'_, T>, scratch: &mut Vec<ContactForce<T>>, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, gravity: Vec3<T>) => owner_block_portable
+}
+
+/// [`owner_block`] for whatever instruction set the caller is compiled for.
 #[inline(always)]
-fn pair_block_portable<T: Real>(first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
-    let stride = ctx.slots.stride;
+fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut Vec<ContactForce<T>>, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, gravity: Vec3<T>) {
+    let first = block.first;
+    for (m, l) in block.load.iter_mut().enumerate() {
+        *l = Load { force: gravity * prop[first + m].mass, torque: Vec3::ZERO };
+    }
+    let first_pair = pairs.owner_start[first] as usize;
+    let (stride, n_pairs) = (ctx.slots.stride, block.report.len());
     if let Some(model) = super::lanes::hertz_mindlin(ctx.model) {
         debug_assert!(!ctx.slots.layout.sliding && !ctx.slots.layout.rolling, "Hertz-Mindlin keeps one spring per pair");
-        return super::lanes::hertz_mindlin_block(&model, first, out, hist, pairs, body, prop, ctx);
+        scratch.resize(BLOCK, ContactForce::default());
+        for start in (0..n_pairs).step_by(scratch.len()) {
+            let n = scratch.len().min(n_pairs - start);
+            let h = if stride == 0 { &mut [][..] } else { &mut block.hist[start * stride..(start + n) * stride] };
+            super::lanes::hertz_mindlin_block(&model, first_pair + start, &mut scratch[..n], h, pairs, body, prop, ctx);
+            for (q, f) in scratch[..n].iter().enumerate() {
+                block.deposit(start + q, pairs.owner[first_pair + start + q] as usize, f);
+            }
+        }
+    } else {
+        for k in 0..n_pairs {
+            let f = pair_force(first_pair + k, pairs, body, prop, ctx, &mut block.hist[k * stride..(k + 1) * stride]);
+            block.deposit(k, pairs.owner[first_pair + k] as usize, &f);
+        }
     }
-    for (m, o) in out.iter_mut().enumerate() {
-        *o = pair_force(first + m, pairs, body, prop, ctx, &mut hist[m * stride..(m + 1) * stride]);
+}
+
+impl<T: Real> OwnerBlock<'_, T> {
+    /// Hands out the force of the block's pair `k` (counted from its first pair), owned by
+    /// grain `owner`.
+    #[inline(always)]
+    fn deposit(&mut self, k: usize, owner: usize, f: &ContactForce<T>) {
+        let l = &mut self.load[owner - self.first];
+        l.force += f.f_i;
+        l.torque += f.t_i;
+        // Field by field: a whole-struct store is assembled on the stack and read back in
+        // wider words than it was written, which stalls store forwarding (a tenth of the
+        // oedometer's step).
+        let (sh, r) = (&mut self.share[k], &mut self.report[k]);
+        sh.force = f.f_j;
+        sh.torque = f.t_j;
+        (r.f_n, r.f_c, r.clamped, r.regime) = (f.f_n, f.f_c, f.clamped, f.regime);
+        if !self.force_i.is_empty() {
+            self.force_i[k] = f.f_i;
+        }
     }
 }

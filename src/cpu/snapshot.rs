@@ -18,15 +18,15 @@ impl<T: Real> CpuEngine<T> {
                 (0..self.pairs.len())
                     .filter_map(|k| {
                         let (h, _) = self.pair_overlap(k);
-                        (h > T::ZERO || self.out[k].f_c != T::ZERO).then(|| {
+                        (h > T::ZERO || self.report[k].f_c != T::ZERO).then(|| {
                             let springs = self.slots.load(&self.hist[k * self.slots.stride..]);
                             ContactRecord {
                                 i: self.id[self.pairs.owner[k] as usize],
                                 j: self.id[self.pairs.partner[k] as usize],
                                 overlap: h.f64(),
-                                normal_force: (self.out[k].f_n + self.out[k].f_c).f64(),
-                                force: self.out[k].f_i.f64(),
-                                force_j: self.out[k].f_j.f64(),
+                                normal_force: (self.report[k].f_n + self.report[k].f_c).f64(),
+                                force: self.owner_force(k).f64(),
+                                force_j: self.share[k].force.f64(),
                                 tangential_spring: springs.tangential.f64(),
                                 rolling_spring: springs.rolling.f64(),
                                 bridge_volume: springs.bridge.f64(),
@@ -78,14 +78,9 @@ impl<T: Real> CpuEngine<T> {
         }
         s.put_reals("hist", self.hist.iter().map(|x| x.f64()));
         s.put_reals("liquid", self.liquid.iter().map(|x| x.f64()));
-        s.put_reals(
-            "out",
-            self.out.iter().flat_map(|o| {
-                let mut r = [v3(&o.f_i), v3(&o.f_j), v3(&o.t_i), v3(&o.t_j), [o.f_n.f64(), if o.clamped { 1.0 } else { 0.0 }, o.f_c.f64()]].concat();
-                r.push(o.regime as u8 as f64);
-                r
-            }),
-        );
+        s.put_reals("share", self.share.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
+        s.put_reals("report", self.report.iter().flat_map(|r| [r.f_n.f64(), r.f_c.f64(), r.clamped as u8 as f64, r.regime as u8 as f64]));
+        s.put_reals("force_i", self.force_i.iter().flat_map(v3));
         s.put_reals("clock", [self.max_moved2.f64(), self.time, self.external_work]);
         s.put_ints("counters", [self.step, self.rebuilds, self.forces_valid as u64]);
         s
@@ -148,11 +143,10 @@ impl<T: Real> CpuEngine<T> {
         };
         self.hist = s.reals("hist", n_pairs * self.slots.stride)?.iter().map(|&x| T::of(x)).collect();
         self.liquid = s.reals("liquid", self.liquid.len())?.iter().map(|&x| T::of(x)).collect();
-        self.out = s
-            .reals("out", 16 * n_pairs)?
-            .chunks_exact(16)
-            .map(|c| ContactForce { f_i: v3(&c[0..3]), f_j: v3(&c[3..6]), t_i: v3(&c[6..9]), t_j: v3(&c[9..12]), f_n: T::of(c[12]), clamped: c[13] != 0.0, f_c: T::of(c[14]), regime: Regime::from_code(c[15] as u8) })
-            .collect();
+        self.share = s.reals("share", 6 * n_pairs)?.chunks_exact(6).map(|c| Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) }).collect();
+        self.report = s.reals("report", 4 * n_pairs)?.chunks_exact(4).map(|c| PairReport { f_n: T::of(c[0]), f_c: T::of(c[1]), clamped: c[2] != 0.0, regime: Regime::from_code(c[3] as u8) }).collect();
+        let kept = if pair_force::keeps_owner_force(&self.model) { n_pairs } else { 0 };
+        self.force_i = s.reals("force_i", 3 * kept)?.chunks_exact(3).map(v3).collect();
         let clock = s.reals("clock", 3)?;
         (self.max_moved2, self.time, self.external_work) = (T::of(clock[0]), clock[1], clock[2]);
         let counters = s.ints("counters", Some(3))?;

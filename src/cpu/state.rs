@@ -2,7 +2,7 @@
 //! together (array of structures: one or two cache lines per grain); the GPU keeps
 //! structures of arrays.
 
-use crate::model::{History, HistoryLayout};
+use crate::model::{History, HistoryLayout, Regime};
 use crate::real::{Real, Vec3};
 
 /// Kinematic state of a grain.
@@ -36,6 +36,21 @@ pub struct Load<T> {
     pub force: Vec3<T>,
     /// Torque (N m).
     pub torque: Vec3<T>,
+}
+
+/// What the statistics and frames read of a pair's last force evaluation (the forces
+/// themselves went to the grains: the owner's share into its load, the partner's into the
+/// pair's [`Load`] record).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairReport<T> {
+    /// Elastic + damping normal force after the no-pull clamp (N, compressive positive).
+    pub f_n: T,
+    /// Capillary normal force (N, tensile negative; 0 without a bridge).
+    pub f_c: T,
+    /// True when the no-pull clamp removed an attractive damping force.
+    pub clamped: bool,
+    /// The tangential regime.
+    pub regime: Regime,
 }
 
 /// Where each history block sits in a contact's fixed-stride slot.

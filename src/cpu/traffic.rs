@@ -20,9 +20,10 @@ impl<T: Real> CpuEngine<T> {
         let orientation = self.orientation.as_deref().map_or(0, bytes);
         let kick = 2 * body + bytes(&self.load) + prop;
         let drift = 2 * body + bytes(&self.built_at) + 2 * orientation;
-        let force = bytes(&l.owner) + bytes(&l.partner) + body + prop + 2 * bytes(&self.hist) + bytes(&self.out);
+        let pair_out = bytes(&self.share) + bytes(&self.report) + bytes(&self.force_i);
+        let force = bytes(&l.owner) + bytes(&l.partner) + body + prop + 2 * bytes(&self.hist) + pair_out + bytes(&self.load);
         let walls = if self.walls.is_empty() { 0 } else { body + prop + bytes(&self.wall_load) + 2 * bytes(&self.wall_hist) };
-        let gather = bytes(&self.out) + bytes(&l.owner_start) + bytes(&l.rev_start) + bytes(&l.rev_pair) + if self.walls.is_empty() { 0 } else { bytes(&self.wall_load) } + prop + bytes(&self.load);
+        let gather = bytes(&self.share) + bytes(&l.rev_start) + bytes(&l.rev_pair) + bytes(&self.wall_load) + 2 * bytes(&self.load);
         let mut out: Vec<(&'static str, u64)> = Vec::new();
         let mut add = |name: &'static str, b: u64| match out.iter_mut().find(|e| e.0 == name) {
             Some(e) => e.1 += b,
