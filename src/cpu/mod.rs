@@ -573,19 +573,23 @@ fn owner_blocks<'a, T: Real>(
     for first in (0..n).step_by(pair_force::OWNERS) {
         let end = (first + pair_force::OWNERS).min(n);
         let count = (pairs.owner_start[end] - pairs.owner_start[first]) as usize;
-        let l;
-        (l, load) = std::mem::take(&mut load).split_at_mut(end - first);
-        let sh;
-        (sh, share) = std::mem::take(&mut share).split_at_mut(count);
-        let r;
-        (r, report) = std::mem::take(&mut report).split_at_mut(count);
-        let fi;
-        (fi, force_i) = std::mem::take(&mut force_i).split_at_mut(if keep_fi { count } else { 0 });
-        let h;
-        (h, hist) = std::mem::take(&mut hist).split_at_mut(count * stride);
-        blocks.push(OwnerBlock { first, load: l, share: sh, report: r, force_i: fi, hist: h });
+        blocks.push(OwnerBlock {
+            first,
+            load: take_front(&mut load, end - first),
+            share: take_front(&mut share, count),
+            report: take_front(&mut report, count),
+            force_i: take_front(&mut force_i, if keep_fi { count } else { 0 }),
+            hist: take_front(&mut hist, count * stride),
+        });
     }
     blocks
+}
+
+/// Splits the first `n` items off `s`, leaving it the rest.
+fn take_front<'a, X>(s: &mut &'a mut [X], n: usize) -> &'a mut [X] {
+    let (front, rest) = std::mem::take(s).split_at_mut(n);
+    *s = rest;
+    front
 }
 
 /// Resizes `v` to `n` default values with no growth slack (a pair array of 10^6 grains is tens

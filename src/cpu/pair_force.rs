@@ -4,9 +4,9 @@
 //! The pass runs in tasks of [`OWNERS`] owner grains, each compiled for the widest instruction
 //! set the CPU has (see `simd`); under the standard Hertz-Mindlin model their pairs run
 //! [`BLOCK`] at a time in vector lanes (see `lanes`), with the same bits, into a scratch record
-//! that stays in cache, and otherwise one at a time. Of each pair's force only the partner's share and
-//! a small report go back to memory: the owner's share is summed into the owner's load on the
-//! spot, in the order the gather used to sum it.
+//! that stays in cache, and otherwise one at a time. Of each pair's force only the partner's
+//! share and a small report go back to memory: the owner's share is summed into the owner's
+//! load on the spot, in the order the gather used to sum it.
 
 use super::pairs::PairList;
 use super::state::{Body, HistorySlots, Load, PairReport, Props};
@@ -120,7 +120,7 @@ fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut Vec
         scratch.resize(BLOCK, ContactForce::default());
         for start in (0..n_pairs).step_by(scratch.len()) {
             let n = scratch.len().min(n_pairs - start);
-            let h = if stride == 0 { &mut [][..] } else { &mut block.hist[start * stride..(start + n) * stride] };
+            let h = &mut block.hist[start * stride..(start + n) * stride];
             super::lanes::hertz_mindlin_block(&model, first_pair + start, &mut scratch[..n], h, pairs, body, prop, ctx);
             for (q, f) in scratch[..n].iter().enumerate() {
                 block.deposit(start + q, pairs.owner[first_pair + start + q] as usize, f);
