@@ -16,6 +16,7 @@ mod pair_force;
 mod pairs;
 mod profile;
 mod reduce;
+mod reorder;
 mod snapshot;
 pub mod simd;
 mod state;
@@ -43,9 +44,10 @@ use gather::gather_block;
 use grid::{hash_cells, CellGrid};
 use pair_force::{owner_block, OwnerBlock};
 use profile::{Phase, PhaseClock};
+use reorder::Renumbering;
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS, PAR_MIN_PAIRS};
-use wall_contacts::wall_block;
+use wall_contacts::{wall_block, WallTouch};
 
 /// The CPU engine in precision `T`.
 pub struct CpuEngine<T: Real> {
@@ -71,9 +73,13 @@ pub struct CpuEngine<T: Real> {
     /// Liquid on each grain waiting for its next bridge (m^3); empty without cohesion.
     liquid: Vec<T>,
     periodic: Periodic<T>,
-    // Grains, indexed by slot; `id` is the permanent id (equal to the slot: grains are not
-    // reordered yet, so history lookups by slot stay valid across rebuilds).
+    /// Rebuilds between renumberings of the slots in cell order (0: never).
+    reorder_every: u64,
+    // Grains, indexed by slot (renumbered in cell order by `reorder`).
+    /// The permanent id of each slot.
     id: Vec<u32>,
+    /// The slot of each permanent id.
+    slot: Vec<u32>,
     body: Vec<Body<T>>,
     prop: Vec<Props<T>>,
     load: Vec<Load<T>>,
@@ -114,6 +120,8 @@ pub struct CpuEngine<T: Real> {
     step: u64,
     time: f64,
     rebuilds: u64,
+    /// Renumberings that moved a grain.
+    renumberings: u64,
     external_work: f64,
     /// Time per phase, when profiling.
     clock: PhaseClock,
@@ -174,7 +182,9 @@ impl<T: Real> CpuEngine<T> {
             bridge_cap: T::of(scene.bridges.volume_cap),
             liquid: if slots.layout.bridge { vec![T::ZERO; n] } else { Vec::new() },
             periodic: Periodic::of(&scene.periodic),
+            reorder_every: scene.reorder_every,
             id: (0..n as u32).collect(),
+            slot: (0..n as u32).collect(),
             built_at: body.iter().map(|b| b.pos).collect(),
             image: if scene.periodic.iter().any(Option::is_some) { vec![[0; 3]; n] } else { Vec::new() },
             body,
@@ -202,6 +212,7 @@ impl<T: Real> CpuEngine<T> {
             step: 0,
             time: 0.0,
             rebuilds: 0,
+            renumberings: 0,
             external_work: 0.0,
             clock: PhaseClock::default(),
         };
@@ -210,7 +221,8 @@ impl<T: Real> CpuEngine<T> {
     }
 
     /// Rebuilds the neighbour list now (`hash_cells`, `detect_pairs`, `remap_history`),
-    /// carrying every contact's history over.
+    /// carrying every contact's history over, and every `reorder_every` rebuilds renumbers the
+    /// slots in cell order (`reorder`).
     pub fn rebuild(&mut self) -> Result<(), SimError> {
         let t = self.clock.start();
         if self.periodic.any() {
@@ -234,6 +246,10 @@ impl<T: Real> CpuEngine<T> {
         let t = self.clock.start();
         self.hist = pairs::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
         self.pairs = pairs;
+        if self.reorder_every > 0 && self.rebuilds.is_multiple_of(self.reorder_every) {
+            self.reorder();
+        }
+        self.pairs.build_reverse(&self.slot);
         let n_pairs = self.pairs.len();
         renew(&mut self.share, n_pairs);
         renew(&mut self.report, n_pairs);
@@ -248,13 +264,50 @@ impl<T: Real> CpuEngine<T> {
         Ok(())
     }
 
+    /// `reorder`: renumbers the slots in the order of the grid's cells (see [`reorder`]); the
+    /// grid then lists the new slots.
+    fn reorder(&mut self) {
+        let r = Renumbering::new(std::mem::take(&mut self.grid.cell_grains));
+        if r.is_identity() {
+            self.grid.cell_grains = r.from;
+            return;
+        }
+        r.apply(&mut self.id);
+        r.apply(&mut self.body);
+        r.apply(&mut self.prop);
+        r.apply(&mut self.load);
+        r.apply(&mut self.built_at);
+        r.apply(&mut self.image);
+        r.apply(&mut self.liquid);
+        r.apply(&mut self.wall_load);
+        r.apply_blocks(&mut self.wall_hist, self.walls.len() * self.slots.stride);
+        if let Some(q) = &mut self.orientation {
+            r.apply(q);
+        }
+        (self.pairs, self.hist) = r.apply_pairs(&self.pairs, &self.hist, self.slots.stride);
+        for (s, &id) in self.id.iter().enumerate() {
+            self.slot[id as usize] = s as u32;
+        }
+        self.grid.cell_grains = (0..self.id.len() as u32).collect();
+        self.renumberings += 1;
+    }
+
+    /// Renumberings so far that moved a grain.
+    pub fn renumberings(&self) -> u64 {
+        self.renumberings
+    }
+
+    /// The lowest permanent id of a grain whose state is not finite.
+    fn first_non_finite(&self) -> Option<u32> {
+        self.slot.iter().map(|&s| &self.body[s as usize]).position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|id| id as u32)
+    }
+
     fn non_finite_error(&self) -> SimError {
-        let grain = self.body.iter().position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).unwrap_or(0);
         SimError::Unstable {
             step: self.step,
             time: self.time,
             what: "non-finite position or velocity".into(),
-            grain: self.id[grain],
+            grain: self.first_non_finite().unwrap_or(0),
             suggested_dt: self.suggested_dt,
             also: "",
         }
@@ -265,24 +318,38 @@ impl<T: Real> CpuEngine<T> {
         self.dt.f64()
     }
 
-    /// Grain states, by slot.
-    pub fn bodies(&self) -> &[Body<T>] {
-        &self.body
+    /// `v`'s items (one per slot) in permanent-id order.
+    fn by_id<X: Copy>(&self, v: &[X]) -> Vec<X> {
+        self.slot.iter().map(|&s| v[s as usize]).collect()
     }
 
-    /// Loads from the last force evaluation, by slot.
-    pub fn loads(&self) -> &[Load<T>] {
-        &self.load
+    /// Grain states, in permanent-id order.
+    pub fn bodies(&self) -> Vec<Body<T>> {
+        self.by_id(&self.body)
     }
 
-    /// Orientation quaternions (scalar first), when tracked.
-    pub fn orientations(&self) -> Option<&[[T; 4]]> {
-        self.orientation.as_deref()
+    /// Loads from the last force evaluation, in permanent-id order.
+    pub fn loads(&self) -> Vec<Load<T>> {
+        self.by_id(&self.load)
     }
 
-    /// The current pair list.
-    pub fn pair_list(&self) -> &PairList {
-        &self.pairs
+    /// Orientation quaternions (scalar first) in permanent-id order, when tracked.
+    pub fn orientations(&self) -> Option<Vec<[T; 4]>> {
+        self.orientation.as_deref().map(|q| self.by_id(q))
+    }
+
+    /// The current pair list in permanent ids: `starts[id]..starts[id + 1]` index the
+    /// partners' ids of the pairs grain `id` owns.
+    pub fn pair_list(&self) -> (Vec<u32>, Vec<u32>) {
+        let l = &self.pairs;
+        let mut starts = vec![0u32];
+        let mut partners = Vec::with_capacity(l.len());
+        for &s in &self.slot {
+            let (a, b) = (l.owner_start[s as usize] as usize, l.owner_start[s as usize + 1] as usize);
+            partners.extend(l.partner[a..b].iter().map(|&j| self.id[j as usize]));
+            starts.push(partners.len() as u32);
+        }
+        (starts, partners)
     }
 
     /// Gap (m) between the surfaces of pair `k`'s grains (negative when they overlap).
@@ -317,8 +384,11 @@ impl<T: Real> CpuEngine<T> {
                 })
                 .collect()
         });
+        // Pair order by slot follows the numbering; the liquid moves in canonical order.
+        let mut events: Vec<(u32, BridgeEvent)> = events.into_iter().flatten().collect();
+        events.sort_by_key(|&(k, _)| (self.id[self.pairs.owner[k as usize] as usize], k));
         let half = T::of(0.5);
-        for (k, event) in events.into_iter().flatten() {
+        for (k, event) in events {
             let k = k as usize;
             let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
             let at = k * stride + b;
@@ -367,7 +437,7 @@ impl<T: Real> CpuEngine<T> {
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
         if !self.walls.is_empty() {
-            let sums = wall_pass(&ctx, body, prop, &self.walls, &mut self.wall_load, &mut self.wall_hist);
+            let sums = wall_pass(&ctx, &self.id, body, prop, &self.walls, &mut self.wall_load, &mut self.wall_hist);
             self.wall_reaction = sums.reaction;
             self.wall_count = sums.count;
             self.wall_response = sums.response;
@@ -519,41 +589,67 @@ impl<T: Real> WallSums<T> {
     fn new(n: usize) -> Self {
         WallSums { reaction: vec![Vec3::ZERO; n], count: vec![0; n], response: vec![(T::ZERO, T::ZERO); n], regimes: RegimeCounts::default() }
     }
+
+    /// The sums of `touches` (sorted by grain id, then wall), per fixed chunk of [`CHUNK`]
+    /// permanent ids in id order, then over chunks in order: the same bits however the slots
+    /// are numbered.
+    fn of(n_walls: usize, touches: &[WallTouch<T>]) -> Self {
+        let mut total = WallSums::new(n_walls);
+        let mut part = WallSums::new(n_walls);
+        let mut chunk = touches.first().map_or(0, |t| t.grain as usize / CHUNK);
+        for t in touches {
+            if t.grain as usize / CHUNK != chunk {
+                total.absorb(&part);
+                part = WallSums::new(n_walls);
+                chunk = t.grain as usize / CHUNK;
+            }
+            let w = t.wall as usize;
+            part.reaction[w] -= t.force;
+            part.count[w] += 1;
+            part.regimes.count(t.regime);
+            part.response[w].0 += t.stiffness;
+            part.response[w].1 += t.damping;
+        }
+        total.absorb(&part);
+        total
+    }
+
+    /// Adds one chunk's sums.
+    fn absorb(&mut self, p: &Self) {
+        for w in 0..self.reaction.len() {
+            self.reaction[w] += p.reaction[w];
+            self.count[w] += p.count[w];
+            self.response[w].0 += p.response[w].0;
+            self.response[w].1 += p.response[w].1;
+        }
+        self.regimes.add(p.regimes);
+    }
 }
 
-/// `wall_contacts` over every grain; returns the per-wall sums (per fixed chunk, then over
-/// chunks in order).
+/// `wall_contacts` over every grain; returns the per-wall sums ([`WallSums::of`]).
 fn wall_pass<T: Real>(
     ctx: &ForceContext<T>,
+    id: &[u32],
     body: &[Body<T>],
     prop: &[Props<T>],
     walls: &[WallState<T>],
     wall_load: &mut [Load<T>],
     wall_hist: &mut [T],
 ) -> WallSums<T> {
-    let n_walls = walls.len();
-    let per_grain = n_walls * ctx.slots.stride;
+    let per_grain = walls.len() * ctx.slots.stride;
     let run = |c: usize, loads: &mut [Load<T>], hist: &mut [T]| {
-        let mut sums = WallSums::new(n_walls);
-        wall_block(c * CHUNK, loads, hist, body, prop, walls, ctx, &mut sums.reaction, &mut sums.count, &mut sums.response, &mut sums.regimes);
-        sums
+        let mut touches = Vec::new();
+        wall_block(c * CHUNK, loads, hist, id, body, prop, walls, ctx, &mut touches);
+        touches
     };
-    let parts: Vec<WallSums<T>> = if per_grain == 0 {
+    let parts: Vec<Vec<WallTouch<T>>> = if per_grain == 0 {
         wall_load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, loads)| run(c, loads, &mut [])).collect()
     } else {
         wall_load.par_chunks_mut(CHUNK).zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, (loads, hist))| run(c, loads, hist)).collect()
     };
-    let mut total = WallSums::new(n_walls);
-    for p in parts {
-        for w in 0..n_walls {
-            total.reaction[w] += p.reaction[w];
-            total.count[w] += p.count[w];
-            total.response[w].0 += p.response[w].0;
-            total.response[w].1 += p.response[w].1;
-        }
-        total.regimes.add(p.regimes);
-    }
-    total
+    let mut touches = parts.concat();
+    touches.sort_unstable_by_key(|t| (t.grain, t.wall));
+    WallSums::of(walls.len(), &touches)
 }
 
 /// Splits the pair pass's outputs into the tasks of [`owner_block`]: [`pair_force::OWNERS`]
@@ -649,16 +745,19 @@ impl<T: Real> Engine for CpuEngine<T> {
         let CohesionLaw::Capillary { theta, .. } = self.model.cohesion else {
             anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
         };
-        let pairs: Vec<(f64, f64, f64)> = (0..self.pairs.len())
-            .map(|k| {
+        let order = self.pairs.in_id_order(&self.slot);
+        let pairs: Vec<(f64, f64, f64)> = order
+            .iter()
+            .map(|&k| {
+                let k = k as usize;
                 let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
                 (self.prop[i].radius.f64(), self.prop[j].radius.f64(), self.gap(k).f64())
             })
             .collect();
         let (shares, rest) = share_liquid(volume, &pairs, self.bridge_cap.f64(), theta.f64());
         let (stride, b) = (self.slots.stride, self.slots.bridge);
-        for (k, v) in shares {
-            self.hist[k * stride + b] += T::of(v);
+        for (c, v) in shares {
+            self.hist[order[c] as usize * stride + b] += T::of(v);
         }
         // What the bridges could not hold waits on the grains.
         let rest = T::of(rest / self.liquid.len() as f64);
@@ -687,7 +786,7 @@ impl<T: Real> Engine for CpuEngine<T> {
 
     fn memory_bytes(&self) -> u64 {
         let l = &self.pairs;
-        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.body) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
+        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
         let walls = allocated(&self.wall_hist) + allocated(&self.wall_load) + self.orientation.as_ref().map_or(0, allocated);
         let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.owner) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
         grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)

@@ -33,8 +33,9 @@ impl PairList {
         self.owner.is_empty()
     }
 
-    /// Runs `detect_pairs` for every grain and assembles the list. Returns the first grain
-    /// (index, count) that owns more than `capacity` pairs, if any.
+    /// Runs `detect_pairs` for every grain and assembles the list, without the reverse lists
+    /// ([`Self::build_reverse`]). Of the grains that own more than `capacity` pairs, returns
+    /// the one with the lowest permanent id (slot, count).
     pub fn detect<T: Real>(
         body: &[Body<T>],
         prop: &[Props<T>],
@@ -59,23 +60,29 @@ impl PairList {
         let total = parts.iter().map(|(_, partners)| partners.len()).sum();
         let mut list = PairList { owner_start: Vec::with_capacity(n + 1), owner: Vec::with_capacity(total), partner: Vec::with_capacity(total), ..Default::default() };
         list.owner_start.push(0);
+        let mut over: Option<(usize, usize)> = None;
         for (counts, partners) in parts {
             for c in counts {
                 let i = list.owner_start.len() - 1;
-                if c as usize > capacity {
-                    return Err((i, c as usize));
+                if c as usize > capacity && over.is_none_or(|(o, _)| id[i] < id[o]) {
+                    over = Some((i, c as usize));
                 }
                 list.owner.extend(std::iter::repeat_n(i as u32, c as usize));
                 list.owner_start.push(list.owner_start[i] + c);
             }
             list.partner.extend(partners);
         }
-        list.build_reverse(n);
-        Ok(list)
+        match over {
+            Some(o) => Err(o),
+            None => Ok(list),
+        }
     }
 
-    /// Counting sort of pair indices by partner (stable, so ascending within a partner).
-    fn build_reverse(&mut self, n: usize) {
+    /// The reverse lists: pair indices grouped by partner, and within a partner in ascending
+    /// permanent id of the owner (the owners walked in id order, `slot[id]` being the slot of
+    /// permanent id `id`), so that the gather's sums do not depend on how slots are numbered.
+    pub fn build_reverse(&mut self, slot: &[u32]) {
+        let n = slot.len();
         self.rev_start = vec![0; n + 1];
         for &j in &self.partner {
             self.rev_start[j as usize + 1] += 1;
@@ -85,10 +92,21 @@ impl PairList {
         }
         let mut cursor = self.rev_start[..n].to_vec();
         self.rev_pair = vec![0; self.partner.len()];
-        for (k, &j) in self.partner.iter().enumerate() {
-            self.rev_pair[cursor[j as usize] as usize] = k as u32;
-            cursor[j as usize] += 1;
+        for k in self.in_id_order(slot) {
+            let j = self.partner[k as usize] as usize;
+            self.rev_pair[cursor[j] as usize] = k;
+            cursor[j] += 1;
         }
+    }
+
+    /// Pair indices in canonical order: owners by ascending permanent id, then the owner's
+    /// pairs in list order (ascending partner id). `slot[id]` is the slot of permanent id `id`.
+    pub fn in_id_order(&self, slot: &[u32]) -> Vec<u32> {
+        let mut order = Vec::with_capacity(self.len());
+        for &s in slot {
+            order.extend(self.owner_start[s as usize]..self.owner_start[s as usize + 1]);
+        }
+        order
     }
 
     /// Index of the pair (owner `i`, partner with permanent id `partner_id`), if listed.

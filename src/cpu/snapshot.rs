@@ -3,20 +3,24 @@
 use super::*;
 
 impl<T: Real> CpuEngine<T> {
-    /// The grain state, and the touching pairs and wall contacts with their forces when
-    /// `contacts`.
+    /// The grain state in permanent-id order, and the touching pairs (canonical order) and
+    /// wall contacts with their forces when `contacts`.
     pub(super) fn snapshot(&self, contacts: bool) -> Frame {
+        let body = self.bodies();
         Frame {
             time: self.time,
-            id: self.id.clone(),
-            position: self.body.iter().map(|b| b.pos.f64()).collect(),
-            radius: self.prop.iter().map(|p| p.radius.f64()).collect(),
-            velocity: self.body.iter().map(|b| b.vel.f64()).collect(),
-            angular_velocity: self.body.iter().map(|b| b.omega.f64()).collect(),
-            orientation: self.orientation.as_ref().map(|q| q.iter().map(|q| [q[0].f64(), q[1].f64(), q[2].f64(), q[3].f64()]).collect()),
+            id: (0..self.id.len() as u32).collect(),
+            position: body.iter().map(|b| b.pos.f64()).collect(),
+            radius: self.by_id(&self.prop).iter().map(|p| p.radius.f64()).collect(),
+            velocity: body.iter().map(|b| b.vel.f64()).collect(),
+            angular_velocity: body.iter().map(|b| b.omega.f64()).collect(),
+            orientation: self.orientation.as_ref().map(|q| self.by_id(q).iter().map(|q| [q[0].f64(), q[1].f64(), q[2].f64(), q[3].f64()]).collect()),
             contacts: contacts.then(|| {
-                (0..self.pairs.len())
+                self.pairs
+                    .in_id_order(&self.slot)
+                    .into_iter()
                     .filter_map(|k| {
+                        let k = k as usize;
                         let (h, _) = self.pair_overlap(k);
                         (h > T::ZERO || self.report[k].f_c != T::ZERO).then(|| {
                             let springs = self.slots.load(&self.hist[k * self.slots.stride..]);
@@ -47,6 +51,8 @@ impl<T: Real> CpuEngine<T> {
     pub(super) fn save_state(&self) -> EngineState {
         let mut s = EngineState::default();
         let v3 = |v: &Vec3<T>| [v.x.f64(), v.y.f64(), v.z.f64()];
+        // The arrays below are by slot; `id` says whose.
+        s.put_ints("id", self.id.iter().map(|&x| x as u64));
         s.put_reals("body", self.body.iter().flat_map(|b| [v3(&b.pos), v3(&b.vel), v3(&b.omega)].concat()));
         s.put_reals("load", self.load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
         s.put_reals("wall_load", self.wall_load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
@@ -89,6 +95,19 @@ impl<T: Real> CpuEngine<T> {
     /// Restores what [`Self::save_state`] returned, for the same scene.
     pub(super) fn restore_state(&mut self, s: &EngineState) -> anyhow::Result<()> {
         let n = self.body.len();
+        let id: Vec<u32> = s.ints("id", Some(n))?.iter().map(|&x| x as u32).collect();
+        let mut seen = vec![false; n];
+        for &i in &id {
+            if (i as usize) >= n || std::mem::replace(&mut seen[i as usize], true) {
+                anyhow::bail!("the checkpoint's `id` is not a numbering of the scene's {n} grains");
+            }
+        }
+        // The grains' constant properties follow the checkpoint's numbering.
+        Renumbering::new(id.iter().map(|&i| self.slot[i as usize]).collect()).apply(&mut self.prop);
+        self.id = id;
+        for (slot, &i) in self.id.iter().enumerate() {
+            self.slot[i as usize] = slot as u32;
+        }
         let v3 = |a: &[f64]| Vec3::new(T::of(a[0]), T::of(a[1]), T::of(a[2]));
         for (b, c) in self.body.iter_mut().zip(s.reals("body", 9 * n)?.chunks_exact(9)) {
             *b = Body { pos: v3(&c[0..3]), vel: v3(&c[3..6]), omega: v3(&c[6..9]) };

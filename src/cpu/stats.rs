@@ -1,5 +1,6 @@
-//! Statistics: sums over grains and over pairs in fixed chunks, combined in order (the same
-//! bits on any thread count).
+//! Statistics: sums over grains and over pairs in fixed chunks, combined in order, grains in
+//! permanent-id order and pairs in canonical order (the same bits on any thread count and
+//! however the slots are numbered).
 
 use super::*;
 
@@ -32,8 +33,9 @@ struct PairSums {
     max_overlap: (f64, u32),
 }
 
+/// The larger value, and of equal values the lower grain id.
 fn max_by_first(a: (f64, u32), b: (f64, u32)) -> (f64, u32) {
-    if b.0 > a.0 { b } else { a }
+    if b.0 > a.0 || (b.0 == a.0 && b.1 < a.1) { b } else { a }
 }
 
 impl<T: Real> CpuEngine<T> {
@@ -45,7 +47,7 @@ impl<T: Real> CpuEngine<T> {
         let g = self.gravity;
         let grain_sums = chunked(self.body.len(), |r| {
             let mut s = GrainSums::default();
-            for i in r {
+            for i in r.map(|id| self.slot[id] as usize) {
                 let (b, p, l) = (&self.body[i], &self.prop[i], &self.load[i]);
                 let m = p.mass.f64();
                 let v = b.vel.f64();
@@ -89,9 +91,10 @@ impl<T: Real> CpuEngine<T> {
             }
             s
         });
-        let pair_sums = chunked(self.pairs.len(), |r| {
+        let canonical = self.pairs.in_id_order(&self.slot);
+        let pair_sums = chunked(canonical.len(), |r| {
             let mut s = PairSums::default();
-            for k in r {
+            for k in r.map(|c| canonical[c] as usize) {
                 let (h, r_min) = self.pair_overlap(k);
                 if h <= T::ZERO {
                     continue;
@@ -179,13 +182,13 @@ impl<T: Real> CpuEngine<T> {
                     let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
                     (v, capillary_potential(kappa, theta, c, self.prop[i].radius, self.prop[j].radius, v, self.gap(k)))
                 };
-                chunked(self.pairs.len(), |r| r.map(bridge).filter(|(v, _)| *v > T::ZERO).fold((0u64, 0.0, 0.0), |(n, s, u), (v, e)| (n + 1, s + v.f64(), u + e.f64())))
+                chunked(canonical.len(), |r| r.map(|c| bridge(canonical[c] as usize)).filter(|(v, _)| *v > T::ZERO).fold((0u64, 0.0, 0.0), |(n, s, u), (v, e)| (n + 1, s + v.f64(), u + e.f64())))
                     .into_iter()
                     .fold((0, 0.0, 0.0), |(n, s, u), (m, t, e)| (n + m, s + t, u + e))
             }
             CohesionLaw::None => (0, 0.0, 0.0),
         };
-        let liquid_on_grains: f64 = chunked(self.liquid.len(), |r| self.liquid[r].iter().map(|x| x.f64()).sum::<f64>()).into_iter().sum();
+        let liquid_on_grains: f64 = chunked(self.liquid.len(), |r| r.map(|id| self.liquid[self.slot[id] as usize].f64()).sum::<f64>()).into_iter().sum();
         Stats {
             step: self.step,
             time: self.time,
@@ -211,7 +214,7 @@ impl<T: Real> CpuEngine<T> {
             unbalanced_force_loaded,
             rattlers: gs.rattlers,
             ke_rattlers: gs.ke_rattlers,
-            non_finite_grain: self.body.iter().position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|i| self.id[i]),
+            non_finite_grain: self.first_non_finite(),
             rebuilds: self.rebuilds,
             bridges,
             liquid_in_bridges,

@@ -3,8 +3,8 @@
 
 use super::pair_force::ForceContext;
 use super::state::{Body, Load, Props};
-use crate::model::{contact_force, normal_damping, normal_stiffness, Bodies, Geometry, Kinematics};
-use crate::engine::{RegimeCounts, WallContactRecord};
+use crate::model::{contact_force, normal_damping, normal_stiffness, Bodies, Geometry, Kinematics, Regime};
+use crate::engine::WallContactRecord;
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
 
@@ -19,21 +19,35 @@ pub struct WallState<T> {
     pub material: u32,
 }
 
-/// `wall_contacts` for grain `i`. `hist` holds the grain's history blocks, one per wall;
-/// the force each wall receives is added to `reaction[w]`, its contact count to `count[w]`,
-/// the contact's normal tangent stiffness (N/m) and damping coefficient (N s/m) to
-/// `response[w]`, and its tangential regime to `regimes`. Returns the load on the grain.
+/// What one grain-wall contact adds to its wall's sums.
+#[derive(Clone, Copy, Debug)]
+pub struct WallTouch<T> {
+    /// The grain's permanent id.
+    pub grain: u32,
+    /// The wall's index.
+    pub wall: u32,
+    /// Force on the grain (N); the wall receives its opposite.
+    pub force: Vec3<T>,
+    /// Normal tangent stiffness (N/m).
+    pub stiffness: T,
+    /// Normal damping coefficient (N s/m).
+    pub damping: T,
+    /// Tangential regime.
+    pub regime: Regime,
+}
+
+/// `wall_contacts` for the grain of permanent id `id`. `hist` holds the grain's history
+/// blocks, one per wall; each touching wall's contact is appended to `touches`. Returns the
+/// load on the grain.
 #[inline(always)]
 pub fn wall_contacts<T: Real>(
+    id: u32,
     b: &Body<T>,
     p: &Props<T>,
     walls: &[WallState<T>],
     ctx: &ForceContext<T>,
     hist: &mut [T],
-    reaction: &mut [Vec3<T>],
-    count: &mut [u64],
-    response: &mut [(T, T)],
-    regimes: &mut RegimeCounts,
+    touches: &mut Vec<WallTouch<T>>,
 ) -> Load<T> {
     let mut load = Load::default();
     let stride = ctx.slots.stride;
@@ -53,35 +67,37 @@ pub fn wall_contacts<T: Real>(
         ctx.slots.store(&h, h_slot);
         load.force += f.f_i;
         load.torque += f.t_i;
-        reaction[w] -= f.f_i;
-        count[w] += 1;
-        regimes.count(f.regime);
-        response[w].0 += normal_stiffness(&ctx.model.normal, c, &geo);
-        response[w].1 += normal_damping(&ctx.model.damping, &ctx.model.normal, c, &geo);
+        touches.push(WallTouch {
+            grain: id,
+            wall: w as u32,
+            force: f.f_i,
+            stiffness: normal_stiffness(&ctx.model.normal, c, &geo),
+            damping: normal_damping(&ctx.model.damping, &ctx.model.normal, c, &geo),
+            regime: f.regime,
+        });
     }
     load
 }
 
 super::simd::dispatch! {
-    /// `wall_contacts` for grains `first..first + loads.len()`; `hist` holds their history
-    /// blocks (empty when the model keeps none); the walls' sums accumulate as in
-    /// [`wall_contacts`].
-    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, reaction: &mut [Vec3<T>], count: &mut [u64], response: &mut [(T, T)], regimes: &mut RegimeCounts) => wall_block_portable
+    /// `wall_contacts` for slots `first..first + loads.len()`; `hist` holds their history
+    /// blocks (empty when the model keeps none); the contacts are appended to `touches`.
+    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) => wall_block_portable
 }
 
 /// [`wall_block`] for whatever instruction set the caller is compiled for.
 #[inline(always)]
-fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, reaction: &mut [Vec3<T>], count: &mut [u64], response: &mut [(T, T)], regimes: &mut RegimeCounts) {
+fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) {
     let per_grain = walls.len() * ctx.slots.stride;
     for (m, l) in loads.iter_mut().enumerate() {
         let i = first + m;
-        *l = wall_contacts(&body[i], &prop[i], walls, ctx, &mut hist[m * per_grain..(m + 1) * per_grain], reaction, count, response, regimes);
+        *l = wall_contacts(id[i], &body[i], &prop[i], walls, ctx, &mut hist[m * per_grain..(m + 1) * per_grain], touches);
     }
 }
 
 /// Every touching grain-wall contact, with its force evaluated from the current state
-/// (springs read, not advanced: `ctx.elapsed` should be 0), grains in slot order, walls in
-/// order.
+/// (springs read, not advanced: `ctx.elapsed` should be 0), grains in permanent-id order,
+/// walls in order.
 pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[u32], walls: &[WallState<T>], ctx: &ForceContext<T>, hist: &[T]) -> Vec<WallContactRecord> {
     let stride = ctx.slots.stride;
     let mut out = Vec::new();
@@ -103,5 +119,6 @@ pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[
             out.push(WallContactRecord { grain: id[i], wall: w as u32, overlap: geo.h.f64(), normal: n.f64(), lever: geo.rp_i.f64(), force: f.f_i.f64() });
         }
     }
+    out.sort_by_key(|r| r.grain);
     out
 }

@@ -158,6 +158,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         skin,
         stats_interval,
         max_neighbours,
+        reorder_every: sim.reorder_every.unwrap_or(DEFAULT_REORDER_EVERY),
         max_overlap,
         track_orientation: sim.track_orientation,
         stages,
@@ -488,6 +489,11 @@ impl Origins {
         false
     }
 }
+
+/// Rebuilds between renumberings of the grains in cell order when the scene does not say:
+/// a pour's grains move a cell or so in a few hundred steps, and a renumbering costs about
+/// one rebuild.
+pub const DEFAULT_REORDER_EVERY: u64 = 10;
 
 /// Overlap with a wall (fraction of the radius) that a grain read from a file may start with:
 /// a settled packing rests on its floor with overlaps of about 1e-3 of a radius.

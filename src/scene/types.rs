@@ -287,6 +287,8 @@ pub struct Scene {
     pub stats_interval: u64,
     /// Pairs a grain may own before the run stops with a capacity error.
     pub max_neighbours: usize,
+    /// Rebuilds between renumberings of the grains in cell order (0: never).
+    pub reorder_every: u64,
     /// Overlap / smaller radius at which a run stops as unstable.
     pub max_overlap: f64,
     /// Integrate orientation quaternions.

@@ -1,0 +1,110 @@
+//! `reorder`: renumbers the grains' slots in the order of the cells that hold them (the
+//! grid's cell-sorted list), as LAMMPS' `atom_modify sort` does, so that grains that touch sit
+//! near each other in memory and the pair pass's partner loads hit the cache. Every per-grain
+//! array, the pair list and the per-contact history move with their grains; the permanent id
+//! moves too, and every order that reaches a result is taken in permanent ids, so a run gives
+//! the same bits however its slots are numbered.
+
+use super::pairs::PairList;
+use super::reduce::chunked;
+use crate::real::Real;
+use rayon::prelude::*;
+
+/// A renumbering of slots.
+pub struct Renumbering {
+    /// The old slot of each new slot.
+    pub from: Vec<u32>,
+    /// The new slot of each old slot.
+    pub to: Vec<u32>,
+}
+
+impl Renumbering {
+    /// The renumbering that puts old slot `from[s]` at new slot `s` (`from` is a permutation).
+    pub fn new(from: Vec<u32>) -> Self {
+        let mut to = vec![0; from.len()];
+        for (s, &o) in from.iter().enumerate() {
+            to[o as usize] = s as u32;
+        }
+        Renumbering { from, to }
+    }
+
+    /// True when no slot moves.
+    pub fn is_identity(&self) -> bool {
+        self.from.iter().enumerate().all(|(s, &o)| s == o as usize)
+    }
+
+    /// Moves one item per slot (an empty array, for a quantity the scene does not have, stays
+    /// empty).
+    pub fn apply<X: Copy + Send + Sync>(&self, v: &mut Vec<X>) {
+        self.apply_blocks(v, 1);
+    }
+
+    /// Moves `width` items per slot.
+    pub fn apply_blocks<X: Copy + Send + Sync>(&self, v: &mut Vec<X>, width: usize) {
+        if v.is_empty() || width == 0 {
+            return;
+        }
+        let old = &*v;
+        let moved: Vec<X> = self.from.par_iter().with_min_len(super::reduce::PAR_MIN_ITEMS).flat_map_iter(|&o| old[o as usize * width..(o as usize + 1) * width].iter().copied()).collect();
+        *v = moved;
+    }
+
+    /// The pair list and its history (`stride` reals per pair) in the new slots: each owner's
+    /// pairs move with it, in the same order (ascending partner id), and partners are
+    /// renamed. The reverse lists are left empty for [`PairList::build_reverse`].
+    pub fn apply_pairs<T: Real>(&self, list: &PairList, hist: &[T], stride: usize) -> (PairList, Vec<T>) {
+        let n = self.from.len();
+        let mut owner_start = Vec::with_capacity(n + 1);
+        owner_start.push(0u32);
+        for &o in &self.from {
+            let o = o as usize;
+            owner_start.push(owner_start.last().copied().unwrap_or(0) + list.owner_start[o + 1] - list.owner_start[o]);
+        }
+        let parts = chunked(n, |r| {
+            let (mut partner, mut h) = (Vec::new(), Vec::new());
+            for s in r {
+                let o = self.from[s] as usize;
+                let (a, b) = (list.owner_start[o] as usize, list.owner_start[o + 1] as usize);
+                partner.extend(list.partner[a..b].iter().map(|&j| self.to[j as usize]));
+                h.extend_from_slice(&hist[a * stride..b * stride]);
+            }
+            (partner, h)
+        });
+        let n_pairs = list.len();
+        let mut moved = PairList { owner: Vec::with_capacity(n_pairs), partner: Vec::with_capacity(n_pairs), ..Default::default() };
+        let mut moved_hist = Vec::with_capacity(hist.len());
+        for (partner, h) in parts {
+            moved.partner.extend(partner);
+            moved_hist.extend(h);
+        }
+        for s in 0..n {
+            moved.owner.extend(std::iter::repeat_n(s as u32, (owner_start[s + 1] - owner_start[s]) as usize));
+        }
+        moved.owner_start = owner_start;
+        (moved, moved_hist)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pairs_follow_their_owners_and_partners_are_renamed() {
+        // Three grains with permanent ids = old slots; pairs 0-1, 0-2, 1-2.
+        let mut list = PairList { owner_start: vec![0, 2, 3, 3], owner: vec![0, 0, 1], partner: vec![1, 2, 2], ..Default::default() };
+        list.build_reverse(&[0, 1, 2]);
+        let hist: Vec<f64> = vec![1.0, 1.5, 2.0, 2.5, 3.0, 3.5];
+        // New slots: old 2, old 0, old 1.
+        let r = Renumbering::new(vec![2, 0, 1]);
+        assert_eq!(r.to, vec![1, 2, 0]);
+        let (moved, h) = r.apply_pairs(&list, &hist, 2);
+        assert_eq!(moved.owner_start, vec![0, 0, 2, 3]);
+        assert_eq!(moved.owner, vec![1, 1, 2]);
+        assert_eq!(moved.partner, vec![2, 0, 0]);
+        assert_eq!(h, hist);
+        let mut v = vec![10, 11, 12];
+        r.apply(&mut v);
+        assert_eq!(v, vec![12, 10, 11]);
+    }
+}
