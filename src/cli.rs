@@ -43,6 +43,15 @@ pub enum BenchBackend {
     All,
 }
 
+/// Whether the CPU engine renumbers the grains in cell order (`grains bench --reorder`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Reorder {
+    /// Every `simulation.reorder_every` rebuilds (the scene's, else the default).
+    On,
+    /// Never: the grains stay in the order they were poured in.
+    Off,
+}
+
 /// Parts of `grains bench`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum BenchPart {
@@ -161,6 +170,10 @@ pub enum Command {
         /// CPU thread counts, comma-separated (default: 1 and every core).
         #[arg(long, value_delimiter = ',')]
         threads: Vec<usize>,
+        /// CPU runs with the grains renumbered in cell order every few rebuilds (on) and left in
+        /// the pour's order (off), comma-separated: `--reorder on,off` compares the two.
+        #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Reorder::On])]
+        reorder: Vec<Reorder>,
         /// Particle-steps per timed run (its steps are this over the grain count, at least 20).
         #[arg(long, default_value_t = 5e7)]
         work: f64,

@@ -1,6 +1,6 @@
 //! The subcommands' bodies.
 
-use crate::cli::{Backend, BenchBackend, BenchPart, Cli, Command, E0Choice, ExportFormat, FitLaw, Precision};
+use crate::cli::{Backend, BenchBackend, BenchPart, Cli, Command, E0Choice, ExportFormat, FitLaw, Precision, Reorder};
 use anyhow::Context;
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
@@ -157,7 +157,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Bench { sizes, backend, adapter, precision, threads, work, repeats, part, cache, bed, out, json } => {
+        Command::Bench { sizes, backend, adapter, precision, threads, reorder, work, repeats, part, cache, bed, out, json } => {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             let mut threads = if threads.is_empty() { vec![1, cores] } else { threads };
             threads.dedup();
@@ -174,6 +174,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 backends,
                 precisions: precision.iter().map(|p| if *p == Precision::F32 { "f32".to_string() } else { "f64".to_string() }).collect(),
                 threads,
+                reorder: reorder.iter().map(|r| *r == Reorder::On).collect(),
                 work,
                 repeats: repeats as usize,
                 throughput: matches!(part, BenchPart::Throughput | BenchPart::All),

@@ -65,7 +65,6 @@ pub fn settled_bed(cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedIn
         scene.grains.position = triples("position").with_context(|| format!("{}: a damaged bed; fix: delete it and run again", path.display()))?;
         scene.grains.velocity = triples("velocity")?;
         scene.grains.angular_velocity = triples("angular_velocity")?;
-        scene.grains = in_cell_order(&scene.grains);
         return Ok((scene, info));
     }
     if progress {
@@ -99,16 +98,13 @@ pub fn settled_bed(cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedIn
     state.put_reals("angular_velocity", flat(&scene.grains.angular_velocity));
     std::fs::create_dir_all(cache).with_context(|| format!("cannot create the cache folder {}", cache.display()))?;
     checkpoint::write(&path, &info, &state)?;
-    scene.grains = in_cell_order(&scene.grains);
     Ok((scene, info))
 }
 
-/// A bed given as a scene file (e.g. one whose `[[read]]` takes LAMMPS' settled bed), renumbered
-/// in cell order as the poured bed is: its contacts per grain at the start, from one
-/// statistics read of a CPU f64 engine.
+/// A bed given as a scene file (e.g. one whose `[[read]]` takes LAMMPS' settled bed): its
+/// contacts per grain at the start, from one statistics read of a CPU f64 engine.
 pub fn given_bed(path: &Path) -> anyhow::Result<(Scene, BedInfo)> {
-    let mut scene = scene::load(path)?;
-    scene.grains = in_cell_order(&scene.grains);
+    let scene = scene::load(path)?;
     let stats = crate::engine::Engine::stats(&mut CpuEngine::<f64>::new(&scene)?)?;
     let n = scene.grains.len() as f64;
     let info = BedInfo {
@@ -121,20 +117,6 @@ pub fn given_bed(path: &Path) -> anyhow::Result<(Scene, BedInfo)> {
         source: path.display().to_string(),
     };
     Ok((scene, info))
-}
-
-/// The grains renumbered in the order of the cells (one largest diameter wide; z, then y,
-/// then x) that hold them, as LAMMPS' `atom_modify sort` keeps its atoms: grains that touch
-/// are then near in memory.
-fn in_cell_order(g: &Grains) -> Grains {
-    let cell = 2.0 * g.radius.iter().copied().fold(0.0, f64::max);
-    let key = |p: &[f64; 3]| p.map(|x| (x / cell).floor() as i64);
-    let mut order: Vec<usize> = (0..g.len()).collect();
-    order.sort_by_key(|&i| {
-        let [x, y, z] = key(&g.position[i]);
-        (z, y, x, i)
-    });
-    g.permuted(&order)
 }
 
 /// `nx x ny` copies of a bed periodic in x and y, side by side in the x-y plane. Copy `c`
@@ -163,6 +145,22 @@ pub fn tile(bed: &Scene, nx: usize, ny: usize) -> anyhow::Result<Scene> {
     scene.grains = out;
     Ok(scene)
 }
+
+/// `bed` with its grains numbered at random (a fixed shuffle): the order of a pour whose
+/// grains were inserted at random places, which the engine's renumbering in cell order
+/// (`simulation.reorder_every`) must undo for the pair pass to find its partners in the cache.
+pub fn shuffled(bed: &Scene) -> Scene {
+    use rand::seq::SliceRandom;
+    use rand::SeedableRng;
+    let mut order: Vec<usize> = (0..bed.grains.len()).collect();
+    order.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(SHUFFLE_SEED));
+    let mut scene = bed.clone();
+    scene.grains = bed.grains.permuted(&order);
+    scene
+}
+
+/// Seed of [`shuffled`]'s order.
+const SHUFFLE_SEED: u64 = 14;
 
 /// Tiles the 10^4-grain bed up to `n` grains (a multiple of 10^4 that is a product of two
 /// tile counts no more than 4:1 apart, e.g. 10^5 = 5 x 2, 10^6 = 10 x 10).

@@ -28,6 +28,8 @@ pub struct BenchOptions {
     pub precisions: Vec<String>,
     /// CPU thread counts.
     pub threads: Vec<usize>,
+    /// CPU runs with the engine renumbering the grains in cell order (true) and without.
+    pub reorder: Vec<bool>,
     /// Particle-steps per timed run (the steps are this over the grain count, at least 20).
     pub work: f64,
     /// Timed runs per configuration; the median is reported.
@@ -139,15 +141,16 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
     if opts.throughput {
         for &n in &opts.sizes {
             for backend in &opts.backends {
-                let configs: Vec<(String, usize)> = if backend == "gpu" {
-                    vec![("f32".into(), 1)]
+                let configs: Vec<(String, usize, bool)> = if backend == "gpu" {
+                    vec![("f32".into(), 1, false)]
                 } else {
-                    opts.precisions.iter().flat_map(|p| opts.threads.iter().map(move |&t| (p.clone(), t))).collect()
+                    opts.precisions.iter().flat_map(|p| opts.threads.iter().flat_map(move |&t| opts.reorder.iter().map(move |&r| (p.clone(), t, r)))).collect()
                 };
-                for (precision, threads) in configs {
+                for (precision, threads, reorder) in configs {
                     let steps = ((opts.work / n as f64).round() as u64).max(20);
                     let warmup = (steps / 5).max(10);
-                    say(&format!("{backend} {precision} {threads} thread(s), {n} grains: {warmup} + {} x {steps} steps", opts.repeats));
+                    let order = if backend == "gpu" { "" } else if reorder { ", renumbered in cell order" } else { ", in the pour's order" };
+                    say(&format!("{backend} {precision} {threads} thread(s), {n} grains{order}: {warmup} + {} x {steps} steps", opts.repeats));
                     let peak_reset = memory::reset_peak();
                     let row = if backend == "gpu" {
                         let gpu = crate::gpu::open(opts.adapter.as_deref())?;
@@ -156,14 +159,17 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
                             let scene = bed::bed_of(&base, n)?;
                             crate::gpu::GpuEngine::new(gpu, &scene)?
                         };
-                        throughput::measure(&mut engine, &device, 1, warmup, steps, opts.repeats, peak_reset)?
+                        throughput::measure(&mut engine, &device, 1, None, warmup, steps, opts.repeats, peak_reset)?
                     } else {
                         pool(threads)?.install(|| -> anyhow::Result<Throughput> {
-                            let mut engine: Box<dyn Engine> = {
-                                let scene = bed::bed_of(&base, n)?;
-                                crate::runner::cpu_engine(&scene, &precision)?
+                            let mut scene = bed::shuffled(&bed::bed_of(&base, n)?);
+                            scene.reorder_every = match (reorder, scene.reorder_every) {
+                                (false, _) => 0,
+                                (true, 0) => crate::scene::DEFAULT_REORDER_EVERY,
+                                (true, every) => every,
                             };
-                            throughput::measure(engine.as_mut(), &machine.cpu, threads, warmup, steps, opts.repeats, peak_reset)
+                            let mut engine = crate::runner::cpu_engine(&scene, &precision)?;
+                            throughput::measure(engine.as_mut(), &machine.cpu, threads, Some(scene.reorder_every), warmup, steps, opts.repeats, peak_reset)
                         })?
                     };
                     say(&format!("  {:.3e} particle-steps/s, Z = {:.3}, {:.0} B/grain", row.particle_steps_per_second, row.contacts_per_grain, row.bytes_per_grain));
@@ -223,7 +229,8 @@ impl BenchReport {
             for b in &self.memory_bandwidth {
                 s.push_str(&format!("memory bandwidth (STREAM triad), {} thread(s): {:.2} GB/s\n", b.threads, b.triad_bytes_per_second / 1e9));
             }
-            s.push_str("backend prec thr    grains  particle-steps/s  spread  ns/p-step     Z  pairs/grain  B/grain  B/p-step  GB/s (of triad)  peak RSS MiB  time shares\n");
+            s.push_str("(reorder: rebuilds between the CPU engine's renumberings in cell order; 0: the grains stay in the pour's order)\n");
+            s.push_str("backend prec thr reorder    grains  particle-steps/s  spread  ns/p-step     Z  pairs/grain  B/grain  B/p-step  GB/s (of triad)  peak RSS MiB  time shares\n");
             for r in &self.throughput {
                 let mut phases = r.phases.clone();
                 phases.sort_by(|a, b| b.share.total_cmp(&a.share));
@@ -235,10 +242,11 @@ impl BenchReport {
                     _ => "-".to_string(),
                 };
                 s.push_str(&format!(
-                    "{:<7} {:<4} {:>3} {:>9} {:>17.3e} {:>6.1}% {:>10.1} {:>5.2} {:>12.2} {:>8.0} {:>9} {:>16} {:>13} {}\n",
+                    "{:<7} {:<4} {:>3} {:>7} {:>9} {:>17.3e} {:>6.1}% {:>10.1} {:>5.2} {:>12.2} {:>8.0} {:>9} {:>16} {:>13} {}\n",
                     r.backend,
                     r.precision,
                     r.threads,
+                    r.reorder_every.map_or("-".to_string(), |e| e.to_string()),
                     r.grains,
                     r.particle_steps_per_second,
                     r.spread_percent(),

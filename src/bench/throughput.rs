@@ -37,6 +37,9 @@ pub struct Throughput {
     pub precision: String,
     /// Worker threads (CPU); 1 for the GPU's host thread.
     pub threads: usize,
+    /// Rebuilds between the CPU engine's renumberings of the grains in cell order (0: never;
+    /// `simulation.reorder_every`); absent on the GPU, which keeps the scene's order.
+    pub reorder_every: Option<u64>,
     /// Grains.
     pub grains: usize,
     /// Untimed steps before the timed ones.
@@ -119,8 +122,10 @@ impl Throughput {
 
 /// Times `repeats` runs of `steps` steps of `engine`, one after the other, after `warmup`
 /// untimed ones, and reports the median. `peak_reset` says whether the process's peak
-/// memory was reset before the engine was built.
-pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u64, steps: u64, repeats: usize, peak_reset: bool) -> anyhow::Result<Throughput> {
+/// memory was reset before the engine was built; `reorder_every` is what the engine was
+/// built with.
+#[allow(clippy::too_many_arguments)]
+pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, reorder_every: Option<u64>, warmup: u64, steps: u64, repeats: usize, peak_reset: bool) -> anyhow::Result<Throughput> {
     engine.advance(warmup)?;
     let before = engine.stats()?;
     let dispatches_before = engine.dispatches();
@@ -163,6 +168,7 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, warmup: u6
         device: device.to_string(),
         precision: engine.precision().to_string(),
         threads,
+        reorder_every,
         grains: n,
         warmup_steps: warmup,
         steps,

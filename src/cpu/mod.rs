@@ -264,12 +264,11 @@ impl<T: Real> CpuEngine<T> {
         Ok(())
     }
 
-    /// `reorder`: renumbers the slots in the order of the grid's cells (see [`reorder`]); the
+    /// `reorder`: renumbers the slots in Z order of the grid's cells (see [`reorder`]); the
     /// grid then lists the new slots.
     fn reorder(&mut self) {
-        let r = Renumbering::new(std::mem::take(&mut self.grid.cell_grains));
+        let r = Renumbering::new(reorder::z_order(&self.grid, &self.body));
         if r.is_identity() {
-            self.grid.cell_grains = r.from;
             return;
         }
         r.apply(&mut self.id);
@@ -288,7 +287,9 @@ impl<T: Real> CpuEngine<T> {
         for (s, &id) in self.id.iter().enumerate() {
             self.slot[id as usize] = s as u32;
         }
-        self.grid.cell_grains = (0..self.id.len() as u32).collect();
+        for s in &mut self.grid.cell_grains {
+            *s = r.to[*s as usize];
+        }
         self.renumberings += 1;
     }
 
