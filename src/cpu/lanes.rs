@@ -234,6 +234,8 @@ mod tests {
     use crate::cpu::pair_force::pair_force;
     use crate::cpu::CpuEngine;
     use crate::engine::Engine;
+    use crate::cpu::state::Load;
+    use crate::cpu::wall_contacts::wall_contacts;
 
     const SCENE: &str = r#"
 seed = 5
@@ -316,6 +318,8 @@ duration = 1.0e-3
         } else {
             SCENE.to_string()
         };
+        // A floor in place of the period along z, so that walls add to the loads too.
+        let text = text.replace("z = [0.0, 14.0e-3]\n", "").replace("[model]", "[[wall]]\ntype = \"plane\"\nmaterial = \"sand\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n\n[model]");
         let mut scene = crate::scene::parse(std::path::Path::new("lanes_test.toml"), &text).unwrap();
         scene.grains.radius.iter_mut().for_each(|r| *r *= 1.1);
         scene.gravity = [0.0, 0.0, -9.81];
@@ -327,6 +331,12 @@ duration = 1.0e-3
         let mut hist = e.hist.clone();
         let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist[stride * k..stride * (k + 1)])).collect();
         let asymmetric = one.iter().filter(|f| f.f_i != -f.f_j).count();
+        // The floor's loads, from the same history.
+        let per_grain = e.walls.len() * stride;
+        let mut wall_hist = e.wall_hist.clone();
+        let mut touches = Vec::new();
+        let wall: Vec<Load<T>> = (0..e.body.len()).map(|i| wall_contacts(e.id[i], &e.body[i], &e.prop[i], &e.walls, &ctx, &mut wall_hist[i * per_grain..(i + 1) * per_grain], &mut touches)).collect();
+        assert!(!touches.is_empty(), "grains must touch the floor");
         e.evaluate_forces(elapsed);
         let p = &e.pairs;
         let first = (0..e.body.len()).find(|&i| {
@@ -339,11 +349,11 @@ duration = 1.0e-3
                 force += one[k as usize].f_j;
                 torque += one[k as usize].t_j;
             }
-            let (force, torque) = (force + e.wall_load[i].force, torque + e.wall_load[i].torque);
+            let (force, torque) = (force + wall[i].force, torque + wall[i].torque);
             let bits = |v: Vec3<T>| [v.x, v.y, v.z].map(|x| x.f64().to_bits());
             bits(force) != bits(e.load[i].force) || bits(torque) != bits(e.load[i].torque)
         });
-        println!("{} {}: {n} pairs, {asymmetric} with f_i != -f_j", T::NAME, if oquendo { "oquendo" } else { "mindlin" });
+        println!("{} {}: {n} pairs, {asymmetric} with f_i != -f_j, {} floor contacts", T::NAME, if oquendo { "oquendo" } else { "mindlin" }, touches.len());
         assert_eq!(first, None, "loads differ at grain {first:?}");
         let reports = (0..n).find(|&k| e.report[k].f_n != one[k].f_n || e.owner_force(k) != one[k].f_i || e.share[k].torque != one[k].t_j);
         assert_eq!(reports, None, "the pair's report differs at pair {reports:?}");

@@ -4,7 +4,7 @@
 //! One step runs the operations of [`crate::schedule`]: kicks, drifts (with the walls'
 //! controllers), the rebuild check (`hash_cells`, `detect_pairs`, `remap_history` when a grain
 //! has moved half the skin) and the force evaluations (`update_bridges`, `pair_force`,
-//! `wall_contacts`, `gather`). Results are bitwise identical for any thread count: every
+//! `gather`, `wall_contacts`). Results are bitwise identical for any thread count: every
 //! invocation writes its own output, and reductions combine fixed chunks in order.
 
 mod gather;
@@ -93,7 +93,9 @@ pub struct CpuEngine<T: Real> {
     piston: Option<Piston<T>>,
     servo: Option<Servo<T>>,
     wall_hist: Vec<T>,
-    wall_load: Vec<Load<T>>,
+    /// The grain-wall contacts of the last force evaluation, by grain id, then wall (their
+    /// loads went straight into the grains' loads).
+    wall_touches: Vec<WallTouch<T>>,
     wall_reaction: Vec<Vec3<T>>,
     wall_count: Vec<u64>,
     /// Wall contacts sliding and rolling at the last force evaluation.
@@ -196,7 +198,7 @@ impl<T: Real> CpuEngine<T> {
             piston,
             servo: scene.servo.map(|s| Servo { walls: s.walls, pressure: T::of(s.pressure), gain: T::of(s.gain), max_speed: T::of(s.max_speed), strain_rate: None }),
             wall_hist: vec![T::ZERO; n * n_walls * slots.stride],
-            wall_load: vec![Load::default(); n],
+            wall_touches: Vec::new(),
             wall_reaction: vec![Vec3::ZERO; n_walls],
             wall_count: vec![0; n_walls],
             wall_regimes: RegimeCounts::default(),
@@ -278,7 +280,6 @@ impl<T: Real> CpuEngine<T> {
         r.apply(&mut self.built_at);
         r.apply(&mut self.image);
         r.apply(&mut self.liquid);
-        r.apply(&mut self.wall_load);
         r.apply_blocks(&mut self.wall_hist, self.walls.len() * self.slots.stride);
         if let Some(q) = &mut self.orientation {
             r.apply(q);
@@ -416,8 +417,8 @@ impl<T: Real> CpuEngine<T> {
         }
     }
 
-    /// Runs the force passes: `update_bridges` (capillary scenes), `pair_force`,
-    /// `wall_contacts`, `gather`; the springs advance by `elapsed` (s).
+    /// Runs the force passes: `update_bridges` (capillary scenes), `pair_force`, `gather`,
+    /// `wall_contacts`; the springs advance by `elapsed` (s).
     fn evaluate_forces(&mut self, elapsed: T) {
         let t = self.clock.start();
         if self.slots.layout.bridge {
@@ -437,17 +438,14 @@ impl<T: Real> CpuEngine<T> {
         blocks.into_par_iter().with_min_len(min_blocks.max(1)).for_each_init(Vec::new, |scratch, b| owner_block(b, scratch, pairs, body, prop, &ctx, gravity));
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
+        let (sums, touches) = complete_loads(&ctx, pairs, &self.share, &self.id, body, prop, &self.walls, &mut self.load, &mut self.wall_hist);
         if !self.walls.is_empty() {
-            let sums = wall_pass(&ctx, &self.id, body, prop, &self.walls, &mut self.wall_load, &mut self.wall_hist);
+            self.wall_touches = touches;
             self.wall_reaction = sums.reaction;
             self.wall_count = sums.count;
             self.wall_response = sums.response;
             self.wall_regimes = sums.regimes;
         }
-        self.clock.stop(Phase::Walls, t);
-        let t = self.clock.start();
-        let (share, wall_load) = (&self.share, &self.wall_load);
-        self.load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().for_each(|(c, l)| gather_block(c * CHUNK, l, pairs, share, wall_load));
         self.forces_valid = true;
         self.clock.stop(Phase::Gather, t);
     }
@@ -627,30 +625,38 @@ impl<T: Real> WallSums<T> {
     }
 }
 
-/// `wall_contacts` over every grain; returns the per-wall sums ([`WallSums::of`]).
-fn wall_pass<T: Real>(
+/// `gather`, then `wall_contacts`, over every grain in one sweep (chunk by chunk): each
+/// grain's load gets its partners' shares, then its wall load. Returns the per-wall sums
+/// ([`WallSums::of`]) and the wall contacts, sorted by grain id, then wall.
+#[allow(clippy::too_many_arguments)]
+fn complete_loads<T: Real>(
     ctx: &ForceContext<T>,
+    pairs: &PairList,
+    share: &[Load<T>],
     id: &[u32],
     body: &[Body<T>],
     prop: &[Props<T>],
     walls: &[WallState<T>],
-    wall_load: &mut [Load<T>],
+    load: &mut [Load<T>],
     wall_hist: &mut [T],
-) -> WallSums<T> {
+) -> (WallSums<T>, Vec<WallTouch<T>>) {
     let per_grain = walls.len() * ctx.slots.stride;
     let run = |c: usize, loads: &mut [Load<T>], hist: &mut [T]| {
+        gather_block(c * CHUNK, loads, pairs, share);
         let mut touches = Vec::new();
-        wall_block(c * CHUNK, loads, hist, id, body, prop, walls, ctx, &mut touches);
+        if !walls.is_empty() {
+            wall_block(c * CHUNK, loads, hist, id, body, prop, walls, ctx, &mut touches);
+        }
         touches
     };
     let parts: Vec<Vec<WallTouch<T>>> = if per_grain == 0 {
-        wall_load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, loads)| run(c, loads, &mut [])).collect()
+        load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, loads)| run(c, loads, &mut [])).collect()
     } else {
-        wall_load.par_chunks_mut(CHUNK).zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, (loads, hist))| run(c, loads, hist)).collect()
+        load.par_chunks_mut(CHUNK).zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, (loads, hist))| run(c, loads, hist)).collect()
     };
     let mut touches = parts.concat();
     touches.sort_unstable_by_key(|t| (t.grain, t.wall));
-    WallSums::of(walls.len(), &touches)
+    (WallSums::of(walls.len(), &touches), touches)
 }
 
 /// Splits the pair pass's outputs into the tasks of [`owner_block`]: [`pair_force::OWNERS`]
@@ -788,7 +794,7 @@ impl<T: Real> Engine for CpuEngine<T> {
     fn memory_bytes(&self) -> u64 {
         let l = &self.pairs;
         let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
-        let walls = allocated(&self.wall_hist) + allocated(&self.wall_load) + self.orientation.as_ref().map_or(0, allocated);
+        let walls = allocated(&self.wall_hist) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
         let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.owner) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
         grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)
     }

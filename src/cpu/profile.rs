@@ -10,26 +10,24 @@ pub enum Phase {
     Hash,
     /// `detect_pairs` and the pair list's assembly.
     Detect,
-    /// `remap_history`.
+    /// `remap_history` and, every few rebuilds, `reorder`.
     Remap,
     /// `pair_force` (and `update_bridges` in capillary scenes).
     Force,
-    /// `wall_contacts`.
-    Walls,
-    /// `gather`.
+    /// `gather` and `wall_contacts` (one sweep over the grains).
     Gather,
     /// Kicks, drifts and the displacement check.
     Integrate,
 }
 
 /// The phases' names, indexed by `Phase as usize`.
-pub const PHASE_NAMES: [&str; 7] = ["hash", "detect", "remap", "force", "walls", "gather", "integrate"];
+pub const PHASE_NAMES: [&str; 6] = ["hash", "detect", "remap", "force", "gather", "integrate"];
 
 /// Accumulated seconds per phase.
 #[derive(Clone, Debug, Default)]
 pub struct PhaseClock {
     on: bool,
-    seconds: [f64; 7],
+    seconds: [f64; 6],
 }
 
 impl PhaseClock {

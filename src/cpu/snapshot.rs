@@ -55,7 +55,8 @@ impl<T: Real> CpuEngine<T> {
         s.put_ints("id", self.id.iter().map(|&x| x as u64));
         s.put_reals("body", self.body.iter().flat_map(|b| [v3(&b.pos), v3(&b.vel), v3(&b.omega)].concat()));
         s.put_reals("load", self.load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
-        s.put_reals("wall_load", self.wall_load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
+        s.put_ints("wall_touch_ids", self.wall_touches.iter().flat_map(|t| [t.grain as u64, t.wall as u64, t.regime as u64]));
+        s.put_reals("wall_touches", self.wall_touches.iter().flat_map(|t| [v3(&t.force).as_slice(), &[t.stiffness.f64(), t.damping.f64()]].concat()));
         s.put_reals("built_at", self.built_at.iter().flat_map(v3));
         s.put_ints("image", self.image.iter().flat_map(|i| i.map(|x| x as i64 as u64)));
         if let Some(q) = &self.orientation {
@@ -115,9 +116,13 @@ impl<T: Real> CpuEngine<T> {
         for (l, c) in self.load.iter_mut().zip(s.reals("load", 6 * n)?.chunks_exact(6)) {
             *l = Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) };
         }
-        for (l, c) in self.wall_load.iter_mut().zip(s.reals("wall_load", 6 * n)?.chunks_exact(6)) {
-            *l = Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) };
-        }
+        let ids = s.ints("wall_touch_ids", None)?;
+        let values = s.reals("wall_touches", 5 * ids.len() / 3)?;
+        self.wall_touches = ids
+            .chunks_exact(3)
+            .zip(values.chunks_exact(5))
+            .map(|(i, v)| WallTouch { grain: i[0] as u32, wall: i[1] as u32, regime: Regime::from_code(i[2] as u8), force: v3(&v[0..3]), stiffness: T::of(v[3]), damping: T::of(v[4]) })
+            .collect();
         for (b, c) in self.built_at.iter_mut().zip(s.reals("built_at", 3 * n)?.chunks_exact(3)) {
             *b = v3(c);
         }

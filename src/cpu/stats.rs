@@ -39,14 +39,26 @@ fn max_by_first(a: (f64, u32), b: (f64, u32)) -> (f64, u32) {
 }
 
 impl<T: Real> CpuEngine<T> {
+    /// Per fixed chunk of grain ids, the sum over its grains (in id order) of the magnitude of
+    /// the force the walls exert on each (N).
+    fn wall_force_by_chunk(&self) -> Vec<f64> {
+        let mut sums = vec![0.0; self.body.len().div_ceil(CHUNK)];
+        for grain in self.wall_touches.chunk_by(|a, b| a.grain == b.grain) {
+            let force = grain.iter().fold(Vec3::ZERO, |f, t| f + t.force);
+            sums[grain[0].grain as usize / CHUNK] += force.norm().f64();
+        }
+        sums
+    }
+
     /// The statistics of the current state (loads evaluated first if nothing has).
     pub(super) fn statistics(&mut self) -> Stats {
         // A rebuild that fails here (a non-finite grain) leaves the loads as they were: the
         // statistics name the grain and the next step returns the error.
         self.ensure_loads().ok();
         let g = self.gravity;
+        let wall_force = self.wall_force_by_chunk();
         let grain_sums = chunked(self.body.len(), |r| {
-            let mut s = GrainSums::default();
+            let mut s = GrainSums { wall_force: wall_force[r.start / CHUNK], ..Default::default() };
             for i in r.map(|id| self.slot[id] as usize) {
                 let (b, p, l) = (&self.body[i], &self.prop[i], &self.load[i]);
                 let m = p.mass.f64();
@@ -79,7 +91,6 @@ impl<T: Real> CpuEngine<T> {
                         s.max_wall_overlap = max_by_first(s.max_wall_overlap, ((h / p.radius).f64(), self.id[i]));
                     }
                 }
-                s.wall_force += self.wall_load[i].force.norm().f64();
                 let net = l.force.norm().f64();
                 s.net_force += net;
                 if contacts < RATTLER_CONTACTS {

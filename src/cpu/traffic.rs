@@ -22,8 +22,9 @@ impl<T: Real> CpuEngine<T> {
         let drift = 2 * body + bytes(&self.built_at) + 2 * orientation;
         let pair_out = bytes(&self.share) + bytes(&self.report) + bytes(&self.force_i);
         let force = bytes(&l.owner) + bytes(&l.partner) + body + prop + 2 * bytes(&self.hist) + pair_out + bytes(&self.load);
-        let walls = if self.walls.is_empty() { 0 } else { body + prop + bytes(&self.wall_load) + 2 * bytes(&self.wall_hist) };
-        let gather = bytes(&self.share) + bytes(&l.rev_start) + bytes(&l.rev_pair) + bytes(&self.wall_load) + 2 * bytes(&self.load);
+        // The wall contacts run in the gather's sweep, on the loads it has in hand.
+        let walls = if self.walls.is_empty() { 0 } else { body + prop + 2 * bytes(&self.wall_hist) };
+        let gather = bytes(&self.share) + bytes(&l.rev_start) + bytes(&l.rev_pair) + 2 * bytes(&self.load);
         let mut out: Vec<(&'static str, u64)> = Vec::new();
         let mut add = |name: &'static str, b: u64| match out.iter_mut().find(|e| e.0 == name) {
             Some(e) => e.1 += b,
@@ -36,8 +37,8 @@ impl<T: Real> CpuEngine<T> {
                 Op::RebuildIfNeeded => {}
                 Op::Forces { .. } => {
                     add("force", force);
-                    add("walls", walls);
                     add("gather", gather);
+                    add("walls", walls);
                 }
             }
         }

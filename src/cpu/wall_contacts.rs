@@ -80,8 +80,9 @@ pub fn wall_contacts<T: Real>(
 }
 
 super::simd::dispatch! {
-    /// `wall_contacts` for slots `first..first + loads.len()`; `hist` holds their history
-    /// blocks (empty when the model keeps none); the contacts are appended to `touches`.
+    /// `wall_contacts` for slots `first..first + loads.len()`, each grain's wall load (zero
+    /// without a contact) added to its load; `hist` holds their history blocks (empty when the
+    /// model keeps none); the contacts are appended to `touches`.
     pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) => wall_block_portable
 }
 
@@ -91,7 +92,9 @@ fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut 
     let per_grain = walls.len() * ctx.slots.stride;
     for (m, l) in loads.iter_mut().enumerate() {
         let i = first + m;
-        *l = wall_contacts(id[i], &body[i], &prop[i], walls, ctx, &mut hist[m * per_grain..(m + 1) * per_grain], touches);
+        let w = wall_contacts(id[i], &body[i], &prop[i], walls, ctx, &mut hist[m * per_grain..(m + 1) * per_grain], touches);
+        l.force += w.force;
+        l.torque += w.torque;
     }
 }
 
