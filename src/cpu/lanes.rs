@@ -355,7 +355,7 @@ duration = 1.0e-3
         });
         println!("{} {}: {n} pairs, {asymmetric} with f_i != -f_j, {} floor contacts", T::NAME, if oquendo { "oquendo" } else { "mindlin" }, touches.len());
         assert_eq!(first, None, "loads differ at grain {first:?}");
-        let reports = (0..n).find(|&k| e.report[k].f_n != one[k].f_n || e.owner_force(k) != one[k].f_i || e.share[k].torque != one[k].t_j);
+        let reports = (0..n).find(|&k| e.report.f_n[k] != one[k].f_n || e.report.regime(k) != one[k].regime || e.report.clamped(k) != one[k].clamped || e.owner_force(k) != one[k].f_i || e.share[k].torque != one[k].t_j);
         assert_eq!(reports, None, "the pair's report differs at pair {reports:?}");
     }
 

@@ -28,7 +28,7 @@ pub use integrate::rotate;
 pub use pairs::PairList;
 pub use pair_force::ForceContext;
 pub use profile::PHASE_NAMES;
-pub use state::{Body, HistorySlots, Load, PairReport, Props};
+pub use state::{Body, HistorySlots, Load, PairFlags, PairReports, Props};
 pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::engine::EngineState;
@@ -111,7 +111,7 @@ pub struct CpuEngine<T: Real> {
     /// owner's went straight into its load).
     share: Vec<Load<T>>,
     /// What the statistics and frames read of each pair's last evaluation.
-    report: Vec<PairReport<T>>,
+    report: PairReports<T>,
     /// Each pair's force on its owner (N), for the laws whose force on the owner is not the
     /// partner's reversed ([`pair_force::keeps_owner_force`]); empty otherwise.
     force_i: Vec<Vec3<T>>,
@@ -207,7 +207,7 @@ impl<T: Real> CpuEngine<T> {
             pairs: PairList::default(),
             hist: Vec::new(),
             share: Vec::new(),
-            report: Vec::new(),
+            report: PairReports::default(),
             force_i: Vec::new(),
             max_moved2: T::ZERO,
             forces_valid: false,
@@ -254,7 +254,7 @@ impl<T: Real> CpuEngine<T> {
         self.pairs.build_reverse(&self.slot);
         let n_pairs = self.pairs.len();
         renew(&mut self.share, n_pairs);
-        renew(&mut self.report, n_pairs);
+        self.report.renew(n_pairs, self.slots.layout.bridge);
         renew(&mut self.force_i, if pair_force::keeps_owner_force(&self.model) { n_pairs } else { 0 });
         for (b, at) in self.body.iter().zip(self.built_at.iter_mut()) {
             *at = b.pos;
@@ -666,12 +666,14 @@ fn owner_blocks<'a, T: Real>(
     stride: usize,
     mut load: &'a mut [Load<T>],
     mut share: &'a mut [Load<T>],
-    mut report: &'a mut [PairReport<T>],
+    report: &'a mut PairReports<T>,
     mut force_i: &'a mut [Vec3<T>],
     mut hist: &'a mut [T],
 ) -> Vec<OwnerBlock<'a, T>> {
     let n = load.len();
     let keep_fi = !force_i.is_empty();
+    let keep_fc = !report.f_c.is_empty();
+    let (mut f_n, mut f_c, mut flags) = (&mut report.f_n[..], &mut report.f_c[..], &mut report.flags[..]);
     let mut blocks = Vec::with_capacity(n.div_ceil(pair_force::OWNERS));
     for first in (0..n).step_by(pair_force::OWNERS) {
         let end = (first + pair_force::OWNERS).min(n);
@@ -680,7 +682,9 @@ fn owner_blocks<'a, T: Real>(
             first,
             load: take_front(&mut load, end - first),
             share: take_front(&mut share, count),
-            report: take_front(&mut report, count),
+            f_n: take_front(&mut f_n, count),
+            f_c: take_front(&mut f_c, if keep_fc { count } else { 0 }),
+            flags: take_front(&mut flags, count),
             force_i: take_front(&mut force_i, if keep_fi { count } else { 0 }),
             hist: take_front(&mut hist, count * stride),
         });
@@ -697,7 +701,7 @@ fn take_front<'a, X>(s: &mut &'a mut [X], n: usize) -> &'a mut [X] {
 
 /// Resizes `v` to `n` default values with no growth slack (a pair array of 10^6 grains is tens
 /// of megabytes).
-fn renew<X: Clone + Default>(v: &mut Vec<X>, n: usize) {
+pub(crate) fn renew<X: Clone + Default>(v: &mut Vec<X>, n: usize) {
     v.clear();
     v.shrink_to(n);
     v.reserve_exact(n);
@@ -795,7 +799,7 @@ impl<T: Real> Engine for CpuEngine<T> {
         let l = &self.pairs;
         let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
         let walls = allocated(&self.wall_hist) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
-        let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.owner) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
+        let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.owner) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
         grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)
     }
 

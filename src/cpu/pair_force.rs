@@ -9,7 +9,7 @@
 //! load on the spot, in the order the gather used to sum it.
 
 use super::pairs::PairList;
-use super::state::{Body, HistorySlots, Load, PairReport, Props};
+use super::state::{Body, HistorySlots, Load, PairFlags, Props};
 use crate::model::{capillary_force, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs, TangentialLaw};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
@@ -81,8 +81,12 @@ pub struct OwnerBlock<'a, T> {
     pub load: &'a mut [Load<T>],
     /// The partner's share of each pair: force (N) and torque (N m) on the partner.
     pub share: &'a mut [Load<T>],
-    /// What the statistics and frames read of each pair.
-    pub report: &'a mut [PairReport<T>],
+    /// Each pair's normal force after the clamp (N; [`super::PairReports`]).
+    pub f_n: &'a mut [T],
+    /// Each pair's capillary force (N); empty without cohesion.
+    pub f_c: &'a mut [T],
+    /// Each pair's [`PairFlags`].
+    pub flags: &'a mut [u8],
     /// The force on the owner of each pair (N), kept only where it is not the partner's
     /// force reversed (see [`keeps_owner_force`]); empty otherwise.
     pub force_i: &'a mut [Vec3<T>],
@@ -114,7 +118,7 @@ fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut Vec
         *l = Load { force: gravity * prop[first + m].mass, torque: Vec3::ZERO };
     }
     let first_pair = pairs.owner_start[first] as usize;
-    let (stride, n_pairs) = (ctx.slots.stride, block.report.len());
+    let (stride, n_pairs) = (ctx.slots.stride, block.f_n.len());
     if let Some(model) = super::lanes::hertz_mindlin(ctx.model) {
         debug_assert!(!ctx.slots.layout.sliding && !ctx.slots.layout.rolling, "Hertz-Mindlin keeps one spring per pair");
         scratch.resize(BLOCK, ContactForce::default());
@@ -145,10 +149,14 @@ impl<T: Real> OwnerBlock<'_, T> {
         // Field by field: a whole-struct store is assembled on the stack and read back in
         // wider words than it was written, which stalls store forwarding (a tenth of the
         // oedometer's step).
-        let (sh, r) = (&mut self.share[k], &mut self.report[k]);
+        let sh = &mut self.share[k];
         sh.force = f.f_j;
         sh.torque = f.t_j;
-        (r.f_n, r.f_c, r.clamped, r.regime) = (f.f_n, f.f_c, f.clamped, f.regime);
+        self.f_n[k] = f.f_n;
+        self.flags[k] = PairFlags::new(f.regime, f.clamped).0;
+        if !self.f_c.is_empty() {
+            self.f_c[k] = f.f_c;
+        }
         if !self.force_i.is_empty() {
             self.force_i[k] = f.f_i;
         }

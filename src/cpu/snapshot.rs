@@ -22,13 +22,13 @@ impl<T: Real> CpuEngine<T> {
                     .filter_map(|k| {
                         let k = k as usize;
                         let (h, _) = self.pair_overlap(k);
-                        (h > T::ZERO || self.report[k].f_c != T::ZERO).then(|| {
+                        (h > T::ZERO || self.report.f_c(k) != T::ZERO).then(|| {
                             let springs = self.slots.load(&self.hist[k * self.slots.stride..]);
                             ContactRecord {
                                 i: self.id[self.pairs.owner[k] as usize],
                                 j: self.id[self.pairs.partner[k] as usize],
                                 overlap: h.f64(),
-                                normal_force: (self.report[k].f_n + self.report[k].f_c).f64(),
+                                normal_force: (self.report.f_n[k] + self.report.f_c(k)).f64(),
                                 force: self.owner_force(k).f64(),
                                 force_j: self.share[k].force.f64(),
                                 tangential_spring: springs.tangential.f64(),
@@ -86,7 +86,9 @@ impl<T: Real> CpuEngine<T> {
         s.put_reals("hist", self.hist.iter().map(|x| x.f64()));
         s.put_reals("liquid", self.liquid.iter().map(|x| x.f64()));
         s.put_reals("share", self.share.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
-        s.put_reals("report", self.report.iter().flat_map(|r| [r.f_n.f64(), r.f_c.f64(), r.clamped as u8 as f64, r.regime as u8 as f64]));
+        s.put_reals("f_n", self.report.f_n.iter().map(|x| x.f64()));
+        s.put_reals("f_c", self.report.f_c.iter().map(|x| x.f64()));
+        s.put_ints("pair_flags", self.report.flags.iter().map(|&x| x as u64));
         s.put_reals("force_i", self.force_i.iter().flat_map(v3));
         s.put_reals("clock", [self.max_moved2.f64(), self.time, self.external_work]);
         s.put_ints("counters", [self.step, self.rebuilds, self.forces_valid as u64]);
@@ -168,7 +170,12 @@ impl<T: Real> CpuEngine<T> {
         self.hist = s.reals("hist", n_pairs * self.slots.stride)?.iter().map(|&x| T::of(x)).collect();
         self.liquid = s.reals("liquid", self.liquid.len())?.iter().map(|&x| T::of(x)).collect();
         self.share = s.reals("share", 6 * n_pairs)?.chunks_exact(6).map(|c| Load { force: v3(&c[0..3]), torque: v3(&c[3..6]) }).collect();
-        self.report = s.reals("report", 4 * n_pairs)?.chunks_exact(4).map(|c| PairReport { f_n: T::of(c[0]), f_c: T::of(c[1]), clamped: c[2] != 0.0, regime: Regime::from_code(c[3] as u8) }).collect();
+        let capillary = if self.slots.layout.bridge { n_pairs } else { 0 };
+        self.report = PairReports {
+            f_n: s.reals("f_n", n_pairs)?.iter().map(|&x| T::of(x)).collect(),
+            f_c: s.reals("f_c", capillary)?.iter().map(|&x| T::of(x)).collect(),
+            flags: s.ints("pair_flags", Some(n_pairs))?.iter().map(|&x| x as u8).collect(),
+        };
         let kept = if pair_force::keeps_owner_force(&self.model) { n_pairs } else { 0 };
         self.force_i = s.reals("force_i", 3 * kept)?.chunks_exact(3).map(v3).collect();
         let clock = s.reals("clock", 3)?;

@@ -38,19 +38,64 @@ pub struct Load<T> {
     pub torque: Vec3<T>,
 }
 
-/// What the statistics and frames read of a pair's last force evaluation (the forces
-/// themselves went to the grains: the owner's share into its load, the partner's into the
-/// pair's [`Load`] record).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct PairReport<T> {
+/// What the statistics and frames read of each pair's last force evaluation, one entry per
+/// pair in arrays of their own (9 bytes a pair in f64 without cohesion; the forces themselves
+/// went to the grains: the owner's share into its load, the partner's into the pair's [`Load`]
+/// record).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PairReports<T> {
     /// Elastic + damping normal force after the no-pull clamp (N, compressive positive).
-    pub f_n: T,
-    /// Capillary normal force (N, tensile negative; 0 without a bridge).
-    pub f_c: T,
-    /// True when the no-pull clamp removed an attractive damping force.
-    pub clamped: bool,
-    /// The tangential regime.
-    pub regime: Regime,
+    pub f_n: Vec<T>,
+    /// Capillary normal force (N, tensile negative; 0 without a bridge); empty in scenes
+    /// without cohesion, where it is always 0.
+    pub f_c: Vec<T>,
+    /// [`PairFlags`]: the tangential regime and the no-pull clamp.
+    pub flags: Vec<u8>,
+}
+
+impl<T: Real> PairReports<T> {
+    /// `n` pairs' worth of zeros, with the capillary force when `capillary`.
+    pub fn renew(&mut self, n: usize, capillary: bool) {
+        super::renew(&mut self.f_n, n);
+        super::renew(&mut self.f_c, if capillary { n } else { 0 });
+        super::renew(&mut self.flags, n);
+    }
+    /// Capillary normal force of pair `k` (N).
+    #[inline]
+    pub fn f_c(&self, k: usize) -> T {
+        self.f_c.get(k).copied().unwrap_or(T::ZERO)
+    }
+    /// True when the no-pull clamp removed an attractive damping force from pair `k`.
+    #[inline]
+    pub fn clamped(&self, k: usize) -> bool {
+        PairFlags(self.flags[k]).clamped()
+    }
+    /// Pair `k`'s tangential regime.
+    #[inline]
+    pub fn regime(&self, k: usize) -> Regime {
+        PairFlags(self.flags[k]).regime()
+    }
+}
+
+/// A pair's tangential regime (bits 0-1, [`Regime`]'s code) and whether the no-pull clamp
+/// removed an attractive damping force (bit 2), in one byte.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PairFlags(pub u8);
+
+impl PairFlags {
+    /// The flags of a regime and a clamp.
+    #[inline(always)]
+    pub fn new(regime: Regime, clamped: bool) -> Self {
+        PairFlags(regime as u8 | (clamped as u8) << 2)
+    }
+    /// The regime.
+    pub fn regime(self) -> Regime {
+        Regime::from_code(self.0 & 3)
+    }
+    /// The clamp.
+    pub fn clamped(self) -> bool {
+        self.0 & 4 != 0
+    }
 }
 
 /// Where each history block sits in a contact's fixed-stride slot.

@@ -77,7 +77,7 @@ impl<T: Real> CpuEngine<T> {
                 s.angular[0] += x[1] * mv[2] - x[2] * mv[1] + ii * w[0];
                 s.angular[1] += x[2] * mv[0] - x[0] * mv[2] + ii * w[1];
                 s.angular[2] += x[0] * mv[1] - x[1] * mv[0] + ii * w[2];
-                let pushes = |k: u32| (self.report[k as usize].f_n > T::ZERO) as u64;
+                let pushes = |k: u32| (self.report.f_n[k as usize] > T::ZERO) as u64;
                 let pl = &self.pairs;
                 let mut contacts: u64 = (pl.owner_start[i]..pl.owner_start[i + 1]).map(pushes).sum::<u64>() + pl.rev_pair[pl.rev_start[i] as usize..pl.rev_start[i + 1] as usize].iter().map(|&k| pushes(k)).sum::<u64>();
                 for wall in &self.walls {
@@ -115,8 +115,8 @@ impl<T: Real> CpuEngine<T> {
                 let c = &self.coeffs[pi.material as usize * self.n_materials + pj.material as usize];
                 let r_eff = pi.radius * pj.radius / (pi.radius + pj.radius);
                 s.contacts += 1;
-                s.clamped += self.report[k].clamped as u64;
-                s.regimes.count(self.report[k].regime);
+                s.clamped += self.report.clamped(k) as u64;
+                s.regimes.count(self.report.regime(k));
                 s.elastic += normal_potential(&self.model.normal, c, r_eff, h).f64();
                 s.force += 2.0 * self.owner_force(k).norm().f64();
                 s.max_overlap = max_by_first(s.max_overlap, ((h / r_min).f64(), self.id[i]));

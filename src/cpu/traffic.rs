@@ -20,7 +20,8 @@ impl<T: Real> CpuEngine<T> {
         let orientation = self.orientation.as_deref().map_or(0, bytes);
         let kick = 2 * body + bytes(&self.load) + prop;
         let drift = 2 * body + bytes(&self.built_at) + 2 * orientation;
-        let pair_out = bytes(&self.share) + bytes(&self.report) + bytes(&self.force_i);
+        let r = &self.report;
+        let pair_out = bytes(&self.share) + bytes(&r.f_n) + bytes(&r.f_c) + bytes(&r.flags) + bytes(&self.force_i);
         let force = bytes(&l.owner) + bytes(&l.partner) + body + prop + 2 * bytes(&self.hist) + pair_out + bytes(&self.load);
         // The wall contacts run in the gather's sweep, on the loads it has in hand.
         let walls = if self.walls.is_empty() { 0 } else { body + prop + 2 * bytes(&self.wall_hist) };
