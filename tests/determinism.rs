@@ -6,49 +6,14 @@ use grains::cpu::CpuEngine;
 use grains::engine::Engine;
 use grains::real::Real;
 
-/// A dense, frictional, colliding gas in a box: many pairs, wall contacts, rebuilds, and
-/// enough grains that every kernel and reduction splits into several chunks.
-const SCENE: &str = r#"
-seed = 11
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
-mu_k = 0.4
-rolling_angle = 3.0
-gamma_n = 1.0e5
-gamma_nt = 10.0
-
-[[generate]]
-material = "sand"
-count = 12000
-diameter = { min = 0.8e-3, max = 1.2e-3 }
-region = { shape = "box", min = [0.0, 0.0, 0.0], max = [30.0e-3, 30.0e-3, 30.0e-3] }
-random_speed = 0.5
-
-[[wall]]
-type = "box"
-material = "sand"
-min = [0.0, 0.0, 0.0]
-max = [30.0e-3, 30.0e-3, 30.0e-3]
-
-[model]
-damping = "papers"
-tangential = "oquendo"
-twisting = "oquendo"
-
-[simulation]
-track_orientation = true
-
-[[stage]]
-kind = "run"
-duration = 1.0e-3
-"#;
+/// Grains in the box gas of `common::box_gas`: enough that every kernel and reduction splits
+/// into several chunks.
+const GRAINS: usize = 12000;
+/// The box's side (m).
+const SIDE: f64 = 30.0e-3;
 
 fn trajectory_bits<T: Real>(threads: usize, steps: u64) -> (Vec<u64>, u64) {
-    let scene = common::parse(SCENE);
+    let scene = common::parse(&common::box_gas(GRAINS, SIDE));
     common::with_threads(threads, || {
         let mut e: CpuEngine<T> = common::engine(&scene);
         e.advance(steps).unwrap();

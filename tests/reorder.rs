@@ -10,46 +10,11 @@ use grains::cpu::CpuEngine;
 use grains::engine::Engine;
 use grains::scene::Scene;
 
-/// A dense frictional gas in a box with seed 000's laws and orientations: about 5,000 grains,
+/// The box gas of `common::box_gas` (seed 000's laws, orientations) with about 5,000 grains,
 /// so that every reduction splits into several chunks.
-const DRY: &str = r#"
-seed = 11
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
-mu_k = 0.4
-rolling_angle = 3.0
-gamma_n = 1.0e5
-gamma_nt = 10.0
-
-[[generate]]
-material = "sand"
-count = 5000
-diameter = { min = 0.8e-3, max = 1.2e-3 }
-region = { shape = "box", min = [0.0, 0.0, 0.0], max = [22.0e-3, 22.0e-3, 22.0e-3] }
-random_speed = 0.5
-
-[[wall]]
-type = "box"
-material = "sand"
-min = [0.0, 0.0, 0.0]
-max = [22.0e-3, 22.0e-3, 22.0e-3]
-
-[model]
-damping = "papers"
-tangential = "oquendo"
-twisting = "oquendo"
-
-[simulation]
-track_orientation = true
-
-[[stage]]
-kind = "run"
-duration = 1.0e-3
-"#;
+fn dry() -> String {
+    common::box_gas(5000, 22.0e-3)
+}
 
 /// Everything a run shows, as bits: every grain's state (permanent-id order), the
 /// statistics, and a frame with its contacts.
@@ -92,7 +57,7 @@ fn same(what: &str, a: &(Vec<u64>, String, String), b: &(Vec<u64>, String, Strin
 
 #[test]
 fn renumbering_changes_no_bit_of_a_dense_gas_in_a_box() {
-    let scene = common::parse(DRY);
+    let scene = common::parse(&dry());
     let plain = run::<f64>(&scene, 0, 200, |_| {});
     let every = run::<f64>(&scene, 1, 200, |_| {});
     let stats = &plain.1;
@@ -106,7 +71,7 @@ fn renumbering_changes_no_bit_of_a_dense_gas_in_a_box() {
 
 #[test]
 fn a_renumbered_run_resumes_from_its_checkpoint_with_the_same_bits() {
-    let scene = common::parse(DRY);
+    let scene = common::parse(&dry());
     let plain = run::<f64>(&scene, 0, 200, |_| {});
     let mut s = scene.clone();
     s.reorder_every = 1;
@@ -148,9 +113,9 @@ fn renumbering_changes_no_bit_of_wet_grains_pushed_by_servo_walls() {
 #[test]
 fn renumbering_changes_no_bit_of_a_periodic_gas() {
     let scene = common::parse(&common::edit(
-        DRY,
+        &dry(),
         &[
-            ("[[wall]]\ntype = \"box\"\nmaterial = \"sand\"\nmin = [0.0, 0.0, 0.0]\nmax = [22.0e-3, 22.0e-3, 22.0e-3]\n", "[periodic]\nx = [0.0, 22.0e-3]\ny = [0.0, 22.0e-3]\nz = [0.0, 22.0e-3]\n"),
+            ("[[wall]]\ntype = \"box\"\nmaterial = \"sand\"\nmin = [0.0, 0.0, 0.0]\nmax = [2.2e-2, 2.2e-2, 2.2e-2]\n", "[periodic]\nx = [0.0, 22.0e-3]\ny = [0.0, 22.0e-3]\nz = [0.0, 22.0e-3]\n"),
             ("[simulation]\n", "[simulation]\ngravity = [0.0, 0.0, 0.0]\n"),
         ],
     ));

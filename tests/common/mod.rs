@@ -76,6 +76,52 @@ pub fn wet_gas() -> Scene {
     ))
 }
 
+/// A dense, frictional, colliding gas of `count` grains (0.8-1.2 mm) in a box of `side` metres
+/// under gravity, with seed 000's laws (the force on the owner kept per pair) and orientations
+/// tracked: many pairs, wall contacts and rebuilds.
+pub fn box_gas(count: usize, side: f64) -> String {
+    format!(
+        r#"
+seed = 11
+[[material]]
+name = "sand"
+density = 2650.0
+youngs_modulus = 7.0e7
+poisson_ratio = 0.3
+mu_s = 0.5
+mu_k = 0.4
+rolling_angle = 3.0
+gamma_n = 1.0e5
+gamma_nt = 10.0
+
+[[generate]]
+material = "sand"
+count = {count}
+diameter = {{ min = 0.8e-3, max = 1.2e-3 }}
+region = {{ shape = "box", min = [0.0, 0.0, 0.0], max = [{side:e}, {side:e}, {side:e}] }}
+random_speed = 0.5
+
+[[wall]]
+type = "box"
+material = "sand"
+min = [0.0, 0.0, 0.0]
+max = [{side:e}, {side:e}, {side:e}]
+
+[model]
+damping = "papers"
+tangential = "oquendo"
+twisting = "oquendo"
+
+[simulation]
+track_orientation = true
+
+[[stage]]
+kind = "run"
+duration = 1.0e-3
+"#
+    )
+}
+
 /// Whether an outside program the tests read files back with runs (`program args` exits 0).
 /// Without it CI fails (`.ci/run` installs it) and a developer machine skips the test with a
 /// visible message naming the package.
