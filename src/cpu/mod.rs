@@ -439,13 +439,11 @@ impl<T: Real> CpuEngine<T> {
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
         let (sums, touches) = complete_loads(&ctx, pairs, &self.share, &self.id, body, prop, &self.walls, &mut self.load, &mut self.wall_hist);
-        if !self.walls.is_empty() {
-            self.wall_touches = touches;
-            self.wall_reaction = sums.reaction;
-            self.wall_count = sums.count;
-            self.wall_response = sums.response;
-            self.wall_regimes = sums.regimes;
-        }
+        self.wall_touches = touches;
+        self.wall_reaction = sums.reaction;
+        self.wall_count = sums.count;
+        self.wall_response = sums.response;
+        self.wall_regimes = sums.regimes;
         self.forces_valid = true;
         self.clock.stop(Phase::Gather, t);
     }
