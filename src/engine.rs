@@ -306,7 +306,7 @@ impl EngineState {
     }
     /// A real array of `len` values.
     pub fn reals(&self, name: &str, len: usize) -> anyhow::Result<&[f64]> {
-        let v = self.reals.get(name).with_context(|| format!("the checkpoint has no `{name}`"))?;
+        let v = self.reals.get(name).with_context(|| missing(name))?;
         if v.len() != len {
             bail!("the checkpoint's `{name}` holds {} values, this scene needs {len}", v.len());
         }
@@ -314,12 +314,17 @@ impl EngineState {
     }
     /// An integer array of `len` values (any length when `len` is `None`).
     pub fn ints(&self, name: &str, len: Option<usize>) -> anyhow::Result<&[u64]> {
-        let v = self.ints.get(name).with_context(|| format!("the checkpoint has no `{name}`"))?;
+        let v = self.ints.get(name).with_context(|| missing(name))?;
         if let Some(len) = len.filter(|&l| l != v.len()) {
             bail!("the checkpoint's `{name}` holds {} values, this scene needs {len}", v.len());
         }
         Ok(v)
     }
+}
+
+/// The error for an array a checkpoint lacks: it was written by another version.
+fn missing(name: &str) -> String {
+    format!("the checkpoint has no `{name}`: another version of grains wrote it; fix: run the scene again from its start with this version")
 }
 
 /// A backend the host loop can drive.
