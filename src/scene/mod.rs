@@ -490,9 +490,8 @@ impl Origins {
     }
 }
 
-/// Rebuilds between renumberings of the grains in cell order when the scene does not say:
-/// a pour's grains move a cell or so in a few hundred steps, and a renumbering costs about
-/// one rebuild.
+/// Rebuilds between renumberings of the grains in cell order when the scene does not say
+/// (`simulation.reorder_every`); not tuned: the benchmarks measured it on against off only.
 pub const DEFAULT_REORDER_EVERY: u64 = 10;
 
 /// Overlap with a wall (fraction of the radius) that a grain read from a file may start with:
