@@ -6,18 +6,19 @@
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
 @group(0) @binding(2) var<storage, read> pos: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read> vel: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read> omega: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read> material: array<u32>;
-@group(0) @binding(6) var<storage, read> coeffs: array<PairCoeffs>;
-@group(0) @binding(7) var<storage, read> pair_i: array<u32>;
-@group(0) @binding(8) var<storage, read> pair_j: array<u32>;
-@group(0) @binding(9) var<storage, read_write> hist: array<vec4<f32>>;
-@group(0) @binding(10) var<storage, read_write> out_fi: array<vec4<f32>>;
-@group(0) @binding(11) var<storage, read_write> out_fj: array<vec4<f32>>;
-@group(0) @binding(12) var<storage, read_write> out_ti: array<vec4<f32>>;
-@group(0) @binding(13) var<storage, read_write> out_tj: array<vec4<f32>>;
-@group(0) @binding(14) var<storage, read> control: Control;
+@group(0) @binding(3) var<storage, read> residual: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> vel: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> omega: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> material: array<u32>;
+@group(0) @binding(7) var<storage, read> coeffs: array<PairCoeffs>;
+@group(0) @binding(8) var<storage, read> pair_i: array<u32>;
+@group(0) @binding(9) var<storage, read> pair_j: array<u32>;
+@group(0) @binding(10) var<storage, read_write> hist: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read_write> out_fi: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read_write> out_fj: array<vec4<f32>>;
+@group(0) @binding(13) var<storage, read_write> out_ti: array<vec4<f32>>;
+@group(0) @binding(14) var<storage, read_write> out_tj: array<vec4<f32>>;
+@group(0) @binding(15) var<storage, read> control: Control;
 
 fn load_history(k: u32) -> History {
     var h = empty_history();
@@ -45,7 +46,7 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
     let j = pair_j[k];
     let pi = pos[i];
     let pj = pos[j];
-    let d = min_image(pi.xyz - pj.xyz);
+    let d = separation(pi.xyz, residual[i], pj.xyz, residual[j]);
     let dist2 = dot(d, d);
     let reach = pi.w + pj.w;
     if (dist2 >= reach * reach) {

@@ -4,16 +4,17 @@
 // kinetic energy if so, and the largest wall overlap.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> vel: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read> omega: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read> force: array<vec4<f32>>; // w: pushing pairs
-@group(0) @binding(5) var<storage, read> wall_force: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read> wall_torque: array<vec4<f32>>;
-@group(0) @binding(7) var<storage, read> image: array<vec4<i32>>;
-@group(0) @binding(8) var<storage, read> material: array<u32>;
-@group(0) @binding(9) var<storage, read> coeffs: array<PairCoeffs>;
-@group(0) @binding(10) var<storage, read> walls: array<Wall>;
-@group(0) @binding(11) var<storage, read_write> grain_rows: array<f32>;
+@group(0) @binding(2) var<storage, read> residual: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> vel: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> omega: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> force: array<vec4<f32>>; // w: pushing pairs
+@group(0) @binding(6) var<storage, read> wall_force: array<vec4<f32>>;
+@group(0) @binding(7) var<storage, read> wall_torque: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read> image: array<vec4<i32>>;
+@group(0) @binding(9) var<storage, read> material: array<u32>;
+@group(0) @binding(10) var<storage, read> coeffs: array<PairCoeffs>;
+@group(0) @binding(11) var<storage, read> walls: array<Wall>;
+@group(0) @binding(12) var<storage, read_write> grain_rows: array<f32>;
 
 var<workgroup> row: array<f32, WG * STAT_ROW>;
 
@@ -47,7 +48,7 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         var contacts = force[i].w;
         var wall_contacts = 0u;
         for (var k = 0u; k < params.n_walls; k++) {
-            let frame = wall_frame(walls[k], p.xyz);
+            let frame = wall_frame(walls[k], p.xyz, residual[i]);
             let h = p.w - frame.w;
             if (h > 0.0) {
                 let c = coeffs[walls[k].material * params.n_materials + material[i]];

@@ -3,15 +3,16 @@
 // contacts, and the largest overlap over the smaller radius.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> material: array<u32>;
-@group(0) @binding(3) var<storage, read> coeffs: array<PairCoeffs>;
-@group(0) @binding(4) var<storage, read> pair_i: array<u32>;
-@group(0) @binding(5) var<storage, read> pair_j: array<u32>;
-@group(0) @binding(6) var<storage, read> out_fi: array<vec4<f32>>;
-@group(0) @binding(7) var<storage, read> out_fj: array<vec4<f32>>;
-@group(0) @binding(8) var<storage, read> out_ti: array<vec4<f32>>;
-@group(0) @binding(9) var<storage, read> control: Control;
-@group(0) @binding(10) var<storage, read_write> pair_rows: array<f32>;
+@group(0) @binding(2) var<storage, read> residual: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> material: array<u32>;
+@group(0) @binding(4) var<storage, read> coeffs: array<PairCoeffs>;
+@group(0) @binding(5) var<storage, read> pair_i: array<u32>;
+@group(0) @binding(6) var<storage, read> pair_j: array<u32>;
+@group(0) @binding(7) var<storage, read> out_fi: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read> out_fj: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read> out_ti: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read> control: Control;
+@group(0) @binding(11) var<storage, read_write> pair_rows: array<f32>;
 
 var<workgroup> row: array<f32, WG * STAT_ROW>;
 
@@ -25,7 +26,7 @@ fn reduce_pairs(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
         let j = pair_j[k];
         let pi = pos[i];
         let pj = pos[j];
-        let h = pi.w + pj.w - length(min_image(pi.xyz - pj.xyz));
+        let h = pi.w + pj.w - length(separation(pi.xyz, residual[i], pj.xyz, residual[j]));
         if (h > 0.0) {
             let c = coeffs[material[i] * params.n_materials + material[j]];
             row[r + P_CONTACTS] = count_field(1u);

@@ -9,15 +9,16 @@ override WALL_RESPONSE: bool = false;
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
 @group(0) @binding(2) var<storage, read> pos: array<vec4<f32>>;
-@group(0) @binding(3) var<storage, read> vel: array<vec4<f32>>;
-@group(0) @binding(4) var<storage, read> omega: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read> material: array<u32>;
-@group(0) @binding(6) var<storage, read> coeffs: array<PairCoeffs>;
-@group(0) @binding(7) var<storage, read> walls: array<Wall>;
-@group(0) @binding(8) var<storage, read_write> wall_hist: array<vec4<f32>>;
-@group(0) @binding(9) var<storage, read_write> wall_force: array<vec4<f32>>;
-@group(0) @binding(10) var<storage, read_write> wall_torque: array<vec4<f32>>;
-@group(0) @binding(11) var<storage, read_write> wall_partials: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> residual: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> vel: array<vec4<f32>>;
+@group(0) @binding(5) var<storage, read> omega: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read> material: array<u32>;
+@group(0) @binding(7) var<storage, read> coeffs: array<PairCoeffs>;
+@group(0) @binding(8) var<storage, read> walls: array<Wall>;
+@group(0) @binding(9) var<storage, read_write> wall_hist: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read_write> wall_force: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read_write> wall_torque: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read_write> wall_partials: array<vec4<f32>>;
 
 var<workgroup> reaction: array<vec4<f32>, 512>; // WG x MAX_WALLS
 
@@ -41,7 +42,7 @@ fn wall_contacts(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         for (var w = 0u; w < params.n_walls; w++) {
             let wall = walls[w];
             let base = (i * params.n_walls + w) * params.hist_blocks;
-            let frame = wall_frame(wall, p.xyz);
+            let frame = wall_frame(wall, p.xyz, residual[i]);
             if (frame.w >= p.w) {
                 for (var b = 0u; b < params.hist_blocks; b++) { wall_hist[base + b] = vec4<f32>(0.0); }
                 continue;

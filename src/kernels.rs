@@ -44,6 +44,7 @@ pub fn shared(name: &str) -> &'static str {
         "walls" => include_str!("../shaders/shared/walls.wgsl"),
         "reduce" => include_str!("../shaders/shared/reduce.wgsl"),
         "kick" => include_str!("../shaders/shared/kick.wgsl"),
+        "position" => include_str!("../shaders/shared/position.wgsl"),
         other => panic!("no shared WGSL file {other}"),
     }
 }
@@ -65,11 +66,12 @@ use Access::{Phase, Read, ReadWrite, Uniform};
 
 const BASE: &[&str] = &["types", "dispatch"];
 const KICK: &[&str] = &["types", "dispatch", "kick"];
-const GRID: &[&str] = &["types", "dispatch", "grid"];
-const DETECT: &[&str] = &["types", "dispatch", "grid", "neighbours"];
-const FORCES: &[&str] = &["types", "dispatch", "grid", "model"];
-const WALLS: &[&str] = &["types", "dispatch", "grid", "model", "walls"];
-const STATS: &[&str] = &["types", "dispatch", "grid", "model", "walls", "reduce"];
+const INTEGRATE: &[&str] = &["types", "dispatch", "kick", "position"];
+const GRID: &[&str] = &["types", "dispatch", "position", "grid"];
+const DETECT: &[&str] = &["types", "dispatch", "position", "grid", "neighbours"];
+const FORCES: &[&str] = &["types", "dispatch", "position", "grid", "model"];
+const WALLS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls"];
+const STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "reduce"];
 
 macro_rules! kernel {
     ($name:literal, $inc:expr, [$($b:literal: $a:expr),* $(,)?]) => {
@@ -79,31 +81,31 @@ macro_rules! kernel {
 
 /// Every kernel, in the order a rebuilding step runs them.
 pub const KERNELS: &[Kernel] = &[
-    kernel!("integrate", KICK, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "force": Read, "torque": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "wall_reaction": Read, "control": ReadWrite]),
+    kernel!("integrate", INTEGRATE, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "residual": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "force": Read, "torque": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "wall_reaction": Read, "control": ReadWrite]),
     kernel!("servo_move", BASE, ["params": Uniform, "phase": Phase, "walls": ReadWrite, "wall_reaction": Read, "servo": ReadWrite]),
     kernel!("decide_rebuild", BASE, ["params": Uniform, "control": ReadWrite, "args": ReadWrite]),
     kernel!("save_starts", BASE, ["params": Uniform, "pair_start": Read, "old_start": ReadWrite]),
     kernel!("save_pairs", BASE, ["params": Uniform, "pair_j": Read, "hist": Read, "old_j": ReadWrite, "old_hist": ReadWrite, "control": Read]),
     kernel!("clear_cells", BASE, ["params": Uniform, "cell_count": ReadWrite, "cell_fill": ReadWrite]),
-    kernel!("hash_cells", GRID, ["params": Uniform, "pos": ReadWrite, "image": ReadWrite, "built_at": ReadWrite, "cell_of": ReadWrite, "cell_count": ReadWrite, "control": ReadWrite, "pair_start": ReadWrite, "rev_start": ReadWrite, "rev_fill": ReadWrite]),
+    kernel!("hash_cells", GRID, ["params": Uniform, "pos": ReadWrite, "residual": ReadWrite, "image": ReadWrite, "built_at": ReadWrite, "cell_of": ReadWrite, "cell_count": ReadWrite, "control": ReadWrite, "pair_start": ReadWrite, "rev_start": ReadWrite, "rev_fill": ReadWrite]),
     kernel!("scan_blocks", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite]),
     kernel!("scan_add", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite]),
     kernel!("scatter_cells", BASE, ["params": Uniform, "cell_of": Read, "cell_count": Read, "cell_fill": ReadWrite, "cell_grains": ReadWrite]),
-    kernel!("detect_count", DETECT, ["params": Uniform, "pos": Read, "cell_count": Read, "cell_grains": Read, "pair_start": ReadWrite, "control": ReadWrite]),
+    kernel!("detect_count", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": ReadWrite, "control": ReadWrite]),
     kernel!("pairs_ready", BASE, ["params": Uniform, "pair_start": Read, "control": ReadWrite, "args": ReadWrite]),
-    kernel!("detect_fill", DETECT, ["params": Uniform, "pos": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Read, "pair_i": ReadWrite, "pair_j": ReadWrite]),
+    kernel!("detect_fill", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Read, "pair_i": ReadWrite, "pair_j": ReadWrite]),
     kernel!("remap_history", BASE, ["params": Uniform, "pair_i": Read, "pair_j": Read, "old_start": Read, "old_j": Read, "old_hist": Read, "hist": ReadWrite, "control": Read]),
     kernel!("reverse_count", BASE, ["params": Uniform, "pair_j": Read, "rev_start": ReadWrite, "control": Read]),
     kernel!("reverse_fill", BASE, ["params": Uniform, "pair_j": Read, "rev_start": Read, "rev_fill": ReadWrite, "rev_pair": ReadWrite, "control": Read]),
     kernel!("reverse_sort", BASE, ["params": Uniform, "rev_start": Read, "rev_pair": ReadWrite]),
-    kernel!("find_bridge_events", FORCES, ["params": Uniform, "pos": Read, "pair_i": Read, "pair_j": Read, "hist": Read, "bridge_event": ReadWrite, "control": Read]),
+    kernel!("find_bridge_events", FORCES, ["params": Uniform, "pos": Read, "residual": Read, "pair_i": Read, "pair_j": Read, "hist": Read, "bridge_event": ReadWrite, "control": Read]),
     kernel!("update_bridges", FORCES, ["params": Uniform, "pair_i": Read, "pair_j": Read, "bridge_event": Read, "hist": ReadWrite, "liquid": ReadWrite, "control": Read]),
-    kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": ReadWrite, "out_fj": ReadWrite, "out_ti": ReadWrite, "out_tj": ReadWrite, "control": Read]),
-    kernel!("wall_contacts", WALLS, ["params": Uniform, "phase": Phase, "pos": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_force": ReadWrite, "wall_torque": ReadWrite, "wall_partials": ReadWrite]),
+    kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": ReadWrite, "out_fj": ReadWrite, "out_ti": ReadWrite, "out_tj": ReadWrite, "control": Read]),
+    kernel!("wall_contacts", WALLS, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_force": ReadWrite, "wall_torque": ReadWrite, "wall_partials": ReadWrite]),
     kernel!("wall_reduce", BASE, ["params": Uniform, "wall_partials": Read, "wall_reaction": ReadWrite]),
     kernel!("gather", KICK, ["params": Uniform, "vel": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "wall_force": Read, "wall_torque": Read, "force": ReadWrite, "torque": ReadWrite, "phase": Phase, "omega": ReadWrite, "walls": ReadWrite, "wall_reaction": Read]),
-    kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "vel": Read, "omega": Read, "force": Read, "wall_force": Read, "wall_torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": ReadWrite]),
-    kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "control": Read, "pair_rows": ReadWrite]),
+    kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "wall_force": Read, "wall_torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": ReadWrite]),
+    kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "control": Read, "pair_rows": ReadWrite]),
     kernel!("reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": ReadWrite]),
 ];
 

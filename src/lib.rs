@@ -16,6 +16,7 @@ pub mod lammps;
 pub mod model;
 pub mod output;
 pub mod periodic;
+pub mod position;
 pub mod protocol;
 pub mod real;
 pub mod runner;

@@ -33,6 +33,11 @@ pub trait Real:
     const ONE: Self;
     /// Name used in reports: "f32" or "f64".
     const NAME: &'static str;
+    /// True when the engines hold each position as two numbers of this type, `pos +
+    /// residual`, the residual keeping what rounding took off `pos` ([`crate::position`]):
+    /// `f32`, whose 24 bits at 1 m are 6e-8 m, coarser than a stiff contact's overlap.
+    /// `f64` holds plain positions (1e-16 m at 1 m).
+    const COMPENSATED: bool;
     /// Converts from `f64`, rounding to nearest.
     fn of(x: f64) -> Self;
     /// Widens to `f64`.
@@ -56,11 +61,12 @@ pub trait Real:
 }
 
 macro_rules! impl_real {
-    ($t:ty) => {
+    ($t:ty, $compensated:expr) => {
         impl Real for $t {
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
             const NAME: &'static str = stringify!($t);
+            const COMPENSATED: bool = $compensated;
             #[inline(always)]
             fn of(x: f64) -> Self {
                 x as $t
@@ -104,8 +110,8 @@ macro_rules! impl_real {
         }
     };
 }
-impl_real!(f32);
-impl_real!(f64);
+impl_real!(f32, true);
+impl_real!(f64, false);
 
 /// A 3-vector of reals (metres, m/s, N, ... as its owner says).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

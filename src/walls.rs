@@ -1,5 +1,6 @@
 //! Wall geometry shared by the scene checks and the engines.
 
+use crate::position::complete;
 use crate::real::{Real, Vec3};
 use crate::scene::types::WallShape;
 
@@ -52,19 +53,21 @@ impl<T: Real> WallGeom<T> {
         }
     }
 
-    /// Unit normal from the wall to a point `p` (m), and the signed distance (m) from the
-    /// surface to `p`, positive on the grains' side.
+    /// Unit normal from the wall to a point `p + r` (m; `r` the residual of a compensated
+    /// position, [`crate::position`]), and the signed distance (m) from the surface to it,
+    /// positive on the grains' side.
     #[inline(always)]
-    pub fn frame(&self, p: Vec3<T>) -> (Vec3<T>, T) {
+    pub fn frame(&self, p: Vec3<T>, r: Vec3<T>) -> (Vec3<T>, T) {
         match *self {
-            WallGeom::Plane { point, normal } => (normal, (p - point).dot(normal)),
+            WallGeom::Plane { point, normal } => (normal, complete(p - point, r).dot(normal)),
             WallGeom::Cylinder { cx, cy, radius } => {
-                let (dx, dy) = (p.x - cx, p.y - cy);
+                let d = complete(Vec3::new(p.x - cx, p.y - cy, T::ZERO), r);
+                let (dx, dy) = (d.x, d.y);
                 let rho = (dx * dx + dy * dy).sqrt();
                 let n = if rho > T::ZERO { Vec3::new(-dx / rho, -dy / rho, T::ZERO) } else { Vec3::new(-T::ONE, T::ZERO, T::ZERO) };
                 (n, radius - rho)
             }
-            WallGeom::Piston { z } => (Vec3::new(T::ZERO, T::ZERO, -T::ONE), z - p.z),
+            WallGeom::Piston { z } => (Vec3::new(T::ZERO, T::ZERO, -T::ONE), if T::COMPENSATED { (z - p.z) - r.z } else { z - p.z }),
         }
     }
 }

@@ -34,3 +34,9 @@ fn min_image(d_in: vec3<f32>) -> vec3<f32> {
     }
     return d;
 }
+
+// The separation r_i - r_j of two compensated positions (src/position.rs separation): the
+// positions' difference folded to the minimum image, plus the residuals' difference.
+fn separation(p_i: vec3<f32>, r_i: vec4<f32>, p_j: vec3<f32>, r_j: vec4<f32>) -> vec3<f32> {
+    return complete(min_image(p_i - p_j), r_i.xyz - r_j.xyz, r_i.w);
+}

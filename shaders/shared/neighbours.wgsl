@@ -1,5 +1,5 @@
-// Neighbour search shared by detect_count and detect_fill (which declare pos, cell_count and
-// cell_grains): the distinct buckets of the 27 cells around a grain.
+// Neighbour search shared by detect_count and detect_fill (which declare pos, residual,
+// cell_count and cell_grains): the distinct buckets of the 27 cells around a grain.
 
 struct Buckets {
     h: array<u32, 27>,
@@ -50,7 +50,7 @@ fn owns(i: u32, j: u32, pi: vec4<f32>) -> bool {
         return false;
     }
     let pj = pos[j];
-    let d = min_image(pi.xyz - pj.xyz);
+    let d = separation(pi.xyz, residual[i], pj.xyz, residual[j]);
     let reach = pi.w + pj.w + params.reach;
     return dot(d, d) < reach * reach;
 }

@@ -1,15 +1,15 @@
-// Wall surfaces (needs `walls`): unit normal from the wall to a point and the signed
-// distance from the surface to it, positive on the grains' side.
-fn wall_frame(w: Wall, p: vec3<f32>) -> vec4<f32> {
+// Wall surfaces (needs `walls`): unit normal from the wall to a compensated position p + r
+// and the signed distance from the surface to it, positive on the grains' side.
+fn wall_frame(w: Wall, p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
     if (w.kind == WALL_PLANE) {
-        return vec4<f32>(w.normal.xyz, dot(p - w.point.xyz, w.normal.xyz));
+        return vec4<f32>(w.normal.xyz, dot(complete(p - w.point.xyz, r.xyz, r.w), w.normal.xyz));
     }
     if (w.kind == WALL_CYLINDER) {
-        let dxy = p.xy - w.point.xy;
+        let dxy = complete(vec3<f32>(p.xy - w.point.xy, 0.0), r.xyz, r.w).xy;
         let rho = length(dxy);
         var n = vec3<f32>(-1.0, 0.0, 0.0);
         if (rho > 0.0) { n = vec3<f32>(-dxy / rho, 0.0); }
         return vec4<f32>(n, w.normal.w - rho);
     }
-    return vec4<f32>(0.0, 0.0, -1.0, w.point.z - p.z);
+    return vec4<f32>(0.0, 0.0, -1.0, keep(vec3<f32>(w.point.z - p.z), r.w).z - r.z);
 }

@@ -4,6 +4,7 @@
 use super::reduce::chunked;
 use super::state::{Body, Props};
 use crate::periodic::Periodic;
+use crate::position;
 use crate::real::{Real, Vec3};
 
 /// A uniform grid over the grains' bounding box (or the period, along a wrapping axis) with
@@ -142,12 +143,14 @@ pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, periodic: &Periodic<T>, 
 }
 
 /// `detect_pairs` for grain `i`: appends to `out` every grain `j` with a higher permanent id
-/// whose surface is within `skin` of i's (`|r_i - r_j| < R_i + R_j + skin`, minimum image),
+/// whose surface is within `skin` of i's (`|r_i - r_j| < R_i + R_j + skin`, minimum image,
+/// residuals included: the grid bins by `pos`, which is within a rounding of the position),
 /// in ascending id order, so that the list does not depend on the grid.
 #[inline]
 pub fn detect_pairs<T: Real>(
     i: usize,
     body: &[Body<T>],
+    residual: &[Vec3<T>],
     prop: &[Props<T>],
     id: &[u32],
     grid: &CellGrid<T>,
@@ -170,7 +173,7 @@ pub fn detect_pairs<T: Real>(
                         continue;
                     }
                     let reach = prop[i].radius + prop[j].radius + skin;
-                    if periodic.min_image(body[i].pos - body[j].pos).norm2() < reach * reach {
+                    if position::separation_of(periodic, |k| body[k].pos, residual, i, j).norm2() < reach * reach {
                         out.push(j as u32);
                     }
                 }

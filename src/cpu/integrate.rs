@@ -2,6 +2,7 @@
 //! one grain. Velocity Verlet and seed 000's optimised velocity Verlet are sequences of these.
 
 use super::state::{Body, Load, Props};
+use crate::position;
 use crate::real::{Real, Vec3};
 
 /// Kick: `v += F/m tau`, `w += T/I tau` (spheres: the inertia is isotropic, so the world-frame
@@ -12,10 +13,12 @@ pub fn kick<T: Real>(b: &mut Body<T>, l: &Load<T>, p: &Props<T>, tau: T) {
     b.omega += l.torque * (tau / p.inertia);
 }
 
-/// Drift: `x += v tau`. Returns the squared displacement since the last neighbour build.
+/// Drift: `x += v tau`, the sum's rounding kept in `residual` where positions are compensated
+/// ([`position::advance`]). Returns the squared displacement of `pos` since the last neighbour
+/// build.
 #[inline(always)]
-pub fn drift<T: Real>(b: &mut Body<T>, built_at: Vec3<T>, tau: T) -> T {
-    b.pos += b.vel * tau;
+pub fn drift<T: Real>(b: &mut Body<T>, residual: &mut Vec3<T>, built_at: Vec3<T>, tau: T) -> T {
+    position::advance(&mut b.pos, residual, b.vel * tau);
     (b.pos - built_at).norm2()
 }
 

@@ -148,7 +148,7 @@ fn lanes<T: Real, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>
         for (m, is_open) in open[..out.len()].iter_mut().enumerate() {
             let keep = if SORT {
                 let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
-                let d = ctx.periodic.min_image(body[i].pos - body[j].pos);
+                let d = ctx.separation(body, i, j);
                 let reach = prop[i].radius + prop[j].radius;
                 d.norm2() < reach * reach
             } else {
@@ -170,7 +170,7 @@ fn lanes<T: Real, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>
                 let i = pairs.owner[base + m] as usize;
                 let j = pairs.partner[base + m] as usize;
                 let (bi, bj, pi, pj) = (&body[i], &body[j], &prop[i], &prop[j]);
-                inp.d.set(l, ctx.periodic.min_image(bi.pos - bj.pos));
+                inp.d.set(l, ctx.separation(body, i, j));
                 (inp.r_i[l], inp.r_j[l], inp.m_i[l], inp.m_j[l]) = (pi.radius, pj.radius, pi.mass, pj.mass);
                 inp.v_i.set(l, bi.vel);
                 inp.v_j.set(l, bj.vel);
@@ -283,7 +283,7 @@ duration = 1.0e-3
         }
         e.advance(400).unwrap();
         let model = hertz_mindlin(&e.model).expect("the scene's model is Hertz-Mindlin");
-        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), periodic: e.periodic };
+        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), periodic: e.periodic, residual: &e.residual };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let (mut hist_one, mut hist_lanes) = (e.hist.clone(), e.hist.clone());
         let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[stride * k..stride * (k + 1)])).collect();
@@ -326,7 +326,7 @@ duration = 1.0e-3
         let mut e = CpuEngine::<T>::new(&scene).unwrap();
         e.advance(400).unwrap();
         let elapsed = T::of(1.0e-7);
-        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed, periodic: e.periodic };
+        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed, periodic: e.periodic, residual: &e.residual };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let mut hist = e.hist.clone();
         let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist[stride * k..stride * (k + 1)])).collect();
@@ -335,7 +335,7 @@ duration = 1.0e-3
         let per_grain = e.walls.len() * stride;
         let mut wall_hist = e.wall_hist.clone();
         let mut touches = Vec::new();
-        let wall: Vec<Load<T>> = (0..e.body.len()).map(|i| wall_contacts(e.id[i], &e.body[i], &e.prop[i], &e.walls, &ctx, &mut wall_hist[i * per_grain..(i + 1) * per_grain], &mut touches)).collect();
+        let wall: Vec<Load<T>> = (0..e.body.len()).map(|i| wall_contacts(e.id[i], &e.body[i], crate::position::residual_at(&e.residual, i), &e.prop[i], &e.walls, &ctx, &mut wall_hist[i * per_grain..(i + 1) * per_grain], &mut touches)).collect();
         assert!(!touches.is_empty(), "grains must touch the floor");
         e.evaluate_forces(elapsed);
         let p = &e.pairs;

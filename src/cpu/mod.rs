@@ -35,6 +35,7 @@ use crate::engine::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
 use crate::model::{capillary_potential, normal_potential, share_liquid, within_rupture, CohesionLaw, ContactModel, PairCoeffs, Regime};
 use crate::periodic::Periodic;
+use crate::position;
 use crate::real::{Real, Vec3};
 use crate::schedule::{Op, Schedule, Trace};
 use crate::scene::{Scene, WallShape};
@@ -81,6 +82,9 @@ pub struct CpuEngine<T: Real> {
     /// The slot of each permanent id.
     slot: Vec<u32>,
     body: Vec<Body<T>>,
+    /// What rounding took off each `body[i].pos` ([`crate::position`]): the grain is at
+    /// `pos + residual`. Empty in f64, whose positions are plain.
+    residual: Vec<Vec3<T>>,
     prop: Vec<Props<T>>,
     load: Vec<Load<T>>,
     built_at: Vec<Vec3<T>>,
@@ -141,8 +145,9 @@ impl<T: Real> CpuEngine<T> {
         }
         let g = &scene.grains;
         let n = g.len();
-        let body: Vec<Body<T>> =
-            (0..n).map(|i| Body { pos: Vec3::of(g.position[i]), vel: Vec3::of(g.velocity[i]), omega: Vec3::of(g.angular_velocity[i]) }).collect();
+        let (positions, residual): (Vec<Vec3<T>>, Vec<Vec3<T>>) = g.position.iter().map(|&x| position::split(x)).unzip();
+        let body: Vec<Body<T>> = (0..n).map(|i| Body { pos: positions[i], vel: Vec3::of(g.velocity[i]), omega: Vec3::of(g.angular_velocity[i]) }).collect();
+        let residual = if T::COMPENSATED { residual } else { Vec::new() };
         let prop: Vec<Props<T>> = (0..n)
             .map(|i| Props {
                 radius: T::of(g.radius[i]),
@@ -190,6 +195,7 @@ impl<T: Real> CpuEngine<T> {
             built_at: body.iter().map(|b| b.pos).collect(),
             image: if scene.periodic.iter().any(Option::is_some) { vec![[0; 3]; n] } else { Vec::new() },
             body,
+            residual,
             prop,
             load: vec![Load::default(); n],
             orientation: scene.track_orientation.then(|| vec![[T::ONE, T::ZERO, T::ZERO, T::ZERO]; n]),
@@ -229,20 +235,24 @@ impl<T: Real> CpuEngine<T> {
         let t = self.clock.start();
         if self.periodic.any() {
             let p = self.periodic;
-            self.body.par_iter_mut().zip(self.image.par_iter_mut()).with_min_len(PAR_MIN_ITEMS).for_each(|(b, image)| {
-                let (pos, moved) = p.wrap(b.pos);
-                b.pos = pos;
+            let wrap = |b: &mut Body<T>, r: &mut Vec3<T>, image: &mut [i32; 3]| {
+                let moved = position::wrap(&p, &mut b.pos, r);
                 for a in 0..3 {
                     image[a] += moved[a];
                 }
-            });
+            };
+            if T::COMPENSATED {
+                self.body.par_iter_mut().zip(self.residual.par_iter_mut()).zip(self.image.par_iter_mut()).with_min_len(PAR_MIN_ITEMS).for_each(|((b, r), image)| wrap(b, r, image));
+            } else {
+                self.body.par_iter_mut().zip(self.image.par_iter_mut()).with_min_len(PAR_MIN_ITEMS).for_each(|(b, image)| wrap(b, &mut Vec3::default(), image));
+            }
         }
         if !hash_cells(&self.body, self.cutoff, &self.periodic, &mut self.grid) {
             return Err(self.non_finite_error());
         }
         self.clock.stop(Phase::Hash, t);
         let t = self.clock.start();
-        let pairs = PairList::detect(&self.body, &self.prop, &self.id, &self.grid, &self.periodic, self.detect_reach, self.capacity)
+        let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &self.grid, &self.periodic, self.detect_reach, self.capacity)
             .map_err(|(i, count)| SimError::Capacity { step: self.step, grain: self.id[i], count, capacity: self.capacity })?;
         self.clock.stop(Phase::Detect, t);
         let t = self.clock.start();
@@ -275,6 +285,7 @@ impl<T: Real> CpuEngine<T> {
         }
         r.apply(&mut self.id);
         r.apply(&mut self.body);
+        r.apply(&mut self.residual);
         r.apply(&mut self.prop);
         r.apply(&mut self.load);
         r.apply(&mut self.built_at);
@@ -325,9 +336,20 @@ impl<T: Real> CpuEngine<T> {
         self.slot.iter().map(|&s| v[s as usize]).collect()
     }
 
-    /// Grain states, in permanent-id order.
+    /// Grain states, in permanent-id order (positions to this precision: see [`Self::positions`]).
     pub fn bodies(&self) -> Vec<Body<T>> {
         self.by_id(&self.body)
+    }
+
+    /// Grain positions in permanent-id order (m, f64): `pos + residual` where compensated.
+    pub fn positions(&self) -> Vec<[f64; 3]> {
+        self.slot.iter().map(|&s| position::absolute(self.body[s as usize].pos, position::residual_at(&self.residual, s as usize))).collect()
+    }
+
+    /// The separation `r_i - r_j` of slots `i` and `j` (m, minimum image, residuals included).
+    #[inline]
+    fn separation(&self, i: usize, j: usize) -> Vec3<T> {
+        position::separation_of(&self.periodic, |k| self.body[k].pos, &self.residual, i, j)
     }
 
     /// Loads from the last force evaluation, in permanent-id order.
@@ -357,7 +379,7 @@ impl<T: Real> CpuEngine<T> {
     /// Gap (m) between the surfaces of pair `k`'s grains (negative when they overlap).
     fn gap(&self, k: usize) -> T {
         let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
-        self.periodic.min_image(self.body[i].pos - self.body[j].pos).norm() - self.prop[i].radius - self.prop[j].radius
+        self.separation(i, j).norm() - self.prop[i].radius - self.prop[j].radius
     }
 
     /// `update_bridges`: ruptures bridges stretched past their rupture distance, returning
@@ -431,6 +453,7 @@ impl<T: Real> CpuEngine<T> {
             slots: self.slots,
             elapsed,
             periodic: self.periodic,
+            residual: &self.residual,
         };
         let (pairs, body, prop, gravity) = (&self.pairs, &self.body, &self.prop, self.gravity);
         let blocks = owner_blocks(pairs, self.slots.stride, &mut self.load, &mut self.share, &mut self.report, &mut self.force_i, &mut self.hist);
@@ -464,13 +487,22 @@ impl<T: Real> CpuEngine<T> {
     /// how far the grains have moved since the last build.
     fn drift(&mut self, tau: T) {
         let t = self.clock.start();
-        let moved: Vec<T> = self
-            .body
-            .par_chunks_mut(CHUNK)
-            .zip(self.built_at.par_chunks(CHUNK))
-            .with_min_len(PAR_MIN_CHUNKS)
-            .map(|(bodies, at)| bodies.iter_mut().zip(at).map(|(b, at)| integrate::drift(b, *at, tau)).fold(T::ZERO, T::max))
-            .collect();
+        let moved: Vec<T> = if T::COMPENSATED {
+            self.body
+                .par_chunks_mut(CHUNK)
+                .zip(self.residual.par_chunks_mut(CHUNK))
+                .zip(self.built_at.par_chunks(CHUNK))
+                .with_min_len(PAR_MIN_CHUNKS)
+                .map(|((bodies, res), at)| bodies.iter_mut().zip(res).zip(at).map(|((b, r), at)| integrate::drift(b, r, *at, tau)).fold(T::ZERO, T::max))
+                .collect()
+        } else {
+            self.body
+                .par_chunks_mut(CHUNK)
+                .zip(self.built_at.par_chunks(CHUNK))
+                .with_min_len(PAR_MIN_CHUNKS)
+                .map(|(bodies, at)| bodies.iter_mut().zip(at).map(|(b, at)| integrate::drift(b, &mut Vec3::default(), *at, tau)).fold(T::ZERO, T::max))
+                .collect()
+        };
         if let Some(q) = &mut self.orientation {
             let body = &self.body;
             q.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, q)| *q = integrate::rotate(*q, body[i].omega, tau));
@@ -556,7 +588,7 @@ impl<T: Real> CpuEngine<T> {
     /// Overlap (m) and smaller radius (m) of pair `k`.
     fn pair_overlap(&self, k: usize) -> (T, T) {
         let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
-        let d = self.periodic.min_image(self.body[i].pos - self.body[j].pos).norm();
+        let d = self.separation(i, j).norm();
         (self.prop[i].radius + self.prop[j].radius - d, self.prop[i].radius.min(self.prop[j].radius))
     }
 }
@@ -795,7 +827,7 @@ impl<T: Real> Engine for CpuEngine<T> {
 
     fn memory_bytes(&self) -> u64 {
         let l = &self.pairs;
-        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
+        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
         let walls = allocated(&self.wall_hist) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
         let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.owner) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
         grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)

@@ -29,6 +29,16 @@ pub struct ForceContext<'a, T> {
     pub elapsed: T,
     /// Wrapping axes.
     pub periodic: Periodic<T>,
+    /// The positions' residuals by slot ([`crate::position`]; empty in f64).
+    pub residual: &'a [Vec3<T>],
+}
+
+impl<T: Real> ForceContext<'_, T> {
+    /// The separation `r_i - r_j` of slots `i` and `j` (m, minimum image, residuals included).
+    #[inline(always)]
+    pub fn separation(&self, body: &[Body<T>], i: usize, j: usize) -> Vec3<T> {
+        crate::position::separation_of(&self.periodic, |k| body[k].pos, self.residual, i, j)
+    }
 }
 
 /// `pair_force` for pair `k`. A listed pair that does not touch forgets its springs and
@@ -38,7 +48,7 @@ pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &
     let i = pairs.owner[k] as usize;
     let j = pairs.partner[k] as usize;
     let (bi, bj, pi, pj) = (&body[i], &body[j], &prop[i], &prop[j]);
-    let d = ctx.periodic.min_image(bi.pos - bj.pos);
+    let d = ctx.separation(body, i, j);
     let dist2 = d.norm2();
     let reach = pi.radius + pj.radius;
     if dist2 >= reach * reach {

@@ -5,7 +5,7 @@ use super::grid::{detect_pairs, CellGrid};
 use super::reduce::chunked;
 use super::state::{Body, Props};
 use crate::periodic::Periodic;
-use crate::real::Real;
+use crate::real::{Real, Vec3};
 use rayon::prelude::*;
 
 /// Candidate pairs, each listed once under its owner (the lower permanent id).
@@ -38,6 +38,7 @@ impl PairList {
     /// the one with the lowest permanent id (slot, count).
     pub fn detect<T: Real>(
         body: &[Body<T>],
+        residual: &[Vec3<T>],
         prop: &[Props<T>],
         id: &[u32],
         grid: &CellGrid<T>,
@@ -51,7 +52,7 @@ impl PairList {
             let mut partners = Vec::new();
             for i in r {
                 let before = partners.len();
-                detect_pairs(i, body, prop, id, grid, periodic, skin, &mut partners);
+                detect_pairs(i, body, residual, prop, id, grid, periodic, skin, &mut partners);
                 counts.push((partners.len() - before) as u32);
             }
             (counts, partners)

@@ -10,7 +10,7 @@ impl<T: Real> CpuEngine<T> {
         Frame {
             time: self.time,
             id: (0..self.id.len() as u32).collect(),
-            position: body.iter().map(|b| b.pos.f64()).collect(),
+            position: self.positions(),
             radius: self.by_id(&self.prop).iter().map(|p| p.radius.f64()).collect(),
             velocity: body.iter().map(|b| b.vel.f64()).collect(),
             angular_velocity: body.iter().map(|b| b.omega.f64()).collect(),
@@ -40,7 +40,7 @@ impl<T: Real> CpuEngine<T> {
                     .collect()
             }),
             wall_contacts: contacts.then(|| {
-                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic };
+                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic, residual: &self.residual };
                 wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_hist)
             }),
             walls: self.walls.iter().map(|w| w.geom.f64()).collect(),
@@ -57,6 +57,9 @@ impl<T: Real> CpuEngine<T> {
         s.put_reals("load", self.load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
         s.put_ints("wall_touch_ids", self.wall_touches.iter().flat_map(|t| [t.grain as u64, t.wall as u64, t.regime as u64]));
         s.put_reals("wall_touches", self.wall_touches.iter().flat_map(|t| [v3(&t.force).as_slice(), &[t.stiffness.f64(), t.damping.f64()]].concat()));
+        if T::COMPENSATED {
+            s.put_reals("residual", self.residual.iter().flat_map(v3));
+        }
         s.put_reals("built_at", self.built_at.iter().flat_map(v3));
         s.put_ints("image", self.image.iter().flat_map(|i| i.map(|x| x as i64 as u64)));
         if let Some(q) = &self.orientation {
@@ -125,6 +128,10 @@ impl<T: Real> CpuEngine<T> {
             .zip(values.chunks_exact(5))
             .map(|(i, v)| WallTouch { grain: i[0] as u32, wall: i[1] as u32, regime: Regime::from_code(i[2] as u8), force: v3(&v[0..3]), stiffness: T::of(v[3]), damping: T::of(v[4]) })
             .collect();
+        // f64 keeps no residuals (and a checkpoint written before there were any still resumes).
+        if T::COMPENSATED {
+            self.residual = s.reals("residual", 3 * n)?.chunks_exact(3).map(v3).collect();
+        }
         for (b, c) in self.built_at.iter_mut().zip(s.reals("built_at", 3 * n)?.chunks_exact(3)) {
             *b = v3(c);
         }

@@ -81,7 +81,7 @@ impl<T: Real> CpuEngine<T> {
                 let pl = &self.pairs;
                 let mut contacts: u64 = (pl.owner_start[i]..pl.owner_start[i + 1]).map(pushes).sum::<u64>() + pl.rev_pair[pl.rev_start[i] as usize..pl.rev_start[i + 1] as usize].iter().map(|&k| pushes(k)).sum::<u64>();
                 for wall in &self.walls {
-                    let (_, dist) = wall.geom.frame(b.pos);
+                    let (_, dist) = wall.geom.frame(b.pos, crate::position::residual_at(&self.residual, i));
                     let h = p.radius - dist;
                     if h > T::ZERO {
                         contacts += 1;

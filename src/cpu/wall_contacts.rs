@@ -43,6 +43,7 @@ pub struct WallTouch<T> {
 pub fn wall_contacts<T: Real>(
     id: u32,
     b: &Body<T>,
+    residual: Vec3<T>,
     p: &Props<T>,
     walls: &[WallState<T>],
     ctx: &ForceContext<T>,
@@ -53,7 +54,7 @@ pub fn wall_contacts<T: Real>(
     let stride = ctx.slots.stride;
     for (w, wall) in walls.iter().enumerate() {
         let h_slot = &mut hist[w * stride..(w + 1) * stride];
-        let (n, dist) = wall.geom.frame(b.pos);
+        let (n, dist) = wall.geom.frame(b.pos, residual);
         if dist >= p.radius {
             ctx.slots.clear_springs(h_slot);
             continue;
@@ -92,7 +93,7 @@ fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut 
     let per_grain = walls.len() * ctx.slots.stride;
     for (m, l) in loads.iter_mut().enumerate() {
         let i = first + m;
-        let w = wall_contacts(id[i], &body[i], &prop[i], walls, ctx, &mut hist[m * per_grain..(m + 1) * per_grain], touches);
+        let w = wall_contacts(id[i], &body[i], crate::position::residual_at(ctx.residual, i), &prop[i], walls, ctx, &mut hist[m * per_grain..(m + 1) * per_grain], touches);
         l.force += w.force;
         l.torque += w.torque;
     }
@@ -106,7 +107,7 @@ pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[
     let mut out = Vec::new();
     for (i, (b, p)) in body.iter().zip(prop).enumerate() {
         for (w, wall) in walls.iter().enumerate() {
-            let (n, dist) = wall.geom.frame(b.pos);
+            let (n, dist) = wall.geom.frame(b.pos, crate::position::residual_at(ctx.residual, i));
             if dist >= p.radius {
                 continue;
             }

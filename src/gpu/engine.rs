@@ -234,6 +234,8 @@ impl GpuEngine {
         let g = &scene.grains;
         let v4 = |a: [f64; 3], w: f64| [a[0] as f32, a[1] as f32, a[2] as f32, w as f32];
         let pos: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.position[i], g.radius[i])).collect();
+        // What rounding took off each position (src/position.rs), as the CPU's f32 engine keeps it.
+        let residual: Vec<[f32; 4]> = g.position.iter().map(|&x| { let (_, r) = crate::position::split::<f32>(x); [r.x, r.y, r.z, 0.0] }).collect();
         let vel: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.velocity[i], g.mass[i])).collect();
         let omega: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.angular_velocity[i], 0.4 * g.mass[i] * g.radius[i] * g.radius[i])).collect();
         let material: Vec<u32> = g.material.iter().map(|&m| m as u32).collect();
@@ -248,6 +250,7 @@ impl GpuEngine {
             buffers.insert(name, b);
         };
         init("pos", bytemuck::cast_slice(&pos), wgpu::BufferUsages::empty());
+        init("residual", bytemuck::cast_slice(&residual), wgpu::BufferUsages::empty());
         init("vel", bytemuck::cast_slice(&vel), wgpu::BufferUsages::empty());
         init("omega", bytemuck::cast_slice(&omega), wgpu::BufferUsages::empty());
         init("material", bytemuck::cast_slice(&material), wgpu::BufferUsages::empty());

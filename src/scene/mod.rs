@@ -417,7 +417,7 @@ pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone, pe
 /// Signed distance (m) from a point to a wall's surface at its initial position, positive on
 /// the grains' side.
 pub fn wall_distance(shape: &WallShape, p: [f64; 3]) -> f64 {
-    crate::walls::WallGeom::<f64>::of(shape).frame(crate::real::Vec3::of(p)).1
+    crate::walls::WallGeom::<f64>::of(shape).frame(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).1
 }
 
 fn validate_periodic(c: &Complainer, f: &SceneFile) -> Result<[Option<[f64; 2]>; 3], SceneError> {

@@ -112,7 +112,8 @@ impl GpuEngine {
         let crate::model::CohesionLaw::Capillary { kappa, theta, c } = self.model.cohesion else { return Ok((0, 0.0, 0.0, 0.0)) };
         let blocks = self.params.hist_blocks as usize;
         let n = self.n as u64;
-        let parts = self.read(&[("hist", 0, 16 * n_pairs * blocks as u64), ("liquid", 0, 4 * n), ("pos", 0, 16 * n), ("pair_i", 0, 4 * n_pairs), ("pair_j", 0, 4 * n_pairs)])?;
+        let parts = self.read(&[("hist", 0, 16 * n_pairs * blocks as u64), ("liquid", 0, 4 * n), ("pos", 0, 16 * n), ("pair_i", 0, 4 * n_pairs), ("pair_j", 0, 4 * n_pairs), ("residual", 0, 16 * n)])?;
+        let residual: &[[f32; 4]] = bytemuck::cast_slice(&parts[5]);
         let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
         let liquid: &[f32] = bytemuck::cast_slice(&parts[1]);
         let pos: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
@@ -122,8 +123,9 @@ impl GpuEngine {
         for k in 0..n_pairs as usize {
             let v = hist[k * blocks + blocks - 1][0];
             if v > 0.0 {
-                let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
-                let gap = self.periodic.min_image(v3(a) - v3(b)).norm() - a[3] - b[3];
+                let (i, j) = (pi[k] as usize, pj[k] as usize);
+                let (a, b) = (&pos[i], &pos[j]);
+                let gap = crate::position::separation(&self.periodic, v3(a), v3(&residual[i]), v3(b), v3(&residual[j])).norm() - a[3] - b[3];
                 bridges += 1;
                 held += v as f64;
                 energy += crate::model::capillary_potential(kappa, theta, c, a[3], b[3], v, gap) as f64;

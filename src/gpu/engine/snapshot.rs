@@ -42,7 +42,7 @@ fn wall_geom(w: &layout::Wall) -> crate::walls::WallGeom<f32> {
 
 impl GpuEngine {
     /// Grain-wall contacts re-evaluated on the host from the GPU's state (the CPU twin's
-    /// function in f32), given the grain arrays `[pos, vel, omega, ..]` already read.
+    /// function in f32), given the grain arrays `[pos, vel, omega, residual, ..]` already read.
     pub(super) fn wall_contact_records(&self, arrays: &[Vec<[f32; 4]>]) -> Result<Vec<crate::engine::WallContactRecord>, SimError> {
         use crate::cpu::{wall_contact_records, Body, ForceContext, HistorySlots, Props, WallState};
         use crate::real::Vec3;
@@ -58,6 +58,7 @@ impl GpuEngine {
         let v3 = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
         let body: Vec<Body<f32>> = (0..self.n as usize).map(|i| Body { pos: v3(arrays[0][i]), vel: v3(arrays[1][i]), omega: v3(arrays[2][i]) }).collect();
         let prop: Vec<Props<f32>> = (0..self.n as usize).map(|i| Props { radius: arrays[0][i][3], mass: arrays[1][i][3], inertia: arrays[2][i][3], material: parts[0][i] }).collect();
+        let residual: Vec<Vec3<f32>> = arrays[3].iter().map(|&r| v3(r)).collect();
         let states: Vec<WallState<f32>> = walls
             .iter()
             .map(|w| WallState {
@@ -75,6 +76,7 @@ impl GpuEngine {
             slots,
             elapsed: 0.0,
             periodic: crate::periodic::Periodic::default(),
+            residual: &residual,
         };
         Ok(wall_contact_records(&body, &prop, &(0..self.n).collect::<Vec<u32>>(), &states, &ctx, &hist))
     }
@@ -82,11 +84,13 @@ impl GpuEngine {
     /// The grain state, and the touching pairs and wall contacts with their forces when
     /// `contacts`.
     pub(super) fn snapshot(&self, contacts: bool) -> Result<Frame, SimError> {
-        let mut names = vec!["pos", "vel", "omega"];
+        let mut names = vec!["pos", "vel", "omega", "residual"];
         if self.track_orientation {
             names.push("quat");
         }
         let arrays = self.read_vec4s(&names)?;
+        let (pos, residual) = (&arrays[0], &arrays[3]);
+        let v3 = |p: &[f32; 4]| crate::real::Vec3::new(p[0], p[1], p[2]);
         let xyz = |v: &[f32; 4]| [v[0] as f64, v[1] as f64, v[2] as f64];
         let contact_records = contacts.then(|| -> Result<Vec<ContactRecord>, SimError> {
             let np = self.control.n_pairs as u64;
@@ -98,18 +102,13 @@ impl GpuEngine {
             let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[4]);
             // out_tj.w: the capillary force.
             let f_c: Vec<f32> = bytemuck::cast_slice::<u32, [f32; 4]>(&parts[5]).iter().map(|t| t[3]).collect();
-            let pos = &arrays[0];
             Ok((0..np as usize)
                 .filter_map(|k| {
-                    let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
-                    let d = [(a[0] - b[0]) as f64, (a[1] - b[1]) as f64, (a[2] - b[2]) as f64];
-                    let mut d2 = 0.0;
-                    for (axis, x) in d.iter().enumerate() {
-                        let len = self.params.periodic_len[axis] as f64;
-                        let x = if len > 0.0 { x - len * (x / len + 0.5).floor() } else { *x };
-                        d2 += x * x;
-                    }
-                    let h = (a[3] + b[3]) as f64 - d2.sqrt();
+                    let (i, j) = (pi[k] as usize, pj[k] as usize);
+                    let (a, b) = (&pos[i], &pos[j]);
+                    // The compensated positions' separation, as the kernels have it.
+                    let d = crate::position::separation(&self.periodic, v3(a), v3(&residual[i]), v3(b), v3(&residual[j])).f64();
+                    let h = (a[3] + b[3]) as f64 - (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
                     (h > 0.0 || f_c[k] != 0.0).then(|| ContactRecord {
                         i: pi[k],
                         j: pj[k],
@@ -135,11 +134,11 @@ impl GpuEngine {
         Ok(Frame {
             time: self.time,
             id: (0..self.n).collect(),
-            position: arrays[0].iter().map(xyz).collect(),
+            position: pos.iter().zip(residual).map(|(p, r)| crate::position::absolute(v3(p), v3(r))).collect(),
             radius: arrays[0].iter().map(|v| v[3] as f64).collect(),
             velocity: arrays[1].iter().map(xyz).collect(),
             angular_velocity: arrays[2].iter().map(xyz).collect(),
-            orientation: self.track_orientation.then(|| arrays[3].iter().map(|q| [q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]).collect()),
+            orientation: self.track_orientation.then(|| arrays[4].iter().map(|q| [q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]).collect()),
             contacts: contact_records,
             wall_contacts: wall_records,
             walls: self.walls_now()?,
@@ -165,8 +164,9 @@ impl GpuEngine {
         // The liquid goes to the pairs of the current list.
         self.ensure_loads();
         let (n, np, blocks) = (self.n as u64, self.read_control()?.n_pairs as u64, self.params.hist_blocks as u64);
-        let parts = self.read(&[("pos", 0, 16 * n), ("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("hist", 0, 16 * np * blocks), ("liquid", 0, 4 * n)])?;
+        let parts = self.read(&[("pos", 0, 16 * n), ("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("hist", 0, 16 * np * blocks), ("liquid", 0, 4 * n), ("residual", 0, 16 * n)])?;
         let pos: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
+        let residual: &[[f32; 4]] = bytemuck::cast_slice(&parts[5]);
         let (pi, pj) = (&parts[1], &parts[2]);
         let mut hist: Vec<[f32; 4]> = bytemuck::cast_slice(&parts[3]).to_vec();
         let mut liquid: Vec<f32> = bytemuck::cast_slice(&parts[4]).to_vec();
@@ -174,8 +174,9 @@ impl GpuEngine {
         let v3 = |p: &[f32; 4]| Vec3::new(p[0], p[1], p[2]);
         let pairs: Vec<(f64, f64, f64)> = (0..np as usize)
             .map(|k| {
-                let (a, b) = (&pos[pi[k] as usize], &pos[pj[k] as usize]);
-                (a[3] as f64, b[3] as f64, (self.periodic.min_image(v3(a) - v3(b)).norm() - a[3] - b[3]) as f64)
+                let (i, j) = (pi[k] as usize, pj[k] as usize);
+                let (a, b) = (&pos[i], &pos[j]);
+                (a[3] as f64, b[3] as f64, (crate::position::separation(&self.periodic, v3(a), v3(&residual[i]), v3(b), v3(&residual[j])).norm() - a[3] - b[3]) as f64)
             })
             .collect();
         let (shares, rest) = crate::model::share_liquid(volume, &pairs, self.params.bridge_cap as f64, theta as f64);
