@@ -25,3 +25,4 @@ pub mod scene;
 pub mod sweep;
 pub mod timestep;
 pub mod walls;
+pub mod workgroup;

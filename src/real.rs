@@ -38,6 +38,11 @@ pub trait Real:
     /// `f32`, whose 24 bits at 1 m are 6e-8 m, coarser than a stiff contact's overlap.
     /// `f64` holds plain positions (1e-16 m at 1 m).
     const COMPENSATED: bool;
+    /// True for the GPU's precision (`f32`): its CPU engine is the GPU's twin and adds the
+    /// walls' sums in the GPU's workgroup order ([`crate::workgroup`]), so the two agree bit
+    /// for bit. `f64`, the reference, keeps its running sums over fixed chunks of ids, the order
+    /// every figure the README quotes from it was computed in.
+    const GPU_TWIN: bool;
     /// Converts from `f64`, rounding to nearest.
     fn of(x: f64) -> Self;
     /// Widens to `f64`.
@@ -61,12 +66,13 @@ pub trait Real:
 }
 
 macro_rules! impl_real {
-    ($t:ty, $compensated:expr) => {
+    ($t:ty, $compensated:expr, $gpu_twin:expr) => {
         impl Real for $t {
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
             const NAME: &'static str = stringify!($t);
             const COMPENSATED: bool = $compensated;
+            const GPU_TWIN: bool = $gpu_twin;
             #[inline(always)]
             fn of(x: f64) -> Self {
                 x as $t
@@ -110,8 +116,8 @@ macro_rules! impl_real {
         }
     };
 }
-impl_real!(f32, true);
-impl_real!(f64, false);
+impl_real!(f32, true, true);
+impl_real!(f64, false, false);
 
 /// A 3-vector of reals (metres, m/s, N, ... as its owner says).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -239,8 +239,9 @@ fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
     }
 }
 
-/// Servo wall pressures, GPU against CPU f32, relative. The two sum each wall's reaction and
-/// contact stiffness in different orders, so a pressure-controlled wall's speed differs by
+/// Servo wall pressures, GPU against CPU f32, relative, on a hardware GPU. Both add each
+/// wall's reaction and contact stiffness in the GPU's workgroup order (`grains::workgroup`),
+/// but a hardware GPU fuses multiply-adds, so a pressure-controlled wall's speed differs by
 /// ulps and its position by about 1e-6 of a diameter after a thousand steps; at the lightly
 /// loaded start of a compaction a wall's few contacts overlap by about 1e-4 of a diameter, and
 /// Hertz forces grow as h^1.5, so that moves the pressure by some 0.1-1%.
@@ -248,9 +249,10 @@ const SERVO_PRESSURE_TOLERANCE: f64 = 1e-2;
 
 /// Servo walls on the GPU against the CPU f32 twin: 300 grains compacted by six servo planes
 /// (the walls first close at full speed, then feel the grains), then a triaxial leg with the
-/// z planes at a fixed strain rate. While the walls close at full speed the two are bitwise
-/// equal; once they follow their pressures, positions agree to f32 round-off of the sums they
-/// follow, the walls' work and the kinetic energy to the statistics tolerance.
+/// z planes at a fixed strain rate. On a software adapter (lavapipe), which runs the twin's
+/// arithmetic, the walls stay bitwise equal through both legs; on a hardware GPU positions
+/// agree to f32 round-off of the sums they follow. The walls' work and the kinetic energy
+/// agree to the statistics tolerance (the host reads them in f64 from each engine's f32).
 #[test]
 fn servo_walls_on_the_gpu_follow_the_cpu_twin() {
     let scene = common::parse(&common::edit(
@@ -261,6 +263,7 @@ fn servo_walls_on_the_gpu_follow_the_cpu_twin() {
     let Some(mut g) = common::gpu_engine(&scene) else { return };
     let mut c: CpuEngine<f32> = common::engine(&scene);
     let d_mean = 2.0 * scene.grains.radius.iter().sum::<f64>() / scene.grains.len() as f64;
+    let wall_tolerance = if g.adapter().device_type == wgpu::DeviceType::Cpu { 0.0 } else { F32_POSITION_TOLERANCE };
     let compare = |g: &mut grains::gpu::GpuEngine, c: &mut CpuEngine<f32>, leg: &str| {
         let (sg, sc) = (g.stats().unwrap(), c.stats().unwrap());
         let (mut worst, mut worst_p): (f64, f64) = (0.0, 0.0);
@@ -274,7 +277,7 @@ fn servo_walls_on_the_gpu_follow_the_cpu_twin() {
             worst / d_mean, sg.wall_contacts, sc.wall_contacts, sg.external_work, sc.external_work, sg.kinetic_energy(), sc.kinetic_energy()
         );
         assert!(sc.wall_contacts > 0, "{leg}: the walls reached the grains");
-        assert!(worst / d_mean < F32_POSITION_TOLERANCE, "{leg}: wall positions");
+        assert!(worst / d_mean <= wall_tolerance, "{leg}: wall positions");
         assert!(worst_p < SERVO_PRESSURE_TOLERANCE, "{leg}: wall pressures");
         assert!((sg.external_work - sc.external_work).abs() <= F32_STATS_TOLERANCE * sc.external_work.abs(), "{leg}: the walls' work");
         assert!((sg.kinetic_energy() - sc.kinetic_energy()).abs() <= F32_STATS_TOLERANCE * sc.kinetic_energy(), "{leg}: kinetic energy");

@@ -614,44 +614,98 @@ struct WallSums<T> {
     regimes: RegimeCounts,
 }
 
-impl<T: Real> WallSums<T> {
-    fn new(n: usize) -> Self {
-        WallSums { reaction: vec![Vec3::ZERO; n], count: vec![0; n], response: vec![(T::ZERO, T::ZERO); n], regimes: RegimeCounts::default() }
+/// One wall's share of the contacts of some grains: what `wall_contacts` and `wall_reduce`
+/// add up (the WGSL rows' xyz, w and the stiffness half).
+#[derive(Clone, Copy)]
+struct WallRow<T> {
+    /// Force the grains exert (N).
+    reaction: Vec3<T>,
+    /// Touching grains.
+    count: u64,
+    /// Summed normal tangent stiffness (N/m) and damping (N s/m).
+    response: (T, T),
+}
+
+impl<T: Real> WallRow<T> {
+    const ZERO: Self = WallRow { reaction: Vec3::ZERO, count: 0, response: (T::ZERO, T::ZERO) };
+
+    fn of(t: &WallTouch<T>) -> Self {
+        WallRow { reaction: -t.force, count: 1, response: (t.stiffness, t.damping) }
     }
 
-    /// The sums of `touches` (sorted by grain id, then wall), per fixed chunk of [`CHUNK`]
-    /// permanent ids in id order, then over chunks in order: the same bits however the slots
-    /// are numbered.
-    fn of(n_walls: usize, touches: &[WallTouch<T>]) -> Self {
-        let mut total = WallSums::new(n_walls);
-        let mut part = WallSums::new(n_walls);
+    fn add(self, o: Self) -> Self {
+        WallRow { reaction: self.reaction + o.reaction, count: self.count + o.count, response: (self.response.0 + o.response.0, self.response.1 + o.response.1) }
+    }
+}
+
+impl<T: Real> WallSums<T> {
+    /// The sums of `touches` (sorted by grain id, then wall) among `n_grains` grains: in the
+    /// GPU's order for its twin ([`Real::GPU_TWIN`]), in chunks of ids otherwise. Either way
+    /// the same bits however the slots are numbered.
+    fn of(n_walls: usize, n_grains: usize, touches: &[WallTouch<T>]) -> Self {
+        let totals = if T::GPU_TWIN { WallRow::in_gpu_order(n_walls, n_grains, touches) } else { WallRow::in_chunks(n_walls, touches) };
+        let mut regimes = RegimeCounts::default();
+        for t in touches {
+            regimes.count(t.regime);
+        }
+        WallSums { reaction: totals.iter().map(|r| r.reaction).collect(), count: totals.iter().map(|r| r.count).collect(), response: totals.iter().map(|r| r.response).collect(), regimes }
+    }
+}
+
+impl<T: Real> WallRow<T> {
+    /// Each wall's row, grains by permanent id in workgroups of [`WG`](crate::workgroup::WG),
+    /// each summed by its tree (`wall_contacts`), then the workgroups' rows by `wall_reduce`'s
+    /// strided tree: the GPU's order, whose grains sit in id order.
+    fn in_gpu_order(n_walls: usize, n_grains: usize, touches: &[WallTouch<T>]) -> Vec<Self> {
+        let wg = crate::workgroup::WG as usize;
+        let rows = crate::workgroup::rows(n_grains as u64) as usize;
+        let mut lanes = vec![WallRow::ZERO; wg];
+        (0..n_walls)
+            .map(|w| {
+                let mut rest = touches;
+                let partials = (0..rows).map(|r| {
+                    let (here, next) = rest.split_at(rest.partition_point(|t| (t.grain as usize) < (r + 1) * wg));
+                    rest = next;
+                    if here.is_empty() {
+                        return WallRow::ZERO;
+                    }
+                    lanes.fill(WallRow::ZERO);
+                    for t in here.iter().filter(|t| t.wall as usize == w) {
+                        lanes[t.grain as usize % wg] = WallRow::of(t);
+                    }
+                    crate::workgroup::tree_sum(&mut lanes, WallRow::add)
+                });
+                crate::workgroup::strided_sum(partials, WallRow::ZERO, WallRow::add)
+            })
+            .collect()
+    }
+
+    /// Each wall's row as running sums over fixed chunks of [`CHUNK`] ids in id order, then
+    /// over the chunks in order.
+    fn in_chunks(n_walls: usize, touches: &[WallTouch<T>]) -> Vec<Self> {
+        let mut total = vec![WallRow::ZERO; n_walls];
+        let mut part = vec![WallRow::ZERO; n_walls];
         let mut chunk = touches.first().map_or(0, |t| t.grain as usize / CHUNK);
         for t in touches {
             if t.grain as usize / CHUNK != chunk {
-                total.absorb(&part);
-                part = WallSums::new(n_walls);
+                absorb(&mut total, &mut part);
                 chunk = t.grain as usize / CHUNK;
             }
-            let w = t.wall as usize;
-            part.reaction[w] -= t.force;
-            part.count[w] += 1;
-            part.regimes.count(t.regime);
-            part.response[w].0 += t.stiffness;
-            part.response[w].1 += t.damping;
+            let p = &mut part[t.wall as usize];
+            p.reaction -= t.force;
+            p.count += 1;
+            p.response = (p.response.0 + t.stiffness, p.response.1 + t.damping);
         }
-        total.absorb(&part);
+        absorb(&mut total, &mut part);
         total
     }
+}
 
-    /// Adds one chunk's sums.
-    fn absorb(&mut self, p: &Self) {
-        for w in 0..self.reaction.len() {
-            self.reaction[w] += p.reaction[w];
-            self.count[w] += p.count[w];
-            self.response[w].0 += p.response[w].0;
-            self.response[w].1 += p.response[w].1;
-        }
-        self.regimes.add(p.regimes);
+/// Adds one chunk's rows to the totals and clears them.
+fn absorb<T: Real>(total: &mut [WallRow<T>], part: &mut [WallRow<T>]) {
+    for (t, p) in total.iter_mut().zip(part.iter_mut()) {
+        *t = t.add(*p);
+        *p = WallRow::ZERO;
     }
 }
 
@@ -686,7 +740,7 @@ fn complete_loads<T: Real>(
     };
     let mut touches = parts.concat();
     touches.sort_unstable_by_key(|t| (t.grain, t.wall));
-    (WallSums::of(walls.len(), &touches), touches)
+    (WallSums::of(walls.len(), id.len(), &touches), touches)
 }
 
 /// Splits the pair pass's outputs into the tasks of [`owner_block`]: [`pair_force::OWNERS`]

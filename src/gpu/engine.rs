@@ -12,7 +12,7 @@ mod traffic;
 
 use super::device::Gpu;
 use encode::Size;
-use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, SCAN_BLOCK, STAT_ROW, WG};
+use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, SCAN_BLOCK, STAT_ROW};
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::kernels::{Access, KERNELS};
 use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness};
@@ -20,6 +20,7 @@ use super::plan::{Dispatch, Entry, Plans};
 use crate::schedule::{Op, Schedule, Trace};
 use crate::scene::{Scene, WallShape};
 use std::collections::HashMap;
+use crate::workgroup;
 use wgpu::util::DeviceExt;
 
 /// Pairs per grain the pair buffers start with; they grow at statistics reads when more than
@@ -95,16 +96,6 @@ pub struct GpuEngine {
     control: Control,
     /// Dispatches recorded so far.
     dispatches: std::cell::Cell<u64>,
-}
-
-fn groups_for(n: u64) -> (u32, u32) {
-    let g = n.div_ceil(WG as u64);
-    if g <= 65535 { (g as u32, 1) } else { (65535, g.div_ceil(65535) as u32) }
-}
-
-fn rows_for(n: u64) -> u64 {
-    let (x, y) = groups_for(n.max(1));
-    x as u64 * y as u64
 }
 
 impl GpuEngine {
@@ -318,9 +309,9 @@ impl GpuEngine {
         let wall_hist = if hist_blocks > 0 { 16 * n * scene.walls.len() as u64 * hist_blocks } else { 16 };
         zeroed("wall_hist", wall_hist);
         // Per wall: the reaction, then the contacts' stiffness and damping (servo walls).
-        zeroed("wall_partials", rows_for(n) * 2 * MAX_WALLS as u64 * 16);
+        zeroed("wall_partials", workgroup::rows(n) * 2 * MAX_WALLS as u64 * 16);
         zeroed("wall_reaction", 2 * MAX_WALLS as u64 * 16);
-        zeroed("grain_rows", rows_for(n) * STAT_ROW as u64 * 4);
+        zeroed("grain_rows", workgroup::rows(n) * STAT_ROW as u64 * 4);
         zeroed("stats", 2 * STAT_ROW as u64 * 4);
 
         let mut engine = GpuEngine {
@@ -380,7 +371,7 @@ impl GpuEngine {
     fn allocate_pairs(&mut self, capacity: u64) {
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let mut sizes: Vec<(&'static str, u64)> = self.pair_buffers().iter().map(|&(name, per_pair)| (name, per_pair * capacity)).collect();
-        sizes.push(("pair_rows", rows_for(capacity) * STAT_ROW as u64 * 4));
+        sizes.push(("pair_rows", workgroup::rows(capacity) * STAT_ROW as u64 * 4));
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         for (name, size) in sizes {
             let b = self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size: size.max(16), usage: storage, mapped_at_creation: false });

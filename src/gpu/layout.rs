@@ -200,8 +200,7 @@ pub struct DispatchArgs {
 
 /// "No grain" / "no wall" (WGSL `NONE`).
 pub const NONE: u32 = u32::MAX;
-/// Invocations per workgroup of the per-item kernels (WGSL `WG`).
-pub const WG: u32 = 64;
+pub use crate::workgroup::WG;
 /// Walls a GPU scene may have (WGSL `MAX_WALLS`).
 pub const MAX_WALLS: usize = 8;
 /// Reals per statistics row (WGSL `STAT_ROW`).

@@ -23,7 +23,7 @@ impl GpuEngine {
         self.dispatches.set(self.dispatches.get() + 1);
         match size {
             Size::Grains => {
-                let (x, y) = groups_for(self.n as u64);
+                let (x, y) = crate::workgroup::groups(self.n as u64);
                 pass.dispatch_workgroups(x, y, 1);
             }
             Size::One => pass.dispatch_workgroups(1, 1, 1),
