@@ -17,14 +17,17 @@ impl<T: Real> CpuEngine<T> {
     pub(super) fn traffic(&self) -> Vec<(&'static str, u64)> {
         let l = &self.pairs;
         let (body, prop) = (bytes(&self.body), bytes(&self.prop));
+        // Compensated positions' residuals (empty in f64): read by every separation and every
+        // wall distance, read and written by a drift.
+        let residual = bytes(&self.residual);
         let orientation = self.orientation.as_deref().map_or(0, bytes);
         let kick = 2 * body + bytes(&self.load) + prop;
-        let drift = 2 * body + bytes(&self.built_at) + 2 * orientation;
+        let drift = 2 * body + 2 * residual + bytes(&self.built_at) + 2 * orientation;
         let r = &self.report;
         let pair_out = bytes(&self.share) + bytes(&r.f_n) + bytes(&r.f_c) + bytes(&r.flags) + bytes(&self.force_i);
-        let force = bytes(&l.owner) + bytes(&l.partner) + body + prop + 2 * bytes(&self.hist) + pair_out + bytes(&self.load);
+        let force = bytes(&l.owner) + bytes(&l.partner) + body + residual + prop + 2 * bytes(&self.hist) + pair_out + bytes(&self.load);
         // The wall contacts run in the gather's sweep, on the loads it has in hand.
-        let walls = if self.walls.is_empty() { 0 } else { body + prop + 2 * bytes(&self.wall_hist) };
+        let walls = if self.walls.is_empty() { 0 } else { body + residual + prop + 2 * bytes(&self.wall_hist) };
         let gather = bytes(&self.share) + bytes(&l.rev_start) + bytes(&l.rev_pair) + 2 * bytes(&self.load);
         let mut out: Vec<(&'static str, u64)> = Vec::new();
         let mut add = |name: &'static str, b: u64| match out.iter_mut().find(|e| e.0 == name) {
