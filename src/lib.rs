@@ -5,6 +5,7 @@
 //! statistics and frames ([`output`]).
 
 pub mod analysis;
+pub mod cd;
 pub mod bench;
 pub mod checkpoint;
 pub mod compare;

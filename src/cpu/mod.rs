@@ -42,7 +42,7 @@ use crate::scene::{Scene, WallShape};
 use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
 use gather::gather_block;
-use grid::{hash_cells, CellGrid};
+pub(crate) use grid::{hash_cells, CellGrid};
 use pair_force::{owner_block, OwnerBlock};
 use profile::{Phase, PhaseClock};
 use reorder::Renumbering;

@@ -1,0 +1,409 @@
+//! Contact dynamics (Moreau-Jean) for rigid frictional spheres and the scene's walls, beside
+//! the DEM engine: the method of seed 001's samples S1 and S2.
+//!
+//! One step of length `h`:
+//! 1. Contacts: every grain pair whose surfaces are within the gap allowance of each other
+//!    (the DEM engine's cell hash and pair detection, canonical order: owner id, then partner
+//!    id) and every grain within the allowance of a wall, after the pairs. Each contact has a
+//!    unit normal `n` from its first body `a` (the owner grain) to its second `b` (the partner
+//!    grain, or the wall), its gap `g` (m, negative when overlapping) and its relative velocity
+//!    at the contact point `u = v_b + w_b x (-R_b n) - v_a - w_a x (R_a n)` (m/s).
+//! 2. Free velocities `v_free = v + h g_vec` (gravity, the only external force), angular ones
+//!    unchanged.
+//! 3. Impulses `r` (N s, on `b`; `-r` on `a`) by nonsmooth Gauss-Seidel: contact after contact
+//!    in the fixed order, the local problem solved exactly and the velocities updated at once.
+//!    The local Delassus operator of two spheres is diagonal in the contact frame,
+//!    `W = w_n n n^T + w_t (1 - n n^T)` with `w_n = 1/m_a + 1/m_b` and
+//!    `w_t = w_n + R_a^2/I_a + R_b^2/I_b` (1/kg; a wall has infinite mass), so that
+//!    * normal (Signorini with Newton's impact law): `u_n^+ >= u_min`, `r_n >= 0`,
+//!      complementary: `r_n = max(0, (u_min - u'_n) / w_n)`, with `u'` the contact's velocity
+//!      without its own impulse. A contact predicted to be closed within the step (`g + h
+//!      u_n^theta <= 0` on the free velocities) takes Newton's impact law, `u_min = -e u_n^-`;
+//!      one predicted open only must not close by the step's end, `g + h u_n^theta >= 0`,
+//!      `u_min = -(g / h + (1 - theta) u_n^-) / theta` (so that a contact in touch whose
+//!      neighbours are yet to push it still carries its load);
+//!    * tangential (Coulomb with `mu`): the sticking impulse `-u'_t / w_t` when it lies in the
+//!      cone `|r_t| <= mu r_n`, else `-mu r_n u'_t / |u'_t|` (sliding against `u'_t`).
+//!
+//!    The sweep repeats until the impulses' relative change `sum |r - r_prev| / sum |r|`
+//!    falls to the tolerance or the iteration cap is reached; the statistics say which.
+//!    Impulses start from the previous step's (warm start), carried per contact by (grain
+//!    id, partner id or wall) like the DEM engine's history.
+//! 4. Positions by the theta-method: `x += h (theta v^+ + (1 - theta) v^-)`.
+//!
+//! Everything runs in a fixed order on one thread (detection in fixed chunks), so a step
+//! gives the same bits on any thread count.
+
+use crate::cpu::{Body, PairList, Props};
+use crate::periodic::Periodic;
+use crate::position;
+use crate::real::{Real, Vec3};
+use crate::scene::{Scene, WallShape};
+use crate::walls::WallGeom;
+use std::collections::HashMap;
+
+/// The solver's parameters (`[contact_dynamics]` in a scene).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CdParams {
+    /// Weight of the end-of-step velocity in the position update (-), in [0.5, 1].
+    pub theta: f64,
+    /// Relative change of the impulses between two sweeps at which the solve stops (-).
+    pub tolerance: f64,
+    /// Most Gauss-Seidel sweeps per step.
+    pub max_iterations: u32,
+    /// Surfaces closer than this are contacts of the step (m).
+    pub gap_allowance: f64,
+}
+
+impl Default for CdParams {
+    fn default() -> Self {
+        CdParams { theta: 0.5, tolerance: 1e-6, max_iterations: 1000, gap_allowance: 0.0 }
+    }
+}
+
+/// The second body of a contact.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Partner {
+    /// A grain, by slot.
+    Grain(u32),
+    /// A wall, by index.
+    Wall(u32),
+}
+
+/// One contact of a step.
+#[derive(Clone, Copy, Debug)]
+pub struct Contact<T> {
+    /// The first body: a grain slot.
+    pub a: u32,
+    /// The second body.
+    pub b: Partner,
+    /// Unit normal from `a` to `b`.
+    pub n: Vec3<T>,
+    /// Gap between the surfaces at the start of the step (m; negative: overlapping).
+    pub gap: T,
+    /// Friction coefficient (-).
+    pub mu: T,
+    /// Normal restitution coefficient (-).
+    pub e: T,
+    /// Normal Delassus diagonal `w_n` (1/kg).
+    pub w_n: T,
+    /// Tangential Delassus diagonal `w_t` (1/kg).
+    pub w_t: T,
+    /// Normal relative velocity at the start of the step, `u_n^-` (m/s; negative: closing).
+    pub u_minus: T,
+    /// Whether the contact is predicted closed within the step (Newton's impact law applies).
+    pub closing: bool,
+    /// Least normal relative velocity at the step's end, `u_min` (m/s).
+    pub u_min: T,
+    /// Impulse on `b` (N s; `-r` on `a`), world frame.
+    pub r: Vec3<T>,
+}
+
+/// What the last step's solve did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SolveReport {
+    /// Gauss-Seidel sweeps run.
+    pub iterations: u32,
+    /// Whether the relative change fell to the tolerance within the cap.
+    pub converged: bool,
+    /// Relative change of the impulses in the last sweep (-).
+    pub relative_change: f64,
+    /// Contacts in the system.
+    pub contacts: usize,
+    /// Contacts carrying a normal impulse.
+    pub loaded: usize,
+    /// Force balance: the mean over grains of the net impulse that the contacts and gravity
+    /// leave on a grain, `|m (v^+ - v^-)|`, over the mean normal impulse of the loaded
+    /// contacts (-; 0 when every grain is in equilibrium).
+    pub unbalanced: f64,
+}
+
+/// A contact-dynamics system: rigid spheres, static walls, the step's contacts.
+pub struct ContactDynamics<T: Real> {
+    params: CdParams,
+    h: T,
+    gravity: Vec3<T>,
+    id: Vec<u32>,
+    body: Vec<Body<T>>,
+    /// Compensated positions' residuals ([`crate::position`]; empty in f64).
+    residual: Vec<Vec3<T>>,
+    prop: Vec<Props<T>>,
+    walls: Vec<(WallGeom<T>, u32)>,
+    /// `(mu, e)` per pair of materials, row-major.
+    coeffs: Vec<(T, T)>,
+    n_materials: usize,
+    r_max: T,
+    contacts: Vec<Contact<T>>,
+    /// Last step's impulses by (grain id, partner grain id or wall), for the warm start.
+    warm: HashMap<(u32, Partner), Vec3<T>>,
+    report: SolveReport,
+    steps: u64,
+}
+
+/// Why a scene cannot run by contact dynamics.
+#[derive(Debug, thiserror::Error)]
+pub enum CdError {
+    /// A feature the solver does not model.
+    #[error("{path}: {what} is not modelled by contact dynamics; fix: {fix}")]
+    Unsupported {
+        /// The scene file.
+        path: String,
+        /// What the scene asks for.
+        what: &'static str,
+        /// What to do instead.
+        fix: &'static str,
+    },
+    /// A parameter out of range.
+    #[error("{path}: contact_dynamics.{key} = {value} is out of range; fix: {fix}")]
+    Parameter {
+        /// The scene file.
+        path: String,
+        /// The key under `[contact_dynamics]`.
+        key: &'static str,
+        /// Its value.
+        value: f64,
+        /// The range it must lie in.
+        fix: &'static str,
+    },
+}
+
+/// Friction and restitution of a contact between two materials, mixed as
+/// [`crate::model::PairCoeffs::mix`] mixes them: the smaller `mu_s`, the mean restitution.
+fn mix(a: &crate::model::MaterialConstants, b: &crate::model::MaterialConstants) -> (f64, f64) {
+    (a.mu_s.min(b.mu_s), 0.5 * (a.restitution + b.restitution))
+}
+
+impl<T: Real> ContactDynamics<T> {
+    /// The system of a scene's grains and walls at step `h` = the scene's time step.
+    pub fn new(scene: &Scene, params: CdParams) -> Result<Self, CdError> {
+        let path = scene.path.display().to_string();
+        let check = |ok: bool, key, value, fix| if ok { Ok(()) } else { Err(CdError::Parameter { path: path.clone(), key, value, fix }) };
+        check((0.5..=1.0).contains(&params.theta), "theta", params.theta, "use a value in [0.5, 1]")?;
+        check(params.tolerance > 0.0 && params.tolerance < 1.0, "tolerance", params.tolerance, "use a value in (0, 1), e.g. 1e-6")?;
+        check(params.max_iterations > 0, "max_iterations", params.max_iterations as f64, "use at least 1")?;
+        check(params.gap_allowance >= 0.0 && params.gap_allowance.is_finite(), "gap_allowance", params.gap_allowance, "use a length >= 0 (m)")?;
+        let unsupported = |what, fix| Err(CdError::Unsupported { path: path.clone(), what, fix });
+        if scene.periodic.iter().any(Option::is_some) {
+            return unsupported("a periodic boundary", "bound the grains with walls");
+        }
+        if scene.servo.is_some() || scene.walls.iter().any(|w| matches!(w.shape, WallShape::Piston { .. })) {
+            return unsupported("a moving wall (servo box or piston)", "use static walls");
+        }
+        if !matches!(scene.model.cohesion, crate::model::CohesionLaw::None) {
+            return unsupported("capillary cohesion", "drop [model] cohesion");
+        }
+        let n_materials = scene.materials.len();
+        let mut coeffs = Vec::with_capacity(n_materials * n_materials);
+        for a in &scene.materials {
+            for b in &scene.materials {
+                let (mu, e) = mix(&a.constants, &b.constants);
+                coeffs.push((T::of(mu), T::of(e)));
+            }
+        }
+        let g = &scene.grains;
+        let n = g.len();
+        let (pos, residual): (Vec<Vec3<T>>, Vec<Vec3<T>>) = g.position.iter().map(|&x| position::split(x)).unzip();
+        let body = (0..n).map(|i| Body { pos: pos[i], vel: Vec3::of(g.velocity[i]), omega: Vec3::of(g.angular_velocity[i]) }).collect();
+        let prop = (0..n)
+            .map(|i| Props { radius: T::of(g.radius[i]), mass: T::of(g.mass[i]), inertia: T::of(0.4 * g.mass[i] * g.radius[i] * g.radius[i]), material: g.material[i] as u32 })
+            .collect();
+        Ok(ContactDynamics {
+            params,
+            h: T::of(scene.time_step.dt),
+            gravity: Vec3::of(scene.gravity),
+            id: (0..n as u32).collect(),
+            body,
+            residual: if T::COMPENSATED { residual } else { Vec::new() },
+            prop,
+            walls: scene.walls.iter().map(|w| (WallGeom::of(&w.shape), w.material as u32)).collect(),
+            coeffs,
+            n_materials,
+            r_max: T::of(g.radius.iter().copied().fold(0.0, f64::max)),
+            contacts: Vec::new(),
+            warm: HashMap::new(),
+            report: SolveReport::default(),
+            steps: 0,
+        })
+    }
+
+    /// The grains' states, by id (slots are ids here).
+    pub fn bodies(&self) -> &[Body<T>] {
+        &self.body
+    }
+
+    /// The contacts of the last step with their impulses, in solve order.
+    pub fn contacts(&self) -> &[Contact<T>] {
+        &self.contacts
+    }
+
+    /// What the last step's solve did.
+    pub fn report(&self) -> SolveReport {
+        self.report
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The time step (s).
+    pub fn dt(&self) -> f64 {
+        self.h.f64()
+    }
+
+    /// Grain `i`'s position (m, f64, residual included).
+    pub fn position(&self, i: usize) -> [f64; 3] {
+        position::absolute(self.body[i].pos, position::residual_at(&self.residual, i))
+    }
+
+    /// `(mu, e)` of materials `a` and `b`.
+    fn pair(&self, a: u32, b: u32) -> (T, T) {
+        self.coeffs[a as usize * self.n_materials + b as usize]
+    }
+
+    /// Velocity of grain `i`'s surface point at `arm` from its centre (m/s).
+    fn point_velocity(&self, i: usize, arm: Vec3<T>) -> Vec3<T> {
+        self.body[i].vel + self.body[i].omega.cross(arm)
+    }
+
+    /// Relative velocity of `b` against `a` at contact `c` (m/s).
+    fn relative_velocity(&self, c: &Contact<T>) -> Vec3<T> {
+        let a = c.a as usize;
+        let u_a = self.point_velocity(a, c.n * self.prop[a].radius);
+        let u_b = match c.b {
+            Partner::Grain(j) => self.point_velocity(j as usize, c.n * -self.prop[j as usize].radius),
+            Partner::Wall(_) => Vec3::ZERO,
+        };
+        u_b - u_a
+    }
+
+    /// Applies impulse `dr` on `b` (and `-dr` on `a`) at contact `c`.
+    fn apply(&mut self, c: &Contact<T>, dr: Vec3<T>) {
+        let a = c.a as usize;
+        let (ra, ma, ia) = (self.prop[a].radius, self.prop[a].mass, self.prop[a].inertia);
+        self.body[a].vel -= dr * (T::ONE / ma);
+        self.body[a].omega -= (c.n * ra).cross(dr) * (T::ONE / ia);
+        if let Partner::Grain(j) = c.b {
+            let j = j as usize;
+            let (rb, mb, ib) = (self.prop[j].radius, self.prop[j].mass, self.prop[j].inertia);
+            self.body[j].vel += dr * (T::ONE / mb);
+            self.body[j].omega += (c.n * -rb).cross(dr) * (T::ONE / ib);
+        }
+    }
+
+    /// Step 1: the contacts within the gap allowance, pairs in canonical order, then walls.
+    fn detect(&mut self) {
+        let allowance = T::of(self.params.gap_allowance);
+        let periodic = Periodic::<T>::of(&[None, None, None]);
+        let mut grid = crate::cpu::CellGrid::default();
+        let cutoff = self.r_max * T::of(2.0) + allowance;
+        crate::cpu::hash_cells(&self.body, cutoff, &periodic, &mut grid);
+        let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grid, &periodic, allowance, usize::MAX).unwrap_or_default();
+        let mut contacts = Vec::with_capacity(pairs.len() + self.walls.len());
+        let (h, theta) = (self.h, T::of(self.params.theta));
+        for (k, &b) in pairs.partner.iter().enumerate() {
+            let (a, b) = (pairs.owner[k] as usize, b as usize);
+            let d = position::separation_of(&periodic, |s| self.body[s].pos, &self.residual, b, a);
+            let dist = d.norm();
+            let (pa, pb) = (&self.prop[a], &self.prop[b]);
+            let (mu, e) = self.pair(pa.material, pb.material);
+            let w_n = T::ONE / pa.mass + T::ONE / pb.mass;
+            let w_t = w_n + pa.radius * pa.radius / pa.inertia + pb.radius * pb.radius / pb.inertia;
+            contacts.push(Contact { a: a as u32, b: Partner::Grain(b as u32), n: d * (T::ONE / dist), gap: dist - pa.radius - pb.radius, mu, e, w_n, w_t, u_minus: T::ZERO, closing: false, u_min: T::ZERO, r: Vec3::ZERO });
+        }
+        for i in 0..self.body.len() {
+            for (w, (geom, material)) in self.walls.iter().enumerate() {
+                let (normal, dist) = geom.frame(self.body[i].pos, position::residual_at(&self.residual, i));
+                let p = &self.prop[i];
+                let gap = dist - p.radius;
+                if gap < allowance {
+                    let (mu, e) = self.pair(p.material, *material);
+                    let w_n = T::ONE / p.mass;
+                    let w_t = w_n + p.radius * p.radius / p.inertia;
+                    contacts.push(Contact { a: i as u32, b: Partner::Wall(w as u32), n: -normal, gap, mu, e, w_n, w_t, u_minus: T::ZERO, closing: false, u_min: T::ZERO, r: Vec3::ZERO });
+                }
+            }
+        }
+        // Normal velocities before and after the free motion decide each contact's law.
+        let u_minus: Vec<T> = contacts.iter().map(|c| self.relative_velocity(c).dot(c.n)).collect();
+        let g = self.gravity * h;
+        for (c, u) in contacts.iter_mut().zip(u_minus) {
+            // Gravity moves both grains alike: only a wall sees it in the relative velocity.
+            let free = u + if matches!(c.b, Partner::Wall(_)) { -g.dot(c.n) } else { T::ZERO };
+            c.u_minus = u;
+            c.closing = c.gap + h * (theta * free + (T::ONE - theta) * u) <= T::ZERO;
+            c.u_min = if c.closing { -c.e * u } else { -(c.gap / h + (T::ONE - theta) * u) / theta };
+            c.r = self.warm.get(&(self.id[c.a as usize], c.b)).copied().unwrap_or(Vec3::ZERO);
+        }
+        self.contacts = contacts;
+    }
+
+    /// Advances one step (see the module's text).
+    pub fn step(&mut self) {
+        self.detect();
+        let h = self.h;
+        let theta = T::of(self.params.theta);
+        let before: Vec<Body<T>> = self.body.clone();
+        for b in &mut self.body {
+            b.vel += self.gravity * h;
+        }
+        let mut contacts = std::mem::take(&mut self.contacts);
+        for c in &contacts {
+            self.apply(c, c.r);
+        }
+        let mut report = SolveReport { contacts: contacts.len(), ..Default::default() };
+        while report.iterations < self.params.max_iterations {
+            report.iterations += 1;
+            let (mut change, mut total) = (0.0f64, 0.0f64);
+            for c in contacts.iter_mut() {
+                let r_old = c.r;
+                // The contact's velocity without its own impulse.
+                let u = self.relative_velocity(c);
+                let own_n = r_old.dot(c.n);
+                let own_t = r_old - c.n * own_n;
+                let u_other = u - c.n * (c.w_n * own_n) - own_t * c.w_t;
+                let u_n = u_other.dot(c.n);
+                let r_n = ((c.u_min - u_n) / c.w_n).max(T::ZERO);
+                let u_t = u_other - c.n * u_n;
+                let stick = u_t * (-T::ONE / c.w_t);
+                let cap = c.mu * r_n;
+                let r_t = if stick.norm2() <= cap * cap {
+                    stick
+                } else {
+                    let s = u_t.norm();
+                    if s > T::ZERO { u_t * (-cap / s) } else { Vec3::ZERO }
+                };
+                let r = c.n * r_n + r_t;
+                self.apply(c, r - r_old);
+                c.r = r;
+                change += (r - r_old).norm().f64();
+                total += r.norm().f64();
+            }
+            report.relative_change = if total > 0.0 { change / total } else { 0.0 };
+            if report.relative_change <= self.params.tolerance {
+                report.converged = true;
+                break;
+            }
+        }
+        // Force balance of the grains, and the warm start of the next step.
+        let loaded: Vec<T> = contacts.iter().map(|c| c.r.dot(c.n)).filter(|&r_n| r_n > T::ZERO).collect();
+        report.loaded = loaded.len();
+        let mean_r = loaded.iter().map(|r| r.f64()).sum::<f64>() / loaded.len().max(1) as f64;
+        let net: f64 = self.body.iter().zip(&before).zip(&self.prop).map(|((b, b0), p)| ((b.vel - b0.vel) * p.mass).norm().f64()).sum();
+        report.unbalanced = if mean_r > 0.0 { net / self.body.len() as f64 / mean_r } else { 0.0 };
+        self.warm = contacts.iter().filter(|c| c.r != Vec3::ZERO).map(|c| ((self.id[c.a as usize], c.b), c.r)).collect();
+        self.contacts = contacts;
+        self.report = report;
+        // Positions by the theta-method.
+        for (i, b0) in before.iter().enumerate() {
+            let b = &mut self.body[i];
+            let dx = (b.vel * theta + b0.vel * (T::ONE - theta)) * h;
+            let mut r = position::residual_at(&self.residual, i);
+            position::advance(&mut b.pos, &mut r, dx);
+            if T::COMPENSATED {
+                self.residual[i] = r;
+            }
+        }
+        self.steps += 1;
+    }
+}

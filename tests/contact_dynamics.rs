@@ -1,0 +1,220 @@
+//! Contact dynamics (`src/cd`) against exact answers: a sphere resting on a plane carries its
+//! weight, a sphere on an incline rolls or slides as rigid-body mechanics says, a column of
+//! spheres carries the weight above each contact, a frictionless head-on collision rebounds at
+//! `e v`; and a box of colliding grains gives the same bits on one and two threads.
+
+mod common;
+
+use grains::cd::{CdParams, ContactDynamics, Partner};
+use grains::scene::Scene;
+
+/// Relative error allowed where the answer is exact up to round-off and the solver's
+/// tolerance (`PARAMS.tolerance`).
+const EXACT: f64 = 1e-9;
+
+/// Tight solver settings for exact answers.
+const PARAMS: CdParams = CdParams { theta: 0.5, tolerance: 1e-13, max_iterations: 10_000, gap_allowance: 1e-6 };
+
+const G: f64 = 9.81;
+const RADIUS: f64 = 0.5e-3;
+const DENSITY: f64 = 2500.0;
+
+fn mass() -> f64 {
+    DENSITY * 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3)
+}
+
+/// A scene of glass grains (`mu`, restitution `e`) at `grains` (TOML `[[grain]]` blocks), a
+/// floor at z = 0 unless `floor` is false, gravity `gravity`, step `dt`.
+fn scene(mu: f64, e: f64, gravity: [f64; 3], floor: bool, dt: f64, grains: &str) -> Scene {
+    // Rigid grains know no Rayleigh time: the step is set after the DEM checks of the file.
+    let floor = if floor { "[[wall]]\ntype = \"plane\"\nmaterial = \"glass\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n" } else { "" };
+    let mut s = common::parse(&format!(
+        r#"
+[[material]]
+name = "glass"
+density = {DENSITY:e}
+youngs_modulus = 7.0e10
+poisson_ratio = 0.25
+mu_s = {mu:e}
+restitution = {e:e}
+
+{floor}
+
+[simulation]
+gravity = [{:e}, {:e}, {:e}]
+dt = "auto"
+
+[[stage]]
+kind = "run"
+duration = 1.0e-3
+
+{grains}
+"#,
+        gravity[0], gravity[1], gravity[2]
+    ));
+    s.time_step.dt = dt;
+    s
+}
+
+fn grain(x: [f64; 3], v: [f64; 3]) -> String {
+    format!("[[grain]]\nmaterial = \"glass\"\nradius = {RADIUS:e}\nposition = [{:e}, {:e}, {:e}]\nvelocity = [{:e}, {:e}, {:e}]\n", x[0], x[1], x[2], v[0], v[1], v[2])
+}
+
+fn relative(a: f64, b: f64) -> f64 {
+    (a - b).abs() / b.abs()
+}
+
+#[test]
+fn a_sphere_resting_on_a_plane_carries_exactly_its_weight() {
+    let dt = 1e-4;
+    let s = scene(0.4, 0.5, [0.0, 0.0, -G], true, dt, &grain([0.0, 0.0, RADIUS], [0.0; 3]));
+    let mut cd = ContactDynamics::<f64>::new(&s, PARAMS).unwrap();
+    for _ in 0..100 {
+        cd.step();
+    }
+    let c = cd.contacts()[0];
+    assert_eq!(c.b, Partner::Wall(0));
+    let force = c.r.z / dt;
+    // The impulse on the wall points down (into it): the wall carries the weight.
+    println!("wall load {force:e} N, weight {:e} N, height {:e} m, report {:?}", -mass() * G, cd.position(0)[2], cd.report());
+    assert!(relative(-force, mass() * G) < EXACT, "{force} against {}", mass() * G);
+    assert!(relative(cd.position(0)[2], RADIUS) < EXACT);
+    assert!(cd.report().converged && cd.report().unbalanced < EXACT);
+}
+
+/// The sphere on a floor under gravity tilted by `angle` (rad): its speed after `steps`.
+fn incline(angle: f64, mu: f64, steps: u64) -> (f64, f64, f64) {
+    let dt = 1e-4;
+    let s = scene(mu, 0.5, [G * angle.sin(), 0.0, -G * angle.cos()], true, dt, &grain([0.0, 0.0, RADIUS], [0.0; 3]));
+    let mut cd = ContactDynamics::<f64>::new(&s, PARAMS).unwrap();
+    for _ in 0..steps {
+        cd.step();
+    }
+    let b = cd.bodies()[0];
+    (b.vel.x, b.omega.y * RADIUS, steps as f64 * dt)
+}
+
+#[test]
+fn a_sphere_on_an_incline_rolls_below_the_slip_angle_and_slides_above_it() {
+    // A solid sphere on an incline rolls without slipping while tan(angle) <= 7/2 mu, at
+    // 5/7 g sin(angle); above, it slides at g (sin - mu cos) and spins up at 5 mu g cos / (2 R).
+    // (A body that cannot turn sticks below tan(angle) = mu instead.)
+    let mu: f64 = 0.2;
+    let slip = (3.5 * mu).atan();
+    for (angle, rolls) in [(0.5 * slip, true), (0.95 * slip, true), (1.05 * slip, false), (1.3 * slip, false)] {
+        let (v, w_r, t) = incline(angle, mu, 200);
+        let (a, a_spin) = if rolls { (5.0 / 7.0 * G * angle.sin(), 5.0 / 7.0 * G * angle.sin()) } else { (G * (angle.sin() - mu * angle.cos()), 2.5 * mu * G * angle.cos()) };
+        println!("angle {:.4} rad ({}): v {v:e} m/s, w R {w_r:e} m/s, expected {:e} and {:e}", angle, if rolls { "rolls" } else { "slides" }, a * t, a_spin * t);
+        assert!(relative(v, a * t) < EXACT, "speed {v} against {}", a * t);
+        // Rolling: the contact point is at rest (w R = v, w about +y for motion along +x).
+        assert!(relative(w_r, a_spin * t) < EXACT, "spin {w_r} against {}", a_spin * t);
+    }
+}
+
+#[test]
+fn a_column_of_spheres_carries_the_weight_above_each_contact() {
+    let n = 8;
+    let dt = 1e-4;
+    let height = |k: usize| RADIUS * (1.0 + 2.0 * k as f64);
+    // Listed 1 um apart (the scene refuses touching grains), then put in touch.
+    let grains: String = (0..n).map(|k| grain([0.0, 0.0, height(k) + 1e-6 * k as f64], [0.0; 3])).collect();
+    let mut s = scene(0.4, 0.5, [0.0, 0.0, -G], true, dt, &grains);
+    for (k, x) in s.grains.position.iter_mut().enumerate() {
+        x[2] = height(k);
+    }
+    let mut cd = ContactDynamics::<f64>::new(&s, PARAMS).unwrap();
+    for _ in 0..20 {
+        cd.step();
+    }
+    let report = cd.report();
+    println!("{report:?}");
+    assert!(report.converged);
+    for c in cd.contacts() {
+        // The contact below grain k carries the n - k grains from k up.
+        let k = c.a as usize + if matches!(c.b, Partner::Wall(_)) { 0 } else { 1 };
+        let carried = (n - k) as f64 * mass() * G;
+        let force = c.r.dot(c.n) / dt;
+        println!("contact below grain {k}: {force:e} N, weight above {carried:e} N");
+        assert!(relative(force, carried) < EXACT);
+    }
+    assert_eq!(cd.contacts().len(), n);
+    for k in 0..n {
+        assert!(relative(cd.position(k)[2], height(k)) < EXACT);
+    }
+}
+
+#[test]
+fn a_frictionless_head_on_collision_rebounds_at_e_v() {
+    let v = 0.1;
+    let dt = 1e-5;
+    for e in [0.3, 0.8, 1.0] {
+        // Each grain approaches at v; they meet after a 2.5e-6 m gap, mid-step.
+        let grains = grain([-RADIUS - 1.25e-6, 0.0, 0.0], [v, 0.0, 0.0]) + &grain([RADIUS + 1.25e-6, 0.0, 0.0], [-v, 0.0, 0.0]);
+        let s = scene(0.0, e, [0.0; 3], false, dt, &grains);
+        let mut cd = ContactDynamics::<f64>::new(&s, PARAMS).unwrap();
+        for _ in 0..10 {
+            cd.step();
+        }
+        let (a, b) = (cd.bodies()[0].vel.x, cd.bodies()[1].vel.x);
+        println!("e = {e}: velocities {a:e}, {b:e} m/s after the impact");
+        assert!((a + e * v).abs() < EXACT * v && (b - e * v).abs() < EXACT * v, "{a} {b} against -/+ {}", e * v);
+        // They never pass through each other.
+        assert!(cd.position(1)[0] - cd.position(0)[0] >= 2.0 * RADIUS * (1.0 - EXACT));
+    }
+}
+
+#[test]
+fn impulses_are_bitwise_equal_on_one_and_two_threads() {
+    // 5,000 grains in a box, colliding and falling: thousands of contacts per step, sticking
+    // and sliding, and more grains than one chunk of the parallel pair detection takes.
+    let mut s = common::parse(
+        r#"
+seed = 3
+[[material]]
+name = "glass"
+density = 2500.0
+youngs_modulus = 7.0e10
+poisson_ratio = 0.25
+mu_s = 0.4
+restitution = 0.5
+
+[[generate]]
+material = "glass"
+count = 5000
+diameter = { min = 0.8e-3, max = 1.2e-3 }
+region = { shape = "box", min = [0.0, 0.0, 0.0], max = [20.0e-3, 20.0e-3, 26.0e-3] }
+random_speed = 0.2
+
+[[wall]]
+type = "box"
+material = "glass"
+min = [0.0, 0.0, 0.0]
+max = [20.0e-3, 20.0e-3, 26.0e-3]
+
+[simulation]
+gravity = [0.0, 0.0, -9.81]
+
+[[stage]]
+kind = "run"
+duration = 1.0e-3
+"#,
+    );
+    s.time_step.dt = 5e-5;
+    let params = CdParams { tolerance: 1e-4, max_iterations: 200, gap_allowance: 2e-5, ..CdParams::default() };
+    let run = || {
+        let mut cd = ContactDynamics::<f64>::new(&s, params).unwrap();
+        let mut loaded = 0;
+        for _ in 0..400 {
+            cd.step();
+            loaded += cd.report().loaded;
+        }
+        let bits: Vec<u64> = cd.bodies().iter().flat_map(|b| [b.pos.x, b.pos.y, b.pos.z, b.vel.x, b.omega.z]).map(f64::to_bits).collect();
+        let impulses: Vec<u64> = cd.contacts().iter().flat_map(|c| [c.r.x, c.r.y, c.r.z]).map(f64::to_bits).collect();
+        (bits, impulses, cd.report(), loaded)
+    };
+    let one = common::with_threads(1, run);
+    let two = common::with_threads(2, run);
+    println!("contacts {}, loaded contacts summed over the steps {}, last step {:?}", one.1.len() / 3, one.3, one.2);
+    assert!(one.3 > 10_000, "the grains must be in contact");
+    assert_eq!(one, two);
+}
