@@ -251,8 +251,10 @@ fn progress_bar(json: bool) -> bool {
 fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision: Option<Precision>, quiet: bool) -> anyhow::Result<Box<dyn Engine>> {
     let gpu = |gpu| -> anyhow::Result<Box<dyn Engine>> { Ok(Box::new(GpuEngine::new(gpu, scene)?)) };
     let cpu = |precision: Option<Precision>| grains::runner::cpu_engine(scene, if precision == Some(Precision::F32) { "f32" } else { "f64" });
+    let rigid = matches!(scene.method, grains::scene::Method::ContactDynamics(_));
     match backend {
         Backend::Cpu => cpu(precision),
+        Backend::Auto if rigid => cpu(precision),
         Backend::Gpu => {
             if precision == Some(Precision::F64) {
                 anyhow::bail!("--precision f64: the GPU backend computes in f32; fix: drop --precision or use --backend cpu");

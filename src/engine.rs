@@ -151,6 +151,26 @@ pub struct Stats {
     pub walls: Vec<WallStats>,
     /// The piston, if any.
     pub piston: Option<PistonStats>,
+    /// Contact dynamics: what its solver did since the last read (absent for DEM).
+    #[serde(default)]
+    pub solver: Option<SolverStats>,
+}
+
+/// What contact dynamics' solver did over the steps since the last statistics read.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SolverStats {
+    /// Steps solved.
+    pub steps: u64,
+    /// Steps whose solve hit `contact_dynamics.max_iterations` before the tolerance.
+    pub unconverged_steps: u64,
+    /// Most Gauss-Seidel sweeps a step took.
+    pub max_iterations: u32,
+    /// Mean sweeps per step.
+    pub mean_iterations: f64,
+    /// Largest relative change of the impulses a step's solve ended with (-).
+    pub relative_change: f64,
+    /// The last step's force balance (see `grains::cd::SolveReport::unbalanced`).
+    pub unbalanced: f64,
 }
 
 /// Grains with fewer contacts than this are rattlers: they carry no load, and a rattler

@@ -1,12 +1,13 @@
 //! Running a scene end to end with its outputs: what `grains run` and every sweep point do.
 
 use crate::analysis::fit::{BauerFit, Estimate};
+use crate::cd::ContactDynamics;
 use crate::checkpoint::{CheckpointHeader, EngineState, RunIdentity};
 use crate::cpu::CpuEngine;
 use crate::engine::Engine;
 use crate::output::{RunRecorder, Summary};
 use crate::protocol::Progress;
-use crate::scene::{self, Scene};
+use crate::scene::{self, Method, Scene};
 use anyhow::Context;
 use std::path::Path;
 use std::time::Instant;
@@ -24,6 +25,13 @@ pub fn identity(scene_file: &Path, engine: &dyn Engine) -> anyhow::Result<RunIde
 
 /// A CPU engine of precision "f32" or "f64".
 pub fn cpu_engine(scene: &Scene, precision: &str) -> anyhow::Result<Box<dyn Engine>> {
+    if let Method::ContactDynamics(params) = scene.method {
+        return Ok(match precision {
+            "f32" => Box::new(ContactDynamics::<f32>::new(scene, params)?),
+            "f64" => Box::new(ContactDynamics::<f64>::new(scene, params)?),
+            other => anyhow::bail!("precision `{other}`: contact dynamics computes in f32 or f64; fix: give --precision f32 or f64"),
+        });
+    }
     Ok(match precision {
         "f32" => Box::new(CpuEngine::<f32>::new(scene)?),
         "f64" => Box::new(CpuEngine::<f64>::new(scene)?),

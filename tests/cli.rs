@@ -44,7 +44,9 @@ fn every_shipped_scene_checks_with_a_time_step_below_the_safe_limit() {
         assert!(o.status.success(), "{}: {}", p.display(), stderr(&o));
         let scene = common::shipped(p.file_name().unwrap().to_str().unwrap());
         let ts = scene.time_step;
-        assert!(ts.dt <= ts.safe_limit(), "{}: dt {} above {}", p.display(), ts.dt, ts.safe_limit());
+        // Rigid grains (contact dynamics) have no contact time to resolve.
+        let rigid = matches!(scene.method, grains::scene::Method::ContactDynamics(_));
+        assert!(rigid || ts.dt <= ts.safe_limit(), "{}: dt {} above {}", p.display(), ts.dt, ts.safe_limit());
         assert!(stdout(&o).contains("Rayleigh time") && stdout(&o).contains("memory estimate"), "{}", stdout(&o));
     }
 }

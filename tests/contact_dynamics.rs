@@ -218,3 +218,46 @@ duration = 1.0e-3
     assert!(one.3 > 10_000, "the grains must be in contact");
     assert_eq!(one, two);
 }
+
+#[test]
+fn the_shipped_pile_runs_by_contact_dynamics_and_resumes_from_a_checkpoint_bit_for_bit() {
+    let s = common::shipped("cd_pile.toml");
+    let grains::scene::Method::ContactDynamics(params) = s.method else { panic!("cd_pile.toml is not a contact-dynamics scene") };
+    assert_eq!((params.theta, params.tolerance, params.max_iterations, params.gap_allowance), (0.5, 1e-4, 500, 5e-5));
+    let engine = || grains::runner::cpu_engine(&s, "f64").unwrap();
+    let mut first = engine();
+    first.advance(150).unwrap();
+    let stats = first.stats().unwrap();
+    let solver = stats.solver.expect("contact dynamics reports its solver");
+    println!("after 150 steps: {} loaded contacts, {} on walls, solver {solver:?}", stats.contacts, stats.wall_contacts);
+    assert_eq!(solver.steps, 150);
+    assert!(stats.wall_contacts > 0, "the grains reach the floor");
+    let saved = first.save().unwrap();
+    first.advance(30).unwrap();
+    let mut resumed = engine();
+    resumed.restore(&saved).unwrap();
+    resumed.advance(30).unwrap();
+    let (a, b) = (first.frame(true).unwrap(), resumed.frame(true).unwrap());
+    assert_eq!(a, b, "the resumed run differs from the uninterrupted one");
+    assert!(!a.wall_contacts.unwrap().is_empty());
+}
+
+#[test]
+fn bad_contact_dynamics_input_gets_one_line_naming_the_key_and_the_fix() {
+    let text = std::fs::read_to_string(common::scene_path("cd_pile.toml")).unwrap();
+    for (from, to, says) in [
+        ("theta = 0.5 ", "theta = 0.2 ", "contact_dynamics.theta = 0.2: must lie in [0.5, 1]; fix:"),
+        ("max_iterations = 500 ", "max_iterations = 0 ", "contact_dynamics.max_iterations = 0: must be at least 1; fix:"),
+        ("dt = 1.0e-4 ", "dt = \"auto\" ", "simulation.dt = \"auto\": has no automatic value for rigid grains"),
+        ("method = \"contact_dynamics\"", "method = \"lmgc\"", "simulation.method = \"lmgc\": unknown method; fix: use \"dem\" or \"contact_dynamics\""),
+    ] {
+        assert!(text.contains(from), "{from}");
+        let err = grains::scene::parse(std::path::Path::new("cd.toml"), &text.replace(from, to)).unwrap_err().to_string();
+        assert!(err.contains(says) && !err.contains('\n'), "{err}");
+    }
+    // A feature the solver does not model is refused when the engine is made.
+    let periodic = text.replace("[simulation]", "[periodic]\nx = [0.0, 12.0e-3]\n\n[simulation]");
+    let s = grains::scene::parse(std::path::Path::new("cd.toml"), &periodic).unwrap();
+    let err = grains::runner::cpu_engine(&s, "f64").err().unwrap().to_string();
+    assert!(err.contains("a periodic boundary is not modelled by contact dynamics; fix:"), "{err}");
+}

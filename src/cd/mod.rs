@@ -38,28 +38,12 @@ use crate::cpu::{Body, PairList, Props};
 use crate::periodic::Periodic;
 use crate::position;
 use crate::real::{Real, Vec3};
+pub use crate::scene::CdParams;
 use crate::scene::{Scene, WallShape};
 use crate::walls::WallGeom;
 use std::collections::HashMap;
 
-/// The solver's parameters (`[contact_dynamics]` in a scene).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CdParams {
-    /// Weight of the end-of-step velocity in the position update (-), in [0.5, 1].
-    pub theta: f64,
-    /// Relative change of the impulses between two sweeps at which the solve stops (-).
-    pub tolerance: f64,
-    /// Most Gauss-Seidel sweeps per step.
-    pub max_iterations: u32,
-    /// Surfaces closer than this are contacts of the step (m).
-    pub gap_allowance: f64,
-}
-
-impl Default for CdParams {
-    fn default() -> Self {
-        CdParams { theta: 0.5, tolerance: 1e-6, max_iterations: 1000, gap_allowance: 0.0 }
-    }
-}
+mod engine;
 
 /// The second body of a contact.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -137,7 +121,10 @@ pub struct ContactDynamics<T: Real> {
     /// Last step's impulses by (grain id, partner grain id or wall), for the warm start.
     warm: HashMap<(u32, Partner), Vec3<T>>,
     report: SolveReport,
+    /// The solver's record since the last statistics read.
+    since_read: crate::engine::SolverStats,
     steps: u64,
+    wall_names: Vec<String>,
 }
 
 /// Why a scene cannot run by contact dynamics.
@@ -153,18 +140,6 @@ pub enum CdError {
         /// What to do instead.
         fix: &'static str,
     },
-    /// A parameter out of range.
-    #[error("{path}: contact_dynamics.{key} = {value} is out of range; fix: {fix}")]
-    Parameter {
-        /// The scene file.
-        path: String,
-        /// The key under `[contact_dynamics]`.
-        key: &'static str,
-        /// Its value.
-        value: f64,
-        /// The range it must lie in.
-        fix: &'static str,
-    },
 }
 
 /// Friction and restitution of a contact between two materials, mixed as
@@ -177,11 +152,6 @@ impl<T: Real> ContactDynamics<T> {
     /// The system of a scene's grains and walls at step `h` = the scene's time step.
     pub fn new(scene: &Scene, params: CdParams) -> Result<Self, CdError> {
         let path = scene.path.display().to_string();
-        let check = |ok: bool, key, value, fix| if ok { Ok(()) } else { Err(CdError::Parameter { path: path.clone(), key, value, fix }) };
-        check((0.5..=1.0).contains(&params.theta), "theta", params.theta, "use a value in [0.5, 1]")?;
-        check(params.tolerance > 0.0 && params.tolerance < 1.0, "tolerance", params.tolerance, "use a value in (0, 1), e.g. 1e-6")?;
-        check(params.max_iterations > 0, "max_iterations", params.max_iterations as f64, "use at least 1")?;
-        check(params.gap_allowance >= 0.0 && params.gap_allowance.is_finite(), "gap_allowance", params.gap_allowance, "use a length >= 0 (m)")?;
         let unsupported = |what, fix| Err(CdError::Unsupported { path: path.clone(), what, fix });
         if scene.periodic.iter().any(Option::is_some) {
             return unsupported("a periodic boundary", "bound the grains with walls");
@@ -222,7 +192,9 @@ impl<T: Real> ContactDynamics<T> {
             contacts: Vec::new(),
             warm: HashMap::new(),
             report: SolveReport::default(),
+            since_read: Default::default(),
             steps: 0,
+            wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
         })
     }
 
@@ -394,6 +366,13 @@ impl<T: Real> ContactDynamics<T> {
         self.warm = contacts.iter().filter(|c| c.r != Vec3::ZERO).map(|c| ((self.id[c.a as usize], c.b), c.r)).collect();
         self.contacts = contacts;
         self.report = report;
+        let r = &mut self.since_read;
+        r.mean_iterations = (r.mean_iterations * r.steps as f64 + report.iterations as f64) / (r.steps + 1) as f64;
+        r.steps += 1;
+        r.unconverged_steps += u64::from(!report.converged);
+        r.max_iterations = r.max_iterations.max(report.iterations);
+        r.relative_change = r.relative_change.max(report.relative_change);
+        r.unbalanced = report.unbalanced;
         // Positions by the theta-method.
         for (i, b0) in before.iter().enumerate() {
             let b = &mut self.body[i];

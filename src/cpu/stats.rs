@@ -232,6 +232,7 @@ impl<T: Real> CpuEngine<T> {
             liquid_on_grains,
             walls,
             piston,
+            solver: None,
         }
     }
 }

@@ -106,6 +106,9 @@ impl GpuEngine {
         let limit = |what, need: u64, have: u64, fix| -> Result<(), GpuSetupError> {
             if need > have { Err(GpuSetupError::Limit { adapter: adapter.clone(), what, need, have, fix }) } else { Ok(()) }
         };
+        if let crate::scene::Method::ContactDynamics(_) = scene.method {
+            anyhow::bail!("{}: simulation.method = \"contact_dynamics\" runs on the CPU only so far; fix: use --backend cpu", scene.path.display());
+        }
         let binding = gpu.limits.max_storage_buffer_binding_size;
         limit("walls", scene.walls.len() as u64, MAX_WALLS as u64, "split the container into at most 8 walls or use --backend cpu")?;
         limit("bytes per grain array (16 per grain)", 16 * n, binding, "use fewer grains per run or a device with larger storage bindings")?;

@@ -30,8 +30,14 @@ fn stats_header(s: &Stats) -> String {
             h.push_str(&format!(",{}_f{a}_N", w.name));
         }
     }
+    if s.solver.is_some() {
+        h.push_str(SOLVER_COLUMNS);
+    }
     h
 }
+
+/// Contact dynamics' columns of `stats.csv`, after the walls' (see [`crate::engine::SolverStats`]).
+const SOLVER_COLUMNS: &str = ",cd_steps,cd_unconverged_steps,cd_max_iterations,cd_mean_iterations,cd_relative_change,cd_unbalanced";
 
 fn stats_row(stage: &str, s: &Stats) -> String {
     let (pz, pp) = s.piston.as_ref().map_or((String::new(), String::new()), |p| (format!("{:e}", p.z), format!("{:e}", p.pressure)));
@@ -60,6 +66,9 @@ fn stats_row(stage: &str, s: &Stats) -> String {
     );
     for w in &s.walls {
         row.push_str(&format!(",{:e},{:e},{:e}", w.force[0], w.force[1], w.force[2]));
+    }
+    if let Some(c) = &s.solver {
+        row.push_str(&format!(",{},{},{},{:e},{:e},{:e}", c.steps, c.unconverged_steps, c.max_iterations, c.mean_iterations, c.relative_change, c.unbalanced));
     }
     row
 }

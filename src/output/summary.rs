@@ -244,8 +244,19 @@ pub fn check_report(scene: &Scene) -> String {
     for w in &scene.walls {
         let _ = writeln!(s, "wall {}: {:?}", w.name, w.shape);
     }
-    let _ = writeln!(s, "model: {}", scene.model.describe());
-    let _ = writeln!(s, "integrator: {}", scene.integrator.name());
+    match scene.method {
+        crate::scene::Method::Dem => {
+            let _ = writeln!(s, "model: {}", scene.model.describe());
+            let _ = writeln!(s, "integrator: {}", scene.integrator.name());
+        }
+        crate::scene::Method::ContactDynamics(p) => {
+            let _ = writeln!(
+                s,
+                "method: contact dynamics (rigid grains, Moreau-Jean, nonsmooth Gauss-Seidel): theta = {}, tolerance = {:e}, at most {} sweeps per step, gap allowance {:.4e} m; friction mu_s and restitution of the materials",
+                p.theta, p.tolerance, p.max_iterations, p.gap_allowance
+            );
+        }
+    }
     let _ = writeln!(s, "Rayleigh time t_R = {:.4e} s", ts.times.rayleigh);
     let _ = writeln!(s, "Hertz time t_c = {:.4e} s at {:.3e} m/s", ts.times.collision, ts.times.expected_speed);
     let _ = writeln!(s, "dt = {:.4e} s ({}; {:.3} t_R, t_c/{:.1})", ts.dt, if ts.auto { "auto" } else { "given" }, ts.dt / ts.times.rayleigh, ts.times.collision / ts.dt);

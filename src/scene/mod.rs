@@ -16,7 +16,7 @@ use crate::model::{
 };
 use crate::timestep;
 use error::Complainer;
-use schema::{DtSpec, ModelSpec, SceneFile, SimulationSpec, StageSpec, WallSpec};
+use schema::{ContactDynamicsSpec, DtSpec, ModelSpec, SceneFile, SimulationSpec, StageSpec, WallSpec};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -115,7 +115,9 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         Some(s) => positive(&c, "simulation.skin", s, "give the skin in metres, e.g. 0.1 x the mean diameter")?,
         None => 0.1 * d_mean,
     };
-    let time_step = choose_time_step(&c, sim, &materials, &grains, &walls, &model, gravity, &mut warnings)?;
+    let method = validate_method(&c, sim, f.contact_dynamics.as_ref(), d_mean)?;
+    let rigid = matches!(method, Method::ContactDynamics(_));
+    let time_step = choose_time_step(&c, sim, rigid, &materials, &grains, &walls, &model, gravity, &mut warnings)?;
     let stats_interval = sim.stats_interval.unwrap_or(500);
     if stats_interval == 0 {
         return Err(c.invalid("simulation.stats_interval", 0, "must be at least 1", "give a number of steps, e.g. 500"));
@@ -153,6 +155,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         periodic,
         gravity,
         model,
+        method,
         integrator,
         time_step,
         skin,
@@ -667,10 +670,46 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
     Ok(ContactModel { normal, damping, tangential, rolling, twisting, cohesion })
 }
 
+/// `simulation.method` and, for contact dynamics, its `[contact_dynamics]` settings.
+fn validate_method(c: &Complainer, sim: &SimulationSpec, spec: Option<&ContactDynamicsSpec>, d_mean: f64) -> Result<Method, SceneError> {
+    match sim.method.as_deref().unwrap_or("dem") {
+        "dem" => {
+            if spec.is_some() {
+                return Err(c.invalid("contact_dynamics", "(set)", "is read only by contact dynamics", "set simulation.method = \"contact_dynamics\" or remove [contact_dynamics]"));
+            }
+            Ok(Method::Dem)
+        }
+        "contact_dynamics" => {
+            let given = spec.copied().unwrap_or_default();
+            let theta = given.theta.unwrap_or(CdParams::default().theta);
+            if !(0.5..=1.0).contains(&theta) {
+                return Err(c.invalid("contact_dynamics.theta", theta, "must lie in [0.5, 1]", "use 0.5 (the midpoint rule) to 1 (implicit Euler)"));
+            }
+            let tolerance = given.tolerance.unwrap_or(CdParams::default().tolerance);
+            if !(tolerance > 0.0 && tolerance < 1.0) {
+                return Err(c.invalid("contact_dynamics.tolerance", tolerance, "must lie in (0, 1)", "give a relative change such as 1e-6"));
+            }
+            let max_iterations = given.max_iterations.unwrap_or(CdParams::default().max_iterations);
+            if max_iterations == 0 {
+                return Err(c.invalid("contact_dynamics.max_iterations", 0, "must be at least 1", "give a number of sweeps, e.g. 1000"));
+            }
+            let gap_allowance = match given.gap_allowance {
+                Some(v) => non_negative(c, "contact_dynamics.gap_allowance", v, "give a length in metres, e.g. 0.1 x the mean diameter")?,
+                None => 0.1 * d_mean,
+            };
+            Ok(Method::ContactDynamics(CdParams { theta, tolerance, max_iterations, gap_allowance }))
+        }
+        other => Err(c.invalid("simulation.method", format!("\"{other}\""), "unknown method", "use \"dem\" or \"contact_dynamics\"")),
+    }
+}
+
 #[allow(clippy::too_many_arguments, reason = "validation needs the whole scene")]
+/// The scene's step: "auto" or a given one within the stability limits; for `rigid` grains
+/// (contact dynamics), which have no contact time to resolve, a given one with no limit.
 fn choose_time_step(
     c: &Complainer,
     sim: &SimulationSpec,
+    rigid: bool,
     materials: &[Material],
     grains: &Grains,
     walls: &[Wall],
@@ -684,6 +723,8 @@ fn choose_time_step(
     };
     let times = timestep::characteristic_times(materials, grains, walls, model, expected_speed);
     match sim.dt.unwrap_or(DtSpec::Auto) {
+        DtSpec::Auto if rigid => Err(c.invalid("simulation.dt", "\"auto\"", "has no automatic value for rigid grains (contact dynamics)", "give the step in seconds, e.g. 1e-4")),
+        DtSpec::Seconds(dt) if rigid => Ok(TimeStep::given(positive(c, "simulation.dt", dt, "give the step in seconds, e.g. 1e-4")?, times)),
         DtSpec::Auto => Ok(TimeStep::auto(times)),
         DtSpec::Seconds(dt) => {
             let dt = positive(c, "simulation.dt", dt, "give the step in seconds or \"auto\"")?;

@@ -45,6 +45,23 @@ pub struct SceneFile {
     /// `[output]`: what `--out DIR` records.
     #[serde(default)]
     pub output: OutputSpec,
+    /// `[contact_dynamics]`: the solver's settings when `simulation.method` is
+    /// "contact_dynamics".
+    pub contact_dynamics: Option<ContactDynamicsSpec>,
+}
+
+/// `[contact_dynamics]`: Moreau-Jean settings (see `grains::cd`).
+#[derive(Clone, Copy, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactDynamicsSpec {
+    /// Weight of the end-of-step velocity in the position update, in [0.5, 1]. Default 0.5.
+    pub theta: Option<f64>,
+    /// Relative change of the impulses between sweeps at which a step's solve stops. Default 1e-6.
+    pub tolerance: Option<f64>,
+    /// Most Gauss-Seidel sweeps per step. Default 1000.
+    pub max_iterations: Option<u32>,
+    /// Surfaces closer than this (m) are contacts of a step. Default 0.1 x the mean diameter.
+    pub gap_allowance: Option<f64>,
 }
 
 /// `[[material]]`: one grain or wall material.
@@ -366,6 +383,9 @@ pub struct SimulationSpec {
     /// Integrate orientation quaternions (Omelyan's norm-preserving update). Default false.
     #[serde(default)]
     pub track_orientation: bool,
+    /// "dem" (default: soft contacts, the `[model]` laws) or "contact_dynamics" (rigid grains,
+    /// Moreau-Jean with `[contact_dynamics]`).
+    pub method: Option<String>,
 }
 
 fn default_gravity() -> [f64; 3] {
@@ -385,6 +405,7 @@ impl Default for SimulationSpec {
             reorder_every: None,
             max_overlap: None,
             track_orientation: false,
+            method: None,
         }
     }
 }

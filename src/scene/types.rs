@@ -277,7 +277,9 @@ pub struct Scene {
     pub gravity: [f64; 3],
     /// Contact law per slot.
     pub model: ContactModel<f64>,
-    /// Time integration scheme.
+    /// DEM or contact dynamics.
+    pub method: Method,
+    /// Time integration scheme (DEM).
     pub integrator: Integrator,
     /// The time step and the times it was chosen from.
     pub time_step: TimeStep,
@@ -302,6 +304,35 @@ pub struct Scene {
     /// Capillary scenes: the largest bridge volume (m^3) and the rupture distance it reaches
     /// (m), which the neighbour search adds to the skin; zero without cohesion.
     pub bridges: BridgeLimits,
+}
+
+/// How the grains interact.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Method {
+    /// Soft contacts with the `[model]` laws, explicit integration.
+    #[default]
+    Dem,
+    /// Rigid grains, Moreau-Jean time stepping with nonsmooth Gauss-Seidel (`grains::cd`).
+    ContactDynamics(CdParams),
+}
+
+/// Contact-dynamics settings (`[contact_dynamics]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CdParams {
+    /// Weight of the end-of-step velocity in the position update (-), in [0.5, 1].
+    pub theta: f64,
+    /// Relative change of the impulses between two sweeps at which a step's solve stops (-).
+    pub tolerance: f64,
+    /// Most Gauss-Seidel sweeps per step.
+    pub max_iterations: u32,
+    /// Surfaces closer than this are contacts of the step (m).
+    pub gap_allowance: f64,
+}
+
+impl Default for CdParams {
+    fn default() -> Self {
+        CdParams { theta: 0.5, tolerance: 1e-6, max_iterations: 1000, gap_allowance: 0.0 }
+    }
 }
 
 /// Bounds on liquid bridges.

@@ -236,6 +236,7 @@ impl GpuEngine {
                 })
                 .collect(),
             piston,
+            solver: None,
         })
     }
 }

@@ -1,0 +1,213 @@
+//! Contact dynamics behind the host loop's [`Engine`]: statistics, frames and checkpoints of
+//! rigid grains, whose contact forces are the step's impulses over the step.
+
+use super::{ContactDynamics, Partner};
+use crate::engine::{ContactRecord, Engine, EngineState, Frame, SimError, Stats, WallContactRecord, WallStats, RATTLER_CONTACTS};
+use crate::real::{Real, Vec3};
+
+/// Encodes a contact's second body for a checkpoint: a grain as its slot, a wall as
+/// `WALL_TAG + index`.
+const WALL_TAG: u64 = 1 << 32;
+
+impl<T: Real> ContactDynamics<T> {
+    /// Force on `b` (N; `-force` on `a`) and normal force (N) of a contact at the last step.
+    fn forces(&self, r: Vec3<T>, n: Vec3<T>) -> ([f64; 3], f64) {
+        let h = self.h.f64();
+        let f = r.f64();
+        ([f[0] / h, f[1] / h, f[2] / h], r.dot(n).f64() / h)
+    }
+
+    /// The first grain whose state is not finite.
+    fn first_non_finite(&self) -> Option<u32> {
+        self.body.iter().position(|b| !(b.pos.f64().iter().chain(&b.vel.f64()).chain(&b.omega.f64()).all(|x| x.is_finite()))).map(|i| self.id[i])
+    }
+}
+
+impl<T: Real> Engine for ContactDynamics<T> {
+    fn backend(&self) -> &'static str {
+        "cpu"
+    }
+    fn precision(&self) -> &'static str {
+        T::NAME
+    }
+    fn grain_count(&self) -> usize {
+        self.body.len()
+    }
+    fn steps(&self) -> u64 {
+        self.steps
+    }
+    fn time(&self) -> f64 {
+        self.steps as f64 * self.h.f64()
+    }
+
+    fn advance(&mut self, n: u64) -> Result<(), SimError> {
+        for _ in 0..n {
+            self.step();
+        }
+        match self.first_non_finite() {
+            Some(grain) => Err(SimError::Unstable { step: self.steps, time: self.time(), what: "the state is not finite".into(), grain, suggested_dt: 0.5 * self.h.f64(), also: ", or raise contact_dynamics.max_iterations" }),
+            None => Ok(()),
+        }
+    }
+
+    fn stats(&mut self) -> Result<Stats, SimError> {
+        let n = self.body.len();
+        let g = self.gravity.f64();
+        let mut s = Stats { step: self.steps, time: self.time(), rebuilds: self.steps, ..Default::default() };
+        for (b, p) in self.body.iter().zip(&self.prop) {
+            let (m, v, w) = (p.mass.f64(), b.vel.f64(), b.omega.f64());
+            s.ke_translational += 0.5 * m * b.vel.norm2().f64();
+            s.ke_rotational += 0.5 * p.inertia.f64() * b.omega.norm2().f64();
+            s.gravity_energy -= m * (g[0] * b.pos.x.f64() + g[1] * b.pos.y.f64() + g[2] * b.pos.z.f64());
+            let x = b.pos.f64();
+            let mv = [m * v[0], m * v[1], m * v[2]];
+            for a in 0..3 {
+                s.momentum[a] += mv[a];
+                s.angular_momentum[a] += x[(a + 1) % 3] * mv[(a + 2) % 3] - x[(a + 2) % 3] * mv[(a + 1) % 3] + p.inertia.f64() * w[a];
+            }
+        }
+        let mut touching = vec![0u64; n];
+        s.walls = self.wall_names.iter().map(|name| WallStats { name: name.clone(), ..Default::default() }).collect();
+        let (mut most, mut most_grain) = (0.0f64, 0);
+        for c in &self.contacts {
+            let r_n = c.r.dot(c.n);
+            if r_n <= T::ZERO {
+                continue;
+            }
+            touching[c.a as usize] += 1;
+            let r_t = c.r - c.n * r_n;
+            s.sliding += u64::from(r_t.norm2() >= c.mu * r_n * c.mu * r_n * T::of(1.0 - 1e-9));
+            let overlap = (-c.gap).f64().max(0.0);
+            match c.b {
+                Partner::Grain(j) => {
+                    s.contacts += 1;
+                    touching[j as usize] += 1;
+                    let r_min = self.prop[c.a as usize].radius.min(self.prop[j as usize].radius).f64();
+                    if overlap / r_min > most {
+                        (most, most_grain) = (overlap / r_min, self.id[c.a as usize]);
+                    }
+                }
+                Partner::Wall(w) => {
+                    s.wall_contacts += 1;
+                    let (f, _) = self.forces(c.r, c.n);
+                    let wall = &mut s.walls[w as usize];
+                    wall.contacts += 1;
+                    for (sum, f) in wall.force.iter_mut().zip(f) {
+                        *sum += f;
+                    }
+                }
+            }
+        }
+        s.pairs = self.contacts.iter().filter(|c| matches!(c.b, Partner::Grain(_))).count() as u64;
+        s.coordination = 2.0 * s.contacts as f64 / n as f64;
+        (s.max_overlap, s.max_overlap_grain) = (most, most_grain);
+        s.unbalanced_force = self.report.unbalanced;
+        s.unbalanced_force_loaded = self.report.unbalanced;
+        s.rattlers = touching.iter().filter(|&&k| k < RATTLER_CONTACTS).count() as u64;
+        s.ke_rattlers = touching.iter().zip(self.body.iter().zip(&self.prop)).filter(|(k, _)| **k < RATTLER_CONTACTS).map(|(_, (b, p))| 0.5 * p.mass.f64() * b.vel.norm2().f64()).sum();
+        s.non_finite_grain = self.first_non_finite();
+        s.solver = Some(std::mem::take(&mut self.since_read));
+        Ok(s)
+    }
+
+    fn frame(&self, contacts: bool) -> Result<Frame, SimError> {
+        let mut f = Frame {
+            time: self.time(),
+            id: self.id.clone(),
+            position: (0..self.body.len()).map(|i| self.position(i)).collect(),
+            radius: self.prop.iter().map(|p| p.radius.f64()).collect(),
+            velocity: self.body.iter().map(|b| b.vel.f64()).collect(),
+            angular_velocity: self.body.iter().map(|b| b.omega.f64()).collect(),
+            walls: self.walls.iter().map(|(geom, _)| geom.f64()).collect(),
+            ..Default::default()
+        };
+        if contacts {
+            let loaded = self.contacts.iter().filter(|c| c.r.dot(c.n) > T::ZERO);
+            let (mut pairs, mut walls) = (Vec::new(), Vec::new());
+            for c in loaded {
+                let (force_b, normal_force) = self.forces(c.r, c.n);
+                let on_a = [-force_b[0], -force_b[1], -force_b[2]];
+                let overlap = (-c.gap).f64().max(0.0);
+                match c.b {
+                    Partner::Grain(j) => pairs.push(ContactRecord { i: self.id[c.a as usize], j: self.id[j as usize], overlap, normal_force, force: on_a, force_j: force_b, ..Default::default() }),
+                    Partner::Wall(w) => {
+                        let n = (-c.n).f64();
+                        walls.push(WallContactRecord { grain: self.id[c.a as usize], wall: w, overlap, normal: n, lever: self.prop[c.a as usize].radius.f64(), force: on_a });
+                    }
+                }
+            }
+            f.contacts = Some(pairs);
+            f.wall_contacts = Some(walls);
+        }
+        Ok(f)
+    }
+
+    fn set_piston_pressure(&mut self, _pressure: f64) {
+        // Contact-dynamics scenes have no piston (refused at `ContactDynamics::new`).
+    }
+
+    fn save(&self) -> Result<EngineState, SimError> {
+        let mut s = EngineState::default();
+        let v3 = |v: Vec3<T>| [v.x.f64(), v.y.f64(), v.z.f64()];
+        s.put_reals("position", self.body.iter().flat_map(|b| v3(b.pos)));
+        s.put_reals("residual", self.residual.iter().flat_map(|&r| v3(r)));
+        s.put_reals("velocity", self.body.iter().flat_map(|b| v3(b.vel)));
+        s.put_reals("omega", self.body.iter().flat_map(|b| v3(b.omega)));
+        // The warm start, in a fixed order.
+        let mut warm: Vec<(&(u32, Partner), &Vec3<T>)> = self.warm.iter().collect();
+        warm.sort_by_key(|((a, b), _)| (*a, code(*b)));
+        s.put_ints("warm_a", warm.iter().map(|((a, _), _)| *a as u64));
+        s.put_ints("warm_b", warm.iter().map(|((_, b), _)| code(*b)));
+        s.put_reals("warm_r", warm.iter().flat_map(|(_, r)| v3(**r)));
+        s.put_ints("steps", [self.steps]);
+        Ok(s)
+    }
+
+    fn restore(&mut self, s: &EngineState) -> anyhow::Result<()> {
+        let n = self.body.len();
+        let of = |x: &[f64]| Vec3::<T>::new(T::of(x[0]), T::of(x[1]), T::of(x[2]));
+        let (pos, vel, omega) = (s.reals("position", 3 * n)?, s.reals("velocity", 3 * n)?, s.reals("omega", 3 * n)?);
+        for (i, b) in self.body.iter_mut().enumerate() {
+            let k = 3 * i..3 * i + 3;
+            (b.pos, b.vel, b.omega) = (of(&pos[k.clone()]), of(&vel[k.clone()]), of(&omega[k]));
+        }
+        if T::COMPENSATED {
+            self.residual = s.reals("residual", 3 * n)?.chunks_exact(3).map(of).collect();
+        }
+        let (a, b) = (s.ints("warm_a", None)?, s.ints("warm_b", None)?);
+        let r = s.reals("warm_r", 3 * a.len())?;
+        self.warm = a.iter().zip(b).zip(r.chunks_exact(3)).map(|((&a, &b), r)| ((a as u32, if b >= WALL_TAG { Partner::Wall((b - WALL_TAG) as u32) } else { Partner::Grain(b as u32) }), of(r))).collect();
+        self.steps = s.ints("steps", Some(1))?[0];
+        Ok(())
+    }
+
+    fn set_servo(&mut self, _pressure: Option<f64>, _axial_strain_rate: Option<f64>) {
+        // Contact-dynamics scenes have no servo walls (refused at `ContactDynamics::new`).
+    }
+
+    fn wet(&mut self, _volume: f64) -> anyhow::Result<()> {
+        anyhow::bail!("contact dynamics models no liquid bridges; fix: run wet stages with simulation.method = \"dem\"")
+    }
+
+    fn place_piston(&mut self, _z: f64) {
+        // No piston: nothing to place.
+    }
+
+    fn memory_bytes(&self) -> u64 {
+        let bytes = |n: usize, each: usize| (n * each) as u64;
+        bytes(self.body.capacity(), std::mem::size_of::<crate::cpu::Body<T>>())
+            + bytes(self.residual.capacity(), std::mem::size_of::<Vec3<T>>())
+            + bytes(self.prop.capacity(), std::mem::size_of::<crate::cpu::Props<T>>())
+            + bytes(self.contacts.capacity(), std::mem::size_of::<super::Contact<T>>())
+            + bytes(self.warm.capacity(), std::mem::size_of::<((u32, Partner), Vec3<T>)>())
+    }
+}
+
+/// A contact's second body as a checkpoint integer (see [`WALL_TAG`]).
+fn code(b: Partner) -> u64 {
+    match b {
+        Partner::Grain(j) => j as u64,
+        Partner::Wall(w) => WALL_TAG + w as u64,
+    }
+}
+
