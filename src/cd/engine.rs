@@ -19,7 +19,7 @@ impl<T: Real> ContactDynamics<T> {
 
     /// The first grain whose state is not finite.
     fn first_non_finite(&self) -> Option<u32> {
-        self.body.iter().position(|b| !(b.pos.f64().iter().chain(&b.vel.f64()).chain(&b.omega.f64()).all(|x| x.is_finite()))).map(|i| self.id[i])
+        self.body.iter().position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|i| self.id[i])
     }
 }
 
@@ -194,12 +194,9 @@ impl<T: Real> Engine for ContactDynamics<T> {
     }
 
     fn memory_bytes(&self) -> u64 {
-        let bytes = |n: usize, each: usize| (n * each) as u64;
-        bytes(self.body.capacity(), std::mem::size_of::<crate::cpu::Body<T>>())
-            + bytes(self.residual.capacity(), std::mem::size_of::<Vec3<T>>())
-            + bytes(self.prop.capacity(), std::mem::size_of::<crate::cpu::Props<T>>())
-            + bytes(self.contacts.capacity(), std::mem::size_of::<super::Contact<T>>())
-            + bytes(self.warm.capacity(), std::mem::size_of::<((u32, Partner), Vec3<T>)>())
+        use crate::cpu::allocated;
+        let warm = (self.warm.capacity() * std::mem::size_of::<((u32, Partner), Vec3<T>)>()) as u64;
+        allocated(&self.id) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.contacts) + warm
     }
 }
 

@@ -794,7 +794,7 @@ pub(crate) fn renew<X: Clone + Default>(v: &mut Vec<X>, n: usize) {
 
 /// Bytes a vector holds allocated.
 #[allow(clippy::ptr_arg)] // the capacity lives on the Vec, not the slice
-fn allocated<X>(v: &Vec<X>) -> u64 {
+pub(crate) fn allocated<X>(v: &Vec<X>) -> u64 {
     (v.capacity() * std::mem::size_of::<X>()) as u64
 }
 
