@@ -213,16 +213,6 @@ impl<T: Real> ContactDynamics<T> {
         self.report
     }
 
-    /// Steps taken.
-    pub fn steps(&self) -> u64 {
-        self.steps
-    }
-
-    /// The time step (s).
-    pub fn dt(&self) -> f64 {
-        self.h.f64()
-    }
-
     /// Grain `i`'s position (m, f64, residual included).
     pub fn position(&self, i: usize) -> [f64; 3] {
         position::absolute(self.body[i].pos, position::residual_at(&self.residual, i))
