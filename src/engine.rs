@@ -171,6 +171,12 @@ pub struct SolverStats {
     pub relative_change: f64,
     /// The last step's force balance (see `grains::cd::SolveReport::unbalanced`).
     pub unbalanced: f64,
+    /// Steps solved since the run started.
+    #[serde(default)]
+    pub steps_total: u64,
+    /// Of those, the steps whose solve hit the cap.
+    #[serde(default)]
+    pub unconverged_total: u64,
 }
 
 /// Grains with fewer contacts than this are rattlers: they carry no load, and a rattler

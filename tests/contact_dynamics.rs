@@ -239,6 +239,9 @@ fn the_shipped_pile_runs_by_contact_dynamics_and_resumes_from_a_checkpoint_bit_f
     resumed.advance(30).unwrap();
     let (a, b) = (first.frame(true).unwrap(), resumed.frame(true).unwrap());
     assert_eq!(a, b, "the resumed run differs from the uninterrupted one");
+    let (sa, sb) = (first.stats().unwrap(), resumed.stats().unwrap());
+    assert_eq!(sa, sb, "the resumed run's statistics differ");
+    assert_eq!(sa.solver.unwrap().steps_total, 180);
     assert!(!a.wall_contacts.unwrap().is_empty());
 }
 

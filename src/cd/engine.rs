@@ -106,7 +106,10 @@ impl<T: Real> Engine for ContactDynamics<T> {
         s.rattlers = touching.iter().filter(|&&k| k < RATTLER_CONTACTS).count() as u64;
         s.ke_rattlers = touching.iter().zip(self.body.iter().zip(&self.prop)).filter(|(k, _)| **k < RATTLER_CONTACTS).map(|(_, (b, p))| 0.5 * p.mass.f64() * b.vel.norm2().f64()).sum();
         s.non_finite_grain = self.first_non_finite();
-        s.solver = Some(std::mem::take(&mut self.since_read));
+        let read = std::mem::take(&mut self.since_read);
+        // The run's totals carry on past the read.
+        (self.since_read.steps_total, self.since_read.unconverged_total) = (read.steps_total, read.unconverged_total);
+        s.solver = Some(read);
         Ok(s)
     }
 
@@ -160,6 +163,11 @@ impl<T: Real> Engine for ContactDynamics<T> {
         s.put_ints("warm_b", warm.iter().map(|((_, b), _)| code(*b)));
         s.put_reals("warm_r", warm.iter().flat_map(|(_, r)| v3(**r)));
         s.put_ints("steps", [self.steps]);
+        // The solver's record since the last statistics read, so that a resumed run's
+        // statistics are the uninterrupted run's.
+        let r = &self.since_read;
+        s.put_ints("solver_counts", [r.steps, r.unconverged_steps, r.max_iterations as u64, r.steps_total, r.unconverged_total]);
+        s.put_reals("solver_reals", [r.mean_iterations, r.relative_change, r.unbalanced, self.report.unbalanced]);
         Ok(s)
     }
 
@@ -178,6 +186,18 @@ impl<T: Real> Engine for ContactDynamics<T> {
         let r = s.reals("warm_r", 3 * a.len())?;
         self.warm = a.iter().zip(b).zip(r.chunks_exact(3)).map(|((&a, &b), r)| ((a as u32, if b >= WALL_TAG { Partner::Wall((b - WALL_TAG) as u32) } else { Partner::Grain(b as u32) }), of(r))).collect();
         self.steps = s.ints("steps", Some(1))?[0];
+        let (counts, reals) = (s.ints("solver_counts", Some(5))?, s.reals("solver_reals", 4)?);
+        self.since_read = crate::engine::SolverStats {
+            steps: counts[0],
+            unconverged_steps: counts[1],
+            max_iterations: counts[2] as u32,
+            steps_total: counts[3],
+            unconverged_total: counts[4],
+            mean_iterations: reals[0],
+            relative_change: reals[1],
+            unbalanced: reals[2],
+        };
+        self.report.unbalanced = reals[3];
         Ok(())
     }
 

@@ -360,6 +360,8 @@ impl<T: Real> ContactDynamics<T> {
         r.mean_iterations = (r.mean_iterations * r.steps as f64 + report.iterations as f64) / (r.steps + 1) as f64;
         r.steps += 1;
         r.unconverged_steps += u64::from(!report.converged);
+        r.steps_total += 1;
+        r.unconverged_total += u64::from(!report.converged);
         r.max_iterations = r.max_iterations.max(report.iterations);
         r.relative_change = r.relative_change.max(report.relative_change);
         r.unbalanced = report.unbalanced;
