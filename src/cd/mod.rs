@@ -73,10 +73,6 @@ pub struct Contact<T> {
     pub w_n: T,
     /// Tangential Delassus diagonal `w_t` (1/kg).
     pub w_t: T,
-    /// Normal relative velocity at the start of the step, `u_n^-` (m/s; negative: closing).
-    pub u_minus: T,
-    /// Whether the contact is predicted closed within the step (Newton's impact law applies).
-    pub closing: bool,
     /// Least normal relative velocity at the step's end, `u_min` (m/s).
     pub u_min: T,
     /// Impulse on `b` (N s; `-r` on `a`), world frame.
@@ -271,7 +267,7 @@ impl<T: Real> ContactDynamics<T> {
             let (mu, e) = self.pair(pa.material, pb.material);
             let w_n = T::ONE / pa.mass + T::ONE / pb.mass;
             let w_t = w_n + pa.radius * pa.radius / pa.inertia + pb.radius * pb.radius / pb.inertia;
-            contacts.push(Contact { a: a as u32, b: Partner::Grain(b as u32), n: d * (T::ONE / dist), gap: dist - pa.radius - pb.radius, mu, e, w_n, w_t, u_minus: T::ZERO, closing: false, u_min: T::ZERO, r: Vec3::ZERO });
+            contacts.push(Contact { a: a as u32, b: Partner::Grain(b as u32), n: d * (T::ONE / dist), gap: dist - pa.radius - pb.radius, mu, e, w_n, w_t, u_min: T::ZERO, r: Vec3::ZERO });
         }
         for i in 0..self.body.len() {
             for (w, (geom, material)) in self.walls.iter().enumerate() {
@@ -282,7 +278,7 @@ impl<T: Real> ContactDynamics<T> {
                     let (mu, e) = self.pair(p.material, *material);
                     let w_n = T::ONE / p.mass;
                     let w_t = w_n + p.radius * p.radius / p.inertia;
-                    contacts.push(Contact { a: i as u32, b: Partner::Wall(w as u32), n: -normal, gap, mu, e, w_n, w_t, u_minus: T::ZERO, closing: false, u_min: T::ZERO, r: Vec3::ZERO });
+                    contacts.push(Contact { a: i as u32, b: Partner::Wall(w as u32), n: -normal, gap, mu, e, w_n, w_t, u_min: T::ZERO, r: Vec3::ZERO });
                 }
             }
         }
@@ -292,9 +288,9 @@ impl<T: Real> ContactDynamics<T> {
         for (c, u) in contacts.iter_mut().zip(u_minus) {
             // Gravity moves both grains alike: only a wall sees it in the relative velocity.
             let free = u + if matches!(c.b, Partner::Wall(_)) { -g.dot(c.n) } else { T::ZERO };
-            c.u_minus = u;
-            c.closing = c.gap + h * (theta * free + (T::ONE - theta) * u) <= T::ZERO;
-            c.u_min = if c.closing { -c.e * u } else { -(c.gap / h + (T::ONE - theta) * u) / theta };
+            // Predicted closed within the step: Newton's impact law; open: no closing by its end.
+            let closing = c.gap + h * (theta * free + (T::ONE - theta) * u) <= T::ZERO;
+            c.u_min = if closing { -c.e * u } else { -(c.gap / h + (T::ONE - theta) * u) / theta };
             c.r = self.warm.get(&(self.id[c.a as usize], c.b)).copied().unwrap_or(Vec3::ZERO);
         }
         self.contacts = contacts;
