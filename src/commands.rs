@@ -15,13 +15,17 @@ use std::path::Path;
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Run { scene, resume, backend, adapter, precision, out, json, vtk, threads, force } => {
+            // Under mpirun, one run over every process (see grains::ranks); alone, one process.
+            #[cfg(feature = "mpi")]
+            let _mpi = grains::ranks::init();
             // The whole run happens on a worker of the pool, so that the CPU kernels' parallel
             // loops split work among workers instead of waking them from outside every time.
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start the worker threads")?;
             match resume {
                 Some(dir) => {
                     let precision = precision.map(|p| if p == Precision::F32 { "f32" } else { "f64" });
-                    report(&pool.install(|| grains::runner::resume(&dir, scene.as_deref(), precision, adapter.as_deref(), progress_bar(json)))?, json)
+                    let summary = pool.install(|| grains::runner::resume(&dir, scene.as_deref(), precision, adapter.as_deref(), progress_bar(json)))?;
+                    report_from_root(&summary, json)
                 }
                 None => {
                     let path = scene.expect("clap requires a scene without --resume");
@@ -30,7 +34,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                     if !force {
                         scene.check_practical()?;
                     }
-                    if !json {
+                    if !json && grains::runner::is_root() {
                         for w in &scene.warnings {
                             eprintln!("warning: {w}");
                         }
@@ -41,7 +45,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                         let identity = grains::runner::identity(&path, engine.as_ref())?;
                         grains::runner::execute(&scene, engine.as_mut(), out.as_deref(), start, identity, None, progress_bar(json))
                     })?;
-                    report(&summary, json)
+                    report_from_root(&summary, json)
                 }
             }
         }
@@ -252,6 +256,12 @@ fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision:
     let gpu = |gpu| -> anyhow::Result<Box<dyn Engine>> { Ok(Box::new(GpuEngine::new(gpu, scene)?)) };
     let cpu = |precision: Option<Precision>| grains::runner::cpu_engine(scene, if precision == Some(Precision::F32) { "f32" } else { "f64" });
     let rigid = matches!(scene.method, grains::scene::Method::ContactDynamics(_));
+    if grains::runner::processes() > 1 {
+        if backend == Backend::Gpu {
+            anyhow::bail!("--backend gpu: a run over several processes runs on the CPU; fix: drop --backend or run on one process");
+        }
+        return cpu(precision);
+    }
     match backend {
         Backend::Cpu => cpu(precision),
         Backend::Auto if rigid => cpu(precision),
@@ -279,6 +289,12 @@ fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision:
 }
 
 /// Prints a finished run's summary.
+/// [`report`] on the process that prints (every process of a run over several ends with
+/// the same summary).
+fn report_from_root(summary: &Summary, json: bool) -> anyhow::Result<()> {
+    if grains::runner::is_root() { report(summary, json) } else { Ok(()) }
+}
+
 fn report(summary: &Summary, json: bool) -> anyhow::Result<()> {
     if json {
         println!("{}", serde_json::to_string(summary)?);

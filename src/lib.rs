@@ -19,6 +19,8 @@ pub mod output;
 pub mod periodic;
 pub mod position;
 pub mod protocol;
+#[cfg(feature = "mpi")]
+pub mod ranks;
 pub mod real;
 pub mod runner;
 pub mod schedule;

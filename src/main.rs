@@ -8,7 +8,10 @@ use clap::Parser;
 fn main() {
     let cli = cli::Cli::parse();
     if let Err(e) = commands::dispatch(cli) {
-        eprintln!("error: {e:#}");
+        // Every process of a run over several meets the same error; rank 0 says it.
+        if grains::runner::is_root() {
+            eprintln!("error: {e:#}");
+        }
         std::process::exit(1);
     }
 }

@@ -32,6 +32,14 @@ pub fn cpu_engine(scene: &Scene, precision: &str) -> anyhow::Result<Box<dyn Engi
             other => anyhow::bail!("precision `{other}`: contact dynamics computes in f32 or f64; fix: give --precision f32 or f64"),
         });
     }
+    #[cfg(feature = "mpi")]
+    if processes() > 1 {
+        return Ok(match precision {
+            "f32" => Box::new(crate::ranks::Distributed::<f32>::new(scene)?),
+            "f64" => Box::new(crate::ranks::Distributed::<f64>::new(scene)?),
+            other => anyhow::bail!("precision `{other}`: the CPU engine computes in f32 or f64; fix: give --precision f32 or f64"),
+        });
+    }
     Ok(match precision {
         "f32" => Box::new(CpuEngine::<f32>::new(scene)?),
         "f64" => Box::new(CpuEngine::<f64>::new(scene)?),
@@ -51,7 +59,10 @@ fn engine_of(scene: &Scene, id: &RunIdentity, adapter: Option<&str>) -> anyhow::
 
 /// Runs the stages from `start` on, recording into `out` (with checkpoints at every stage
 /// end), and writes `summary.json` last: a directory with a summary holds a finished run.
+/// In a run over several processes every process runs this alike, and rank 0 alone writes.
 pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start: Progress, identity: RunIdentity, resumed_from: Option<&CheckpointHeader>, progress_bar: bool) -> anyhow::Result<Summary> {
+    let writes = is_root();
+    let (out, progress_bar) = (out.filter(|_| writes), progress_bar && writes);
     let rec = match (out, resumed_from) {
         (Some(dir), Some(header)) => RunRecorder::resume(dir, header, progress_bar)?,
         _ => RunRecorder::new(out, progress_bar)?,
@@ -85,6 +96,8 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
             }
         }
         if scene.output.analysis {
+            // Rank 0 alone reads this last state; the statistics and frame of a run over
+            // several processes are gathered at every advance, so the others need not join.
             let stats = engine.stats()?;
             let a = crate::output::network::write(scene, &engine.frame(true)?, &stats, dir)?;
             if progress_bar {
@@ -95,6 +108,23 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
         std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))?;
     }
     Ok(summary)
+}
+
+/// True on the process that writes outputs and prints: always, unless this is a run over
+/// several processes (feature `mpi`), where rank 0 alone does.
+pub fn is_root() -> bool {
+    #[cfg(feature = "mpi")]
+    return crate::ranks::is_root();
+    #[cfg(not(feature = "mpi"))]
+    true
+}
+
+/// Processes this run is spread over: 1, unless started by mpirun (feature `mpi`).
+pub fn processes() -> usize {
+    #[cfg(feature = "mpi")]
+    return crate::ranks::size();
+    #[cfg(not(feature = "mpi"))]
+    1
 }
 
 /// A fresh run of the scene file on a CPU engine, into `out`.

@@ -14,6 +14,9 @@ mod integrate;
 mod lanes;
 mod pair_force;
 mod pairs;
+// What a run over several processes reads and writes of the engine (src/ranks).
+#[cfg(feature = "mpi")]
+mod parts;
 mod profile;
 mod reduce;
 mod reorder;
@@ -26,6 +29,10 @@ mod wall_contacts;
 
 pub use integrate::rotate;
 pub use pairs::PairList;
+#[cfg(feature = "mpi")]
+pub(crate) use parts::{state_of_rows, touch_of_row, touches_state, RowWidths, Rows, TOUCH_ROW};
+#[cfg(feature = "mpi")]
+pub(crate) use wall_contacts::WallTouch as WallContact;
 pub use pair_force::ForceContext;
 pub use profile::PHASE_NAMES;
 pub use state::{Body, HistorySlots, Load, PairFlags, PairReports, Props};
@@ -530,23 +537,34 @@ impl<T: Real> CpuEngine<T> {
         Ok(())
     }
 
-    /// Runs one operation of the schedule.
-    fn run(&mut self, op: Op) -> Result<(), SimError> {
+    /// Runs one operation of the schedule, with `hooks` around it.
+    fn run(&mut self, op: Op, hooks: &mut impl StepHooks<T>) -> Result<(), SimError> {
         self.trace.record(op);
         match op {
             Op::Kick { tau } => self.kick(T::of(tau)),
-            Op::Drift { tau } => self.drift(T::of(tau)),
-            Op::RebuildIfNeeded => self.rebuild_if_needed()?,
-            Op::Forces { elapsed } => self.evaluate_forces(T::of(elapsed)),
+            Op::Drift { tau } => {
+                self.drift(T::of(tau));
+                hooks.drifted(self)?;
+            }
+            Op::RebuildIfNeeded => hooks.rebuild_if_needed(self)?,
+            Op::Forces { elapsed } => {
+                self.evaluate_forces(T::of(elapsed));
+                hooks.forces_evaluated(self)?;
+            }
         }
         Ok(())
     }
 
     /// Makes the loads valid by the schedule's prologue, if nothing has evaluated them yet.
     fn ensure_loads(&mut self) -> Result<(), SimError> {
+        self.ensure_loads_with(&mut Alone)
+    }
+
+    /// [`Self::ensure_loads`] with `hooks` around each operation.
+    pub(crate) fn ensure_loads_with(&mut self, hooks: &mut impl StepHooks<T>) -> Result<(), SimError> {
         if !self.forces_valid {
             for k in 0..self.schedule.prologue.len() {
-                self.run(self.schedule.prologue[k])?;
+                self.run(self.schedule.prologue[k], hooks)?;
             }
         }
         Ok(())
@@ -564,12 +582,18 @@ impl<T: Real> CpuEngine<T> {
 
     /// One time step of the scene's integrator.
     pub fn step(&mut self) -> Result<(), SimError> {
+        self.step_with(&mut Alone)
+    }
+
+    /// One time step with `hooks` around its operations (a hook may replace the engine; the
+    /// step goes on with the one it leaves).
+    pub(crate) fn step_with(&mut self, hooks: &mut impl StepHooks<T>) -> Result<(), SimError> {
         if self.schedule.needs_loads {
-            self.ensure_loads()?;
+            self.ensure_loads_with(hooks)?;
         }
         let ops = self.schedule.ops(self.step).len();
         for k in 0..ops {
-            self.run(self.schedule.ops(self.step)[k])?;
+            self.run(self.schedule.ops(self.step)[k], hooks)?;
         }
         self.step += 1;
         self.time += self.dt.f64();
@@ -590,6 +614,33 @@ impl<T: Real> CpuEngine<T> {
         let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
         let d = self.separation(i, j).norm();
         (self.prop[i].radius + self.prop[j].radius - d, self.prop[i].radius.min(self.prop[j].radius))
+    }
+}
+
+/// What a driver does between the operations of a step: the distributed engine exchanges
+/// the grains other processes own after each drift, decides rebuilds over every process and
+/// sums the walls' loads over them after each force evaluation ([`crate::ranks`]).
+pub(crate) trait StepHooks<T: Real> {
+    /// After each drift.
+    fn drifted(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError>;
+    /// In place of the rebuild check.
+    fn rebuild_if_needed(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError>;
+    /// After each force evaluation.
+    fn forces_evaluated(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError>;
+}
+
+/// The hooks of an engine that holds every grain: the rebuild check alone.
+struct Alone;
+
+impl<T: Real> StepHooks<T> for Alone {
+    fn drifted(&mut self, _: &mut CpuEngine<T>) -> Result<(), SimError> {
+        Ok(())
+    }
+    fn rebuild_if_needed(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
+        e.rebuild_if_needed()
+    }
+    fn forces_evaluated(&mut self, _: &mut CpuEngine<T>) -> Result<(), SimError> {
+        Ok(())
     }
 }
 

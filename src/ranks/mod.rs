@@ -1,0 +1,415 @@
+//! One run over several processes (feature `mpi`): `mpirun -np K grains run SCENE`.
+//!
+//! The domain is cut into slabs ([`Slabs`]), one per process. Each process runs the CPU
+//! engine over the grains it owns and, as ghosts, the grains of its neighbours within the
+//! neighbour reach of its slab. A pair with a ghost is computed by both processes with the
+//! same operations on the same bits, and every sum a grain's load takes runs in permanent-id
+//! order whatever the numbering (see `cpu`), so each owned grain's load, and so its motion,
+//! is the one process's to the bit. Between the operations of a step
+//! ([`crate::cpu::CpuEngine::step_with`]):
+//! - after each drift, each process sends its neighbours the motion of the grains they hold
+//!   as ghosts, and the largest displacement since the last rebuild is the maximum over all;
+//! - when that calls for a rebuild, every process rebuilds at once: each grain goes to the
+//!   process that owns it now, with its walls' history, and each pair's history goes from a
+//!   process that owned one of its grains (and so computed it every step) to every process
+//!   that holds both, before the local neighbour list is built and the history carried over;
+//! - after each force evaluation, the walls' sums (piston, servo walls) are taken over every
+//!   process's wall contacts in permanent-id order, so every process moves its walls alike.
+//!
+//! After each `advance` every process gathers the whole state (grains by permanent id, each
+//! pair once), and statistics, frames and checkpoints are the one-process engine's, computed
+//! from it: they are the same on every process, so the host loop takes the same decisions
+//! everywhere and rank 0 writes the outputs. A checkpoint is a one-process checkpoint and
+//! resumes on any number of processes.
+//!
+//! Limits of this first version: every process reads the whole scene and holds the whole
+//! state after each `advance` (memory and traffic O(N) per process per statistics read); the
+//! cuts stay where they started (no load balancing); capillary scenes, contact dynamics and
+//! scenes periodic along every axis are refused.
+
+mod slabs;
+
+pub use slabs::Slabs;
+
+use crate::cpu::{touch_of_row, touches_state, CpuEngine, RowWidths, Rows, StepHooks, WallContact, TOUCH_ROW};
+use crate::engine::{Engine, EngineState, Frame, SimError, Stats};
+use crate::model::CohesionLaw;
+use crate::real::Real;
+use crate::scene::{Method, Scene};
+use mpi::collective::SystemOperation;
+use mpi::datatype::PartitionMut;
+use mpi::topology::SimpleCommunicator;
+use mpi::traits::*;
+use std::cell::RefCell;
+use std::sync::OnceLock;
+
+/// This process's rank and the number of processes, once MPI has started.
+static WORLD: OnceLock<(usize, usize)> = OnceLock::new();
+
+/// Starts MPI, when the run command begins; `None` when it was started already. Holding the
+/// universe keeps MPI up; dropping it finalises it. Calls from any thread, one at a time:
+/// the run happens on a worker of the thread pool.
+pub fn init() -> Option<mpi::environment::Universe> {
+    let (universe, _) = mpi::initialize_with_threading(mpi::Threading::Serialized)?;
+    let world = universe.world();
+    WORLD.get_or_init(|| (world.rank() as usize, world.size() as usize));
+    Some(universe)
+}
+
+/// Processes in the run (1 when MPI was not started).
+pub fn size() -> usize {
+    WORLD.get().map_or(1, |w| w.1)
+}
+
+/// True on the process that writes outputs and prints: rank 0, or the only one.
+pub fn is_root() -> bool {
+    WORLD.get().is_none_or(|w| w.0 == 0)
+}
+
+/// The CPU engine over several processes.
+pub struct Distributed<T: Real> {
+    /// The grains this process owns and its ghosts, numbered in ascending permanent id.
+    local: CpuEngine<T>,
+    net: Net<T>,
+    /// The whole state, gathered after each `advance`: statistics, frames and checkpoints.
+    whole: RefCell<CpuEngine<T>>,
+}
+
+/// What the hooks between a step's operations need: everything but the local engine.
+struct Net<T: Real> {
+    world: SimpleCommunicator,
+    rank: usize,
+    slabs: Slabs,
+    /// The scene with no grains: the local engines are made from it and their grains.
+    template: Scene,
+    /// The scene's grains, by permanent id.
+    grains: crate::scene::Grains,
+    widths: RowWidths,
+    /// The permanent id of each local grain (ascending).
+    gid: Vec<u32>,
+    /// Whether this process owns each local grain.
+    owned: Vec<bool>,
+    /// The processes this one exchanges ghosts with.
+    links: Vec<Link>,
+    /// Every process's wall contacts at the last force evaluation, by permanent id.
+    touches: Vec<WallContact<T>>,
+}
+
+/// The ghosts one process and a neighbour exchange after each drift (local numbers, each
+/// list ascending, so that both ends agree on the order).
+struct Link {
+    rank: usize,
+    /// Grains this process owns and the neighbour holds as ghosts.
+    send: Vec<u32>,
+    /// Ghosts here that the neighbour owns.
+    recv: Vec<u32>,
+}
+
+impl<T: Real> Distributed<T> {
+    /// Sets the scene up over every process of MPI's world (each process calls this alike).
+    pub fn new(scene: &Scene) -> anyhow::Result<Self> {
+        let file = scene.path.display();
+        if !matches!(scene.method, Method::Dem) {
+            anyhow::bail!("{file}: simulation.method = \"contact_dynamics\" runs on one process; fix: run it without mpirun");
+        }
+        if !matches!(scene.model.cohesion, CohesionLaw::None) {
+            anyhow::bail!("{file}: model.cohesion = \"capillary\" runs on one process in this version (its liquid moves in one global order); fix: run it without mpirun");
+        }
+        let world = SimpleCommunicator::world();
+        let slabs = Slabs::new(scene, world.size() as usize)?;
+        let mut whole = CpuEngine::<T>::new(scene)?;
+        let template = Scene { grains: Default::default(), ..scene.clone() };
+        let mut net = Net {
+            rank: world.rank() as usize,
+            world,
+            slabs,
+            template,
+            grains: scene.grains.clone(),
+            widths: whole.row_widths(),
+            gid: Vec::new(),
+            owned: Vec::new(),
+            links: Vec::new(),
+            touches: Vec::new(),
+        };
+        let local = net.scatter(&mut whole)?;
+        Ok(Distributed { local, net, whole: RefCell::new(whole) })
+    }
+
+    /// Gathers the whole state from every process into `whole`.
+    fn gather(&mut self) -> Result<(), SimError> {
+        let state = self.local.save()?;
+        let net = &self.net;
+        let mut rows = Rows::of_state(&state, &net.widths, |l| net.owned[l as usize], |a, _| net.owned[a as usize]);
+        rows.renumber(&net.widths, |l| net.gid[l as usize]);
+        let all = Rows { grains: net.all_gather(&rows.grains), pairs: net.all_gather(&rows.pairs) };
+        let (whole_state, _) = crate::cpu::state_of_rows(&all, &net.widths, &state, &touches_state(&net.touches));
+        let whole = self.whole.get_mut();
+        whole.restore(&whole_state).map_err(|e| net.internal(&self.local, &format!("cannot gather the whole state: {e:#}")))?;
+        // The walls' counts of sliding and rolling contacts are not in a state: from the contacts.
+        whole.set_wall_sums(&net.touches, net.grains.len());
+        Ok(())
+    }
+}
+
+impl<T: Real> Net<T> {
+    /// Makes the local engine from the whole state, which every process holds: this process
+    /// owns the grains in its slab and holds as ghosts their partners in the current list.
+    fn scatter(&mut self, whole: &mut CpuEngine<T>) -> anyhow::Result<CpuEngine<T>> {
+        let state = whole.save()?;
+        let n = self.grains.len();
+        let axis = self.slabs.axis;
+        let owner: Vec<usize> = (0..n as u32).map(|i| self.slabs.owner(whole.coordinate(i, axis))).collect();
+        let me = self.rank;
+        // Each grain's holders: its owner and the owners of its partners.
+        let mut held: Vec<Vec<usize>> = owner.iter().map(|&o| vec![o]).collect();
+        let ids = &state.ints["id"];
+        let (o, p) = (&state.ints["owner"], &state.ints["partner"]);
+        for k in 0..o.len() {
+            let (a, b) = (ids[o[k] as usize] as usize, ids[p[k] as usize] as usize);
+            if owner[a] != owner[b] {
+                held[a].push(owner[b]);
+                held[b].push(owner[a]);
+            }
+        }
+        for h in &mut held {
+            h.sort_unstable();
+            h.dedup();
+        }
+        let local = |i: u32| held[i as usize].contains(&me);
+        let rows = Rows::of_state(&state, &self.widths, local, |a, b| local(a) && local(b));
+        self.touches = whole.touch_rows(|_| true, |i| i).chunks_exact(TOUCH_ROW).map(touch_of_row).collect();
+        let engine = self.make_local(&rows, &state)?;
+        let gid = &self.gid;
+        self.owned = gid.iter().map(|&i| owner[i as usize] == me).collect();
+        let mut links = Vec::new();
+        for r in (0..self.world.size() as usize).filter(|&r| r != me) {
+            let send = (0..gid.len() as u32).filter(|&l| self.owned[l as usize] && held[gid[l as usize] as usize].contains(&r)).collect();
+            let recv = (0..gid.len() as u32).filter(|&l| owner[gid[l as usize] as usize] == r).collect();
+            links.push(Link { rank: r, send, recv });
+        }
+        links.retain(|l: &Link| !l.send.is_empty() || !l.recv.is_empty());
+        self.links = links;
+        Ok(engine)
+    }
+
+    /// A local engine holding the grains of `rows` (by permanent id), with the whole-engine
+    /// values of `template`; notes their permanent ids.
+    fn make_local(&mut self, rows: &Rows, template: &EngineState) -> anyhow::Result<CpuEngine<T>> {
+        let (state, gid) = crate::cpu::state_of_rows(rows, &self.widths, template, &touches_state::<T>(&[]));
+        let order: Vec<usize> = gid.iter().map(|&i| i as usize).collect();
+        let mut grains = self.grains.permuted(&order);
+        // Where the grains are now, for the list the new engine builds before the restore.
+        for (p, b) in grains.position.iter_mut().zip(state.reals["body"].chunks_exact(9)) {
+            *p = [b[0], b[1], b[2]];
+        }
+        let scene = Scene { grains, ..self.template.clone() };
+        let mut local = CpuEngine::<T>::new(&scene)?;
+        local.restore(&state)?;
+        self.gid = gid;
+        Ok(local)
+    }
+
+    /// Every process's `mine`, concatenated in rank order.
+    fn all_gather(&self, mine: &[f64]) -> Vec<f64> {
+        let size = self.world.size() as usize;
+        let mut counts = vec![0i32; size];
+        self.world.all_gather_into(&(mine.len() as i32), &mut counts[..]);
+        let displs: Vec<i32> = counts.iter().scan(0, |at, &c| Some(std::mem::replace(at, *at + c))).collect();
+        let mut all = vec![0.0; counts.iter().map(|&c| c as usize).sum()];
+        self.world.all_gather_varcount_into(mine, &mut PartitionMut::new(&mut all[..], &counts[..], &displs[..]));
+        all
+    }
+
+    /// Sends `out[k]` to `ranks[k]` and returns what each of them sent back, in that order.
+    fn exchange(&self, ranks: &[usize], out: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        mpi::request::scope(|scope| {
+            let sends: Vec<_> = ranks.iter().zip(out).map(|(&r, buf)| self.world.process_at_rank(r as i32).immediate_send(scope, &buf[..])).collect();
+            let got = ranks.iter().map(|&r| self.world.process_at_rank(r as i32).receive_vec::<f64>().0).collect();
+            for s in sends {
+                s.wait();
+            }
+            got
+        })
+    }
+
+    /// The same error on every process: of the errors the processes met (`mine` here), the one
+    /// about the lowest permanent id.
+    fn agree(&self, e: &CpuEngine<T>, mine: Option<SimError>) -> Result<(), SimError> {
+        // [kind (0: none, 1: capacity, 2: non-finite, 3: a grain past a slab), grain, count]
+        let code = match &mine {
+            None => [0, u32::MAX as u64, 0],
+            Some(SimError::Capacity { grain, count, .. }) => [1, self.gid[*grain as usize] as u64, *count as u64],
+            Some(SimError::Unstable { grain, what, .. }) if what.contains("slab") => [3, *grain as u64, 0],
+            Some(SimError::Unstable { grain, .. }) => [2, self.gid.get(*grain as usize).copied().unwrap_or(*grain) as u64, 0],
+            Some(SimError::Device { .. }) => [2, 0, 0],
+        };
+        let mut all = vec![0u64; 3 * self.world.size() as usize];
+        self.world.all_gather_into(&code[..], &mut all[..]);
+        let Some(c) = all.chunks_exact(3).filter(|c| c[0] != 0).min_by_key(|c| (c[1], c[0])) else { return Ok(()) };
+        let (step, time, suggested_dt) = e.error_context();
+        let grain = c[1] as u32;
+        Err(match c[0] {
+            1 => SimError::Capacity { step, grain, count: c[2] as usize, capacity: self.template.max_neighbours },
+            3 => SimError::Unstable { step, time, what: "a grain moved past a whole slab between two rebuilds".into(), grain, suggested_dt, also: "" },
+            _ => SimError::Unstable { step, time, what: "non-finite position or velocity".into(), grain, suggested_dt, also: "" },
+        })
+    }
+
+    /// An error for a state the processes disagree on (a bug, not the scene's doing).
+    fn internal(&self, e: &CpuEngine<T>, what: &str) -> SimError {
+        let (step, time, suggested_dt) = e.error_context();
+        SimError::Unstable { step, time, what: format!("process {}: {what}", self.rank), grain: 0, suggested_dt, also: ", and report this as a bug" }
+    }
+
+    /// Local numbers of the grains this process owns.
+    fn owned_numbers(&self) -> impl Iterator<Item = u32> + '_ {
+        self.owned.iter().enumerate().filter(|(_, o)| **o).map(|(l, _)| l as u32)
+    }
+
+    /// Rebuilds on every process: grains to their owners, pairs' history to the processes
+    /// holding both grains, then the local list (see the module's doc).
+    fn redistribute(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
+        let bad = self.owned_numbers().find(|&l| !e.is_finite(l));
+        self.agree(e, bad.map(|l| SimError::Unstable { step: 0, time: 0.0, what: String::new(), grain: l, suggested_dt: 0.0, also: "" }))?;
+        let state = e.save()?;
+        let axis = self.slabs.axis;
+        let holders: Vec<Vec<usize>> = (0..self.gid.len() as u32).map(|l| self.slabs.holders(e.coordinate(l, axis))).collect();
+        let me = self.rank;
+        let neighbours: Vec<usize> = [me.wrapping_sub(1), me + 1].into_iter().filter(|&r| r < self.world.size() as usize).collect();
+        let far = self.owned_numbers().find(|&l| holders[l as usize].iter().any(|r| *r != me && !neighbours.contains(r)));
+        self.agree(e, far.map(|l| SimError::Unstable { step: 0, time: 0.0, what: "slab".into(), grain: self.gid[l as usize], suggested_dt: 0.0, also: "" }))?;
+        // The rows each process gets from this one: the grains it will hold that this one
+        // owns, and the pairs between two grains it will hold of which this one owns one.
+        let rows_for = |r: usize| {
+            let held = |l: u32| holders[l as usize].contains(&r);
+            let mut rows = Rows::of_state(&state, &self.widths, |l| self.owned[l as usize] && held(l), |a, b| (self.owned[a as usize] || self.owned[b as usize]) && held(a) && held(b));
+            rows.renumber(&self.widths, |l| self.gid[l as usize]);
+            rows
+        };
+        let out: Vec<Vec<f64>> = neighbours.iter().map(|&r| rows_for(r).to_message()).collect();
+        let mut rows = rows_for(me);
+        for got in self.exchange(&neighbours, &out) {
+            rows.append(&Rows::from_message(&got));
+        }
+        let mut local = self.make_local(&rows, &state).map_err(|err| self.internal(e, &format!("{err:#}")))?;
+        let built = local.rebuild();
+        self.agree(&local, built.err())?;
+        let x: Vec<f64> = (0..self.gid.len() as u32).map(|l| local.coordinate(l, axis)).collect();
+        let owner: Vec<usize> = x.iter().map(|&x| self.slabs.owner(x)).collect();
+        self.owned = owner.iter().map(|&o| o == me).collect();
+        self.links = neighbours
+            .iter()
+            .map(|&r| Link {
+                rank: r,
+                send: (0..x.len() as u32).filter(|&l| owner[l as usize] == me && self.slabs.near(x[l as usize], r)).collect(),
+                recv: (0..x.len() as u32).filter(|&l| owner[l as usize] == r).collect(),
+            })
+            .filter(|l| !l.send.is_empty() || !l.recv.is_empty())
+            .collect();
+        *e = local;
+        Ok(())
+    }
+}
+
+impl<T: Real> StepHooks<T> for Net<T> {
+    fn drifted(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
+        let ranks: Vec<usize> = self.links.iter().map(|l| l.rank).collect();
+        let out: Vec<Vec<f64>> = self.links.iter().map(|l| {
+            let mut buf = Vec::with_capacity(l.send.len() * e.motion_row());
+            e.motion_rows(&l.send, &mut buf);
+            buf
+        }).collect();
+        for (l, got) in self.links.iter().zip(self.exchange(&ranks, &out)) {
+            if got.len() != l.recv.len() * e.motion_row() {
+                return Err(self.internal(e, &format!("process {} sent {} values for {} ghosts", l.rank, got.len(), l.recv.len())));
+            }
+            e.set_motion_rows(&l.recv, &got);
+        }
+        let mine = e.moved2_of(self.owned_numbers());
+        let mut max = 0.0;
+        self.world.all_reduce_into(&mine, &mut max, SystemOperation::max());
+        e.set_moved2(max);
+        Ok(())
+    }
+
+    fn rebuild_if_needed(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
+        if e.needs_rebuild() {
+            self.redistribute(e)?;
+        }
+        Ok(())
+    }
+
+    fn forces_evaluated(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
+        if self.template.walls.is_empty() {
+            return Ok(());
+        }
+        let mine = e.touch_rows(|l| self.owned[l as usize], |l| self.gid[l as usize]);
+        let mut touches: Vec<WallContact<T>> = self.all_gather(&mine).chunks_exact(TOUCH_ROW).map(touch_of_row).collect();
+        touches.sort_by_key(|t| (t.grain, t.wall));
+        e.set_wall_sums(&touches, self.grains.len());
+        self.touches = touches;
+        Ok(())
+    }
+}
+
+impl<T: Real> Engine for Distributed<T> {
+    fn backend(&self) -> &'static str {
+        "cpu"
+    }
+    fn precision(&self) -> &'static str {
+        T::NAME
+    }
+    fn grain_count(&self) -> usize {
+        self.net.grains.len()
+    }
+    fn steps(&self) -> u64 {
+        self.local.steps()
+    }
+    fn time(&self) -> f64 {
+        self.local.time()
+    }
+    fn advance(&mut self, n: u64) -> Result<(), SimError> {
+        for _ in 0..n {
+            self.local.step_with(&mut self.net)?;
+        }
+        self.gather()
+    }
+    fn stats(&mut self) -> Result<Stats, SimError> {
+        self.whole.get_mut().stats()
+    }
+    fn frame(&self, contacts: bool) -> Result<Frame, SimError> {
+        self.whole.borrow().frame(contacts)
+    }
+    fn set_piston_pressure(&mut self, pressure: f64) {
+        self.local.set_piston_pressure(pressure);
+        self.whole.get_mut().set_piston_pressure(pressure);
+    }
+    fn save(&self) -> Result<EngineState, SimError> {
+        self.whole.borrow().save()
+    }
+    fn restore(&mut self, state: &EngineState) -> anyhow::Result<()> {
+        self.whole.get_mut().restore(state)?;
+        self.local = self.net.scatter(self.whole.get_mut())?;
+        Ok(())
+    }
+    fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
+        self.local.set_servo(pressure, axial_strain_rate);
+        self.whole.get_mut().set_servo(pressure, axial_strain_rate);
+    }
+    fn wet(&mut self, _volume: f64) -> anyhow::Result<()> {
+        anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\" and run it on one process")
+    }
+    fn place_piston(&mut self, z: f64) {
+        self.local.place_piston(z);
+        self.whole.get_mut().place_piston(z);
+    }
+    fn memory_bytes(&self) -> u64 {
+        self.local.memory_bytes() + self.whole.borrow().memory_bytes()
+    }
+    fn set_profiling(&mut self, on: bool) {
+        self.local.set_profiling(on);
+    }
+    fn phase_seconds(&self) -> Vec<(&'static str, f64)> {
+        self.local.phase_seconds()
+    }
+}
