@@ -125,10 +125,12 @@ pub struct Stats {
     pub max_overlap: f64,
     /// Grain with the largest overlap.
     pub max_overlap_grain: u32,
-    /// Mean |net force| on a grain over mean |contact force| (-); 0 when nothing acts.
+    /// Mean |net force| on a grain over mean |contact force| (-); 0 when nothing acts,
+    /// infinite when forces act and no grain touches (JSON writes it `null`).
+    #[serde(deserialize_with = "infinite_if_null")]
     pub unbalanced_force: f64,
     /// The same over the loaded grains only (rattlers left out).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "infinite_if_null")]
     pub unbalanced_force_loaded: f64,
     /// Rattlers: grains with fewer than [`RATTLER_CONTACTS`] contacts (pushing grain-grain
     /// contacts and touching walls); 0 in checkpoints from before they were counted.
@@ -193,6 +195,12 @@ pub fn unbalanced(net: f64, grains: f64, contact_force: f64, contact_ends: u64) 
     } else {
         (net / grains) / (contact_force / contact_ends as f64)
     }
+}
+
+/// A ratio JSON holds as `null` where it was infinite ([`unbalanced`] with forces and no
+/// contact), read back as infinite: a checkpoint written while grains fly resumes.
+pub fn infinite_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
 }
 
 /// Contacts counted per tangential regime.

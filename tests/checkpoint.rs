@@ -66,43 +66,6 @@ fn checkpointing_within_stages() -> String {
     format!("{SCENE}[output]\ncheckpoint_interval = 1.0e-9\n")
 }
 
-/// Keeps checkpoint number `at` (1 = the first offered) in memory, passing every one to the
-/// inner recorder, and stops the run there.
-struct StopAt {
-    inner: RunRecorder,
-    at: usize,
-    seen: usize,
-    saved: Option<(Progress, EngineState)>,
-}
-
-impl StopAt {
-    fn new(inner: RunRecorder, at: usize) -> Self {
-        StopAt { inner, at, seen: 0, saved: None }
-    }
-}
-
-impl Recorder for StopAt {
-    fn stats(&mut self, stage: &str, s: &Stats) -> anyhow::Result<()> {
-        self.inner.stats(stage, s)
-    }
-    fn frame(&mut self, f: &Frame) -> anyhow::Result<()> {
-        self.inner.frame(f)
-    }
-    fn stage_end(&mut self, r: &StageResult) -> anyhow::Result<()> {
-        self.inner.stage_end(r)
-    }
-    fn progress(&mut self, _: &str, _: u64, _: u64) {}
-    fn checkpoint(&mut self, progress: &Progress, engine: &dyn Engine) -> anyhow::Result<()> {
-        self.inner.checkpoint(progress, engine)?;
-        self.seen += 1;
-        if self.seen < self.at {
-            return Ok(());
-        }
-        self.saved = Some((progress.clone(), engine.save().unwrap()));
-        anyhow::bail!("interrupted at checkpoint {} (stage {}, inside it: {})", self.seen, progress.next_stage, progress.in_stage.is_some())
-    }
-}
-
 fn bits(e: &dyn Engine) -> Vec<u64> {
     let f = e.frame(true).unwrap();
     let mut v: Vec<u64> = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|x| x.map(f64::to_bits)).collect();
@@ -120,7 +83,7 @@ fn resume_ends_bitwise(text: &str, at: usize, make: &dyn Fn(&grains::scene::Scen
     let full = protocol::run(&scene, whole.as_mut(), &mut RunRecorder::new(None, false).unwrap()).unwrap();
 
     let mut first = make(&scene);
-    let mut stopper = StopAt::new(RunRecorder::new(None, false).unwrap(), at);
+    let mut stopper = common::StopAt::new(RunRecorder::new(None, false).unwrap(), at);
     let err = protocol::run(&scene, first.as_mut(), &mut stopper).unwrap_err();
     assert!(err.to_string().contains(&format!("interrupted at checkpoint {at}")), "{err}");
     let (progress, state) = stopper.saved.unwrap();
@@ -186,7 +149,7 @@ fn grains_run_resume_continues_a_stopped_run_to_the_same_summary() {
     scene.output.vtk = true;
     let mut e: CpuEngine<f64> = CpuEngine::new(&scene).unwrap();
     let id = RunIdentity { scene_file: scene_path.display().to_string(), scene_hash: grains::checkpoint::fnv1a(text.as_bytes()), backend: "cpu".into(), precision: "f64".into() };
-    let mut stopper = StopAt::new(RunRecorder::new(Some(&cut), false).unwrap().with_checkpoints(&cut, id).with_vtk(&cut, &scene, None).unwrap(), 28);
+    let mut stopper = common::StopAt::new(RunRecorder::new(Some(&cut), false).unwrap().with_checkpoints(&cut, id).with_vtk(&cut, &scene, None).unwrap(), 28);
     let err = protocol::run(&scene, &mut e, &mut stopper).unwrap_err();
     assert!(err.to_string().contains("stage 1, inside it: true"), "{err}");
     stopper.inner.finish().unwrap();

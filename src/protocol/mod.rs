@@ -31,7 +31,8 @@ pub struct StageResult {
     pub settled: Option<bool>,
     /// Translational kinetic energy per grain at the end (J), the settle criterion's measure.
     pub ke_per_grain: f64,
-    /// Unbalanced-force ratio at the end (-).
+    /// Unbalanced-force ratio at the end (-; infinite, `null` in JSON, while no grain touches).
+    #[serde(deserialize_with = "crate::engine::infinite_if_null")]
     pub unbalanced_force: f64,
     /// Statistics at the end.
     pub stats: Stats,

@@ -1,7 +1,11 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code, reason = "each test binary uses a different subset")]
 
+use grains::checkpoint::EngineState;
 use grains::cpu::CpuEngine;
+use grains::engine::{Engine, Frame, Stats};
+use grains::output::RunRecorder;
+use grains::protocol::{Progress, Recorder, StageResult};
 use grains::real::Real;
 use grains::scene::{self, Scene};
 use std::path::{Path, PathBuf};
@@ -134,4 +138,44 @@ pub fn reader(program: &str, args: &[&str], package: &str) -> bool {
         eprintln!("SKIPPED ({program} from the Debian package {package} is not installed)");
     }
     ok
+}
+
+/// Keeps checkpoint number `at` (1 = the first offered) in memory, passing every one to the
+/// inner recorder, and stops the run there.
+pub struct StopAt {
+    /// The recorder every call goes on to.
+    pub inner: RunRecorder,
+    at: usize,
+    seen: usize,
+    /// Where the run stopped and the engine's state there.
+    pub saved: Option<(Progress, EngineState)>,
+}
+
+impl StopAt {
+    /// Stops at checkpoint `at`.
+    pub fn new(inner: RunRecorder, at: usize) -> Self {
+        StopAt { inner, at, seen: 0, saved: None }
+    }
+}
+
+impl Recorder for StopAt {
+    fn stats(&mut self, stage: &str, s: &Stats) -> anyhow::Result<()> {
+        self.inner.stats(stage, s)
+    }
+    fn frame(&mut self, f: &Frame) -> anyhow::Result<()> {
+        self.inner.frame(f)
+    }
+    fn stage_end(&mut self, r: &StageResult) -> anyhow::Result<()> {
+        self.inner.stage_end(r)
+    }
+    fn progress(&mut self, _: &str, _: u64, _: u64) {}
+    fn checkpoint(&mut self, progress: &Progress, engine: &dyn Engine) -> anyhow::Result<()> {
+        self.inner.checkpoint(progress, engine)?;
+        self.seen += 1;
+        if self.seen < self.at {
+            return Ok(());
+        }
+        self.saved = Some((progress.clone(), engine.save().unwrap()));
+        anyhow::bail!("interrupted at checkpoint {} (stage {}, inside it: {})", self.seen, progress.next_stage, progress.in_stage.is_some())
+    }
 }
