@@ -38,11 +38,15 @@ fn same_checkpoint<T: grains::real::Real>(scene: &Path, a: &Path, b: &Path) {
     assert_eq!(ra.1, rb.1, "the checkpoints restore different statistics");
 }
 
-/// `grains run SCENE --out OUT` (f64 unless `precision`) on `ranks` processes under mpirun
-/// (oversubscribed: this machine may have fewer cores), one thread each; 1 runs it alone.
+/// `grains run SCENE --out OUT --precision P` on `ranks` processes (see [`grains`]).
 fn run(ranks: usize, scene: &Path, out: &Path, precision: &str) -> Output {
+    grains(ranks, &["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--precision", precision])
+}
+
+/// `grains ARGS --threads 1` on `ranks` processes under mpirun (oversubscribed: this machine
+/// may have fewer cores); 1 runs it alone.
+fn grains(ranks: usize, args: &[&str]) -> Output {
     let grains = env!("CARGO_BIN_EXE_grains");
-    let args = ["run", scene.to_str().unwrap(), "--out", out.to_str().unwrap(), "--threads", "1", "--precision", precision];
     let mut cmd = if ranks == 1 {
         Command::new(grains)
     } else {
@@ -51,7 +55,7 @@ fn run(ranks: usize, scene: &Path, out: &Path, precision: &str) -> Output {
         c
     };
     // CI runs as root, which OpenMPI refuses unless told.
-    cmd.args(args).env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
+    cmd.args(args).args(["--threads", "1"]).env("OMPI_ALLOW_RUN_AS_ROOT", "1").env("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1");
     cmd.output().expect("mpirun runs (Debian package openmpi-bin)")
 }
 
@@ -170,6 +174,47 @@ fn grains_migrate_with_loaded_springs_and_keep_the_same_bits() {
     const MIN_MIGRATED: usize = 5;
     assert!(migrated >= MIN_MIGRATED, "the bed must carry loaded contacts across the cut");
     same_bits_on(&[2], &path, "f64");
+}
+
+/// A run stopped at a checkpoint inside the oedometer's pressure step on one process (the
+/// library, checkpointing at every statistics read) and resumed on two processes ends where
+/// the uninterrupted run on one does: the same `stats.csv`, row for row, and final state.
+#[test]
+fn a_checkpoint_written_on_one_process_resumes_on_two() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = oedometer(dir.path());
+    let text = format!("{}\ncheckpoint_interval = 1.0e-9\n", std::fs::read_to_string(&path).unwrap());
+    std::fs::write(&path, &text).unwrap();
+    let whole = dir.path().join("whole");
+    assert!(run(1, &path, &whole, "f64").status.success());
+
+    let cut = dir.path().join("cut");
+    let scene = grains::scene::load(&path).unwrap();
+    let mut e = CpuEngine::<f64>::new(&scene).unwrap();
+    let id = grains::checkpoint::RunIdentity { scene_file: path.display().to_string(), scene_hash: grains::checkpoint::fnv1a(text.as_bytes()), backend: "cpu".into(), precision: "f64".into() };
+    let mut stopper = common::StopAt::new(grains::output::RunRecorder::new(Some(&cut), false).unwrap().with_checkpoints(&cut, id), 250);
+    let err = grains::protocol::run(&scene, &mut e, &mut stopper).unwrap_err();
+    assert!(err.to_string().contains("stage 1, inside it: true"), "{err}");
+    stopper.inner.finish().unwrap();
+
+    let o = grains(2, &["run", "--resume", cut.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let rows = |d: &Path| std::fs::read_to_string(d.join("stats.csv")).unwrap();
+    println!("stopped at step {}, resumed on 2 processes: {} rows", e.steps(), rows(&cut).lines().count());
+    assert_eq!(rows(&whole), rows(&cut), "the resumed run's statistics are the uninterrupted run's");
+    let summary = |d: &Path| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap()).unwrap() };
+    assert_eq!(summary(&whole)["final"], summary(&cut)["final"]);
+}
+
+#[test]
+fn slabs_narrower_than_the_reach_are_a_one_line_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = run(16, &pour(dir.path()), &dir.path().join("out"), "f64");
+    let err = String::from_utf8_lossy(&o.stderr);
+    let line = err.lines().find(|l| l.starts_with("error: ")).expect("an error line");
+    println!("{line}");
+    assert!(!o.status.success());
+    assert!(line.contains("16 processes cut the grains into slabs along z as narrow as") && line.ends_with("fix: run on fewer processes"), "{line}");
 }
 
 #[test]
