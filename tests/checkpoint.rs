@@ -6,9 +6,9 @@ mod common;
 
 use grains::checkpoint::{CheckpointHeader, EngineState, RunIdentity};
 use grains::cpu::CpuEngine;
-use grains::engine::{Engine, Frame, Stats};
+use grains::engine::Engine;
 use grains::output::RunRecorder;
-use grains::protocol::{self, Progress, Recorder, StageResult};
+use grains::protocol;
 use std::process::Command;
 
 /// Three stages of a frictional, twisting, spinning gas in a box with a piston: every kind of

