@@ -288,13 +288,13 @@ fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision:
     }
 }
 
-/// Prints a finished run's summary.
 /// [`report`] on the process that prints (every process of a run over several ends with
 /// the same summary).
 fn report_from_root(summary: &Summary, json: bool) -> anyhow::Result<()> {
     if grains::runner::is_root() { report(summary, json) } else { Ok(()) }
 }
 
+/// Prints a finished run's summary.
 fn report(summary: &Summary, json: bool) -> anyhow::Result<()> {
     if json {
         println!("{}", serde_json::to_string(summary)?);

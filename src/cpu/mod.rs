@@ -561,7 +561,7 @@ impl<T: Real> CpuEngine<T> {
     }
 
     /// [`Self::ensure_loads`] with `hooks` around each operation.
-    pub(crate) fn ensure_loads_with(&mut self, hooks: &mut impl StepHooks<T>) -> Result<(), SimError> {
+    fn ensure_loads_with(&mut self, hooks: &mut impl StepHooks<T>) -> Result<(), SimError> {
         if !self.forces_valid {
             for k in 0..self.schedule.prologue.len() {
                 self.run(self.schedule.prologue[k], hooks)?;
