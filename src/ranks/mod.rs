@@ -314,7 +314,15 @@ impl<T: Real> Net<T> {
             rows.renumber(&self.widths, |l| self.gid[l as usize]);
             rows
         };
-        let out: Vec<Vec<f64>> = (0..self.world.size() as usize).map(|r| if r == me { Vec::new() } else { rows_for(r).to_message() }).collect();
+        // Only the processes that hold one of this one's grains get rows (the slabs' neighbours):
+        // the others get no rows, without a pass over the state.
+        let mut dest = vec![false; self.world.size() as usize];
+        for l in self.owned_numbers() {
+            for &r in &holders[l as usize] {
+                dest[r] = true;
+            }
+        }
+        let out: Vec<Vec<f64>> = dest.iter().enumerate().map(|(r, &d)| (if d && r != me { rows_for(r) } else { Rows::default() }).to_message()).collect();
         let mut rows = rows_for(me);
         for (r, got) in self.all_to_all(&out).iter().enumerate() {
             if r != me {
