@@ -200,7 +200,9 @@ duration = 1.0e-3
 "#,
     );
     s.time_step.dt = 5e-5;
-    let params = CdParams { tolerance: 1e-4, max_iterations: 200, gap_allowance: 2e-5, ..CdParams::default() };
+    // A wide gap allowance lists thousands of contacts per colour, open ones included, so that
+    // each colour is solved on both threads.
+    let params = CdParams { tolerance: 1e-4, max_iterations: 200, gap_allowance: 3e-4, ..CdParams::default() };
     let run = || {
         let mut cd = ContactDynamics::<f64>::new(&s, params).unwrap();
         let mut loaded = 0;
@@ -216,6 +218,7 @@ duration = 1.0e-3
     let two = common::with_threads(2, run);
     println!("contacts {}, loaded contacts summed over the steps {}, last step {:?}", one.1.len() / 3, one.3, one.2);
     assert!(one.3 > 10_000, "the grains must be in contact");
+    assert!(one.2.colours > 1 && one.2.largest_colour > 2 * 1024, "colours large enough to be split over threads: {:?}", one.2);
     assert_eq!(one, two);
 }
 

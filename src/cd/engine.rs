@@ -83,8 +83,10 @@ impl<T: Real> Engine for ContactDynamics<T> {
                     s.contacts += 1;
                     touching[j as usize] += 1;
                     let r_min = self.prop[c.a as usize].radius.min(self.prop[j as usize].radius).f64();
-                    if overlap / r_min > most {
-                        (most, most_grain) = (overlap / r_min, self.id[c.a as usize]);
+                    // Ties go to the lower id, whatever the solve's order.
+                    let (ratio, grain) = (overlap / r_min, self.id[c.a as usize]);
+                    if ratio > most || (ratio == most && ratio > 0.0 && grain < most_grain) {
+                        (most, most_grain) = (ratio, grain);
                     }
                 }
                 Partner::Wall(w) => {
@@ -139,6 +141,8 @@ impl<T: Real> Engine for ContactDynamics<T> {
                     }
                 }
             }
+            // Canonical order (the solve's is by colour).
+            pairs.sort_by_key(|p| (p.i, p.j));
             f.contacts = Some(pairs);
             f.wall_contacts = Some(walls);
         }

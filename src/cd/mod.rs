@@ -31,8 +31,10 @@
 //!    id, partner id or wall) like the DEM engine's history.
 //! 4. Positions by the theta-method: `x += h (theta v^+ + (1 - theta) v^-)`.
 //!
-//! Everything runs in a fixed order on one thread (detection in fixed chunks), so a step
-//! gives the same bits on any thread count.
+//! The sweep solves the grain pairs colour by colour (`colour`: no two contacts of a colour
+//! share a grain), each colour's contacts at once on the engine's threads, then the wall
+//! contacts one after the other; the schedule depends on the contacts alone, so a step gives
+//! the same bits on any thread count.
 
 use crate::cpu::{Body, PairList, Props};
 use crate::periodic::Periodic;
@@ -43,7 +45,11 @@ use crate::scene::{Scene, WallShape};
 use crate::walls::WallGeom;
 use std::collections::HashMap;
 
+mod colour;
 mod engine;
+mod solve;
+
+pub use colour::{Schedule, MAX_COLOURS};
 
 /// The second body of a contact.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -69,6 +75,18 @@ pub struct Contact<T> {
     pub mu: T,
     /// Normal restitution coefficient (-).
     pub e: T,
+    /// Radius of `a` (m).
+    pub radius_a: T,
+    /// Radius of `b` (m; 0 for a wall).
+    pub radius_b: T,
+    /// `1/m_a` (1/kg).
+    pub inv_mass_a: T,
+    /// `1/I_a` (1/(kg m^2)).
+    pub inv_inertia_a: T,
+    /// `1/m_b` (1/kg): a wall's along its normal, 0 for a wall that does not yield.
+    pub inv_mass_b: T,
+    /// `1/I_b` (1/(kg m^2); 0 for a wall).
+    pub inv_inertia_b: T,
     /// Normal Delassus diagonal `w_n` (1/kg).
     pub w_n: T,
     /// Tangential Delassus diagonal `w_t` (1/kg).
@@ -77,6 +95,15 @@ pub struct Contact<T> {
     pub u_min: T,
     /// Impulse on `b` (N s; `-r` on `a`), world frame.
     pub r: Vec3<T>,
+}
+
+/// A wall's motion: walls translate along their normal only.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WallMotion<T> {
+    /// Velocity (m/s).
+    pub vel: Vec3<T>,
+    /// `1/M` (1/kg): 0 for a wall that moves as prescribed (or not at all).
+    pub inv_mass: T,
 }
 
 /// What the last step's solve did.
@@ -92,6 +119,12 @@ pub struct SolveReport {
     pub contacts: usize,
     /// Contacts carrying a normal impulse.
     pub loaded: usize,
+    /// Colours of the grain pairs (each solved at once over the threads).
+    pub colours: usize,
+    /// Contacts of the largest colour.
+    pub largest_colour: usize,
+    /// Contacts solved one after the other: the wall contacts and any uncoloured pair.
+    pub serial: usize,
     /// Force balance: the mean over grains of the net impulse that the contacts and gravity
     /// leave on a grain, `|m (v^+ - v^-)|`, over the mean normal impulse of the loaded
     /// contacts (-; 0 when every grain is in equilibrium).
@@ -109,11 +142,14 @@ pub struct ContactDynamics<T: Real> {
     residual: Vec<Vec3<T>>,
     prop: Vec<Props<T>>,
     walls: Vec<(WallGeom<T>, u32)>,
+    wall_motion: Vec<WallMotion<T>>,
     /// `(mu, e)` per pair of materials, row-major.
     coeffs: Vec<(T, T)>,
     n_materials: usize,
     r_max: T,
     contacts: Vec<Contact<T>>,
+    schedule: Schedule,
+    scratch: solve::Scratch<T>,
     /// Last step's impulses by (grain id, partner grain id or wall), for the warm start.
     warm: HashMap<(u32, Partner), Vec3<T>>,
     report: SolveReport,
@@ -182,10 +218,13 @@ impl<T: Real> ContactDynamics<T> {
             residual: if T::COMPENSATED { residual } else { Vec::new() },
             prop,
             walls: scene.walls.iter().map(|w| (WallGeom::of(&w.shape), w.material as u32)).collect(),
+            wall_motion: vec![WallMotion::default(); scene.walls.len()],
             coeffs,
             n_materials,
             r_max: T::of(g.radius.iter().copied().fold(0.0, f64::max)),
             contacts: Vec::new(),
+            schedule: Schedule::default(),
+            scratch: solve::Scratch::default(),
             warm: HashMap::new(),
             report: SolveReport::default(),
             since_read: Default::default(),
@@ -219,37 +258,21 @@ impl<T: Real> ContactDynamics<T> {
         self.coeffs[a as usize * self.n_materials + b as usize]
     }
 
-    /// Velocity of grain `i`'s surface point at `arm` from its centre (m/s).
-    fn point_velocity(&self, i: usize, arm: Vec3<T>) -> Vec3<T> {
-        self.body[i].vel + self.body[i].omega.cross(arm)
-    }
-
-    /// Relative velocity of `b` against `a` at contact `c` (m/s).
-    fn relative_velocity(&self, c: &Contact<T>) -> Vec3<T> {
-        let a = c.a as usize;
-        let u_a = self.point_velocity(a, c.n * self.prop[a].radius);
-        let u_b = match c.b {
-            Partner::Grain(j) => self.point_velocity(j as usize, c.n * -self.prop[j as usize].radius),
-            Partner::Wall(_) => Vec3::ZERO,
-        };
-        u_b - u_a
-    }
-
-    /// Applies impulse `dr` on `b` (and `-dr` on `a`) at contact `c`.
-    fn apply(&mut self, c: &Contact<T>, dr: Vec3<T>) {
-        let a = c.a as usize;
-        let (ra, ma, ia) = (self.prop[a].radius, self.prop[a].mass, self.prop[a].inertia);
-        self.body[a].vel -= dr * (T::ONE / ma);
-        self.body[a].omega -= (c.n * ra).cross(dr) * (T::ONE / ia);
-        if let Partner::Grain(j) = c.b {
-            let j = j as usize;
-            let (rb, mb, ib) = (self.prop[j].radius, self.prop[j].mass, self.prop[j].inertia);
-            self.body[j].vel += dr * (T::ONE / mb);
-            self.body[j].omega += (c.n * -rb).cross(dr) * (T::ONE / ib);
+    /// The contact's second body as the solve sees it: a grain, or a wall's motion.
+    fn body_b(&self, c: &Contact<T>) -> Body<T> {
+        match c.b {
+            Partner::Grain(j) => self.body[j as usize],
+            Partner::Wall(w) => Body { pos: Vec3::ZERO, vel: self.wall_motion[w as usize].vel, omega: Vec3::ZERO },
         }
     }
 
-    /// Step 1: the contacts within the gap allowance, pairs in canonical order, then walls.
+    /// Normal relative velocity of each contact (m/s).
+    fn normal_velocities(&self) -> Vec<T> {
+        self.contacts.iter().map(|c| solve::relative_velocity(c, &self.body[c.a as usize], &self.body_b(c)).dot(c.n)).collect()
+    }
+
+    /// Step 1: the contacts within the gap allowance, pairs in canonical order, then walls,
+    /// scheduled into colours; their impulses from the warm start.
     fn detect(&mut self) {
         let allowance = T::of(self.params.gap_allowance);
         let periodic = Periodic::<T>::of(&[None, None, None]);
@@ -258,42 +281,52 @@ impl<T: Real> ContactDynamics<T> {
         crate::cpu::hash_cells(&self.body, cutoff, &periodic, &mut grid);
         let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grid, &periodic, allowance, usize::MAX).unwrap_or_default();
         let mut contacts = Vec::with_capacity(pairs.len() + self.walls.len());
-        let (h, theta) = (self.h, T::of(self.params.theta));
         for (k, &b) in pairs.partner.iter().enumerate() {
             let (a, b) = (pairs.owner[k] as usize, b as usize);
             let d = position::separation_of(&periodic, |s| self.body[s].pos, &self.residual, b, a);
             let dist = d.norm();
             let (pa, pb) = (&self.prop[a], &self.prop[b]);
-            let (mu, e) = self.pair(pa.material, pb.material);
-            let w_n = T::ONE / pa.mass + T::ONE / pb.mass;
-            let w_t = w_n + pa.radius * pa.radius / pa.inertia + pb.radius * pb.radius / pb.inertia;
-            contacts.push(Contact { a: a as u32, b: Partner::Grain(b as u32), n: d * (T::ONE / dist), gap: dist - pa.radius - pb.radius, mu, e, w_n, w_t, u_min: T::ZERO, r: Vec3::ZERO });
+            let (inv_mass_b, inv_inertia_b) = (T::ONE / pb.mass, T::ONE / pb.inertia);
+            contacts.push(self.contact(a, Partner::Grain(b as u32), d * (T::ONE / dist), dist - pa.radius - pb.radius, pb.material, (pb.radius, inv_mass_b, inv_inertia_b)));
         }
         for i in 0..self.body.len() {
             for (w, (geom, material)) in self.walls.iter().enumerate() {
                 let (normal, dist) = geom.frame(self.body[i].pos, position::residual_at(&self.residual, i));
-                let p = &self.prop[i];
-                let gap = dist - p.radius;
+                let gap = dist - self.prop[i].radius;
                 if gap < allowance {
-                    let (mu, e) = self.pair(p.material, *material);
-                    let w_n = T::ONE / p.mass;
-                    let w_t = w_n + p.radius * p.radius / p.inertia;
-                    contacts.push(Contact { a: i as u32, b: Partner::Wall(w as u32), n: -normal, gap, mu, e, w_n, w_t, u_min: T::ZERO, r: Vec3::ZERO });
+                    contacts.push(self.contact(i, Partner::Wall(w as u32), -normal, gap, *material, (T::ZERO, self.wall_motion[w].inv_mass, T::ZERO)));
                 }
             }
         }
-        // Normal velocities before and after the free motion decide each contact's law.
-        let u_minus: Vec<T> = contacts.iter().map(|c| self.relative_velocity(c).dot(c.n)).collect();
-        let g = self.gravity * h;
-        for (c, u) in contacts.iter_mut().zip(u_minus) {
-            // Gravity moves both grains alike: only a wall sees it in the relative velocity.
-            let free = u + if matches!(c.b, Partner::Wall(_)) { -g.dot(c.n) } else { T::ZERO };
-            // Predicted closed within the step: Newton's impact law; open: no closing by its end.
-            let closing = c.gap + h * (theta * free + (T::ONE - theta) * u) <= T::ZERO;
-            c.u_min = if closing { -c.e * u } else { -(c.gap / h + (T::ONE - theta) * u) / theta };
+        self.schedule = colour::schedule(&mut contacts, self.body.len());
+        for c in &mut contacts {
             c.r = self.warm.get(&(self.id[c.a as usize], c.b)).copied().unwrap_or(Vec3::ZERO);
         }
         self.contacts = contacts;
+    }
+
+    /// A contact of grain `a` with `b` (of `material`; `(radius, 1/m, 1/I)`) along the unit
+    /// normal `n` at `gap`, with its Delassus diagonals.
+    fn contact(&self, a: usize, b: Partner, n: Vec3<T>, gap: T, material: u32, (radius_b, inv_mass_b, inv_inertia_b): (T, T, T)) -> Contact<T> {
+        let pa = &self.prop[a];
+        let (mu, e) = self.pair(pa.material, material);
+        let (inv_mass_a, inv_inertia_a) = (T::ONE / pa.mass, T::ONE / pa.inertia);
+        let w_n = inv_mass_a + inv_mass_b;
+        // A wall turns no more than it slides: only its normal motion yields.
+        let w_t = inv_mass_a + pa.radius * pa.radius * inv_inertia_a + if matches!(b, Partner::Grain(_)) { inv_mass_b + radius_b * radius_b * inv_inertia_b } else { T::ZERO };
+        Contact { a: a as u32, b, n, gap, mu, e, radius_a: pa.radius, radius_b, inv_mass_a, inv_inertia_a, inv_mass_b, inv_inertia_b, w_n, w_t, u_min: T::ZERO, r: Vec3::ZERO }
+    }
+
+    /// Each contact's least normal velocity at the step's end, from its normal velocity before
+    /// (`u_minus`) and after the free motion: a contact predicted closed within the step takes
+    /// Newton's impact law; one predicted open must not close by the step's end.
+    fn set_laws(&mut self, u_minus: &[T]) {
+        let (h, theta) = (self.h, T::of(self.params.theta));
+        let u_free = self.normal_velocities();
+        for ((c, &u), free) in self.contacts.iter_mut().zip(u_minus).zip(u_free) {
+            let closing = c.gap + h * (theta * free + (T::ONE - theta) * u) <= T::ZERO;
+            c.u_min = if closing { -c.e * u } else { -(c.gap / h + (T::ONE - theta) * u) / theta };
+        }
     }
 
     /// Advances one step (see the module's text).
@@ -301,43 +334,26 @@ impl<T: Real> ContactDynamics<T> {
         self.detect();
         let h = self.h;
         let theta = T::of(self.params.theta);
+        let u_minus = self.normal_velocities();
         let before: Vec<Body<T>> = self.body.clone();
         for b in &mut self.body {
             b.vel += self.gravity * h;
         }
+        self.set_laws(&u_minus);
         let mut contacts = std::mem::take(&mut self.contacts);
         for c in &contacts {
-            self.apply(c, c.r);
+            let mut b = self.body_b(c);
+            solve::apply_a(c, &mut self.body[c.a as usize], c.r);
+            solve::apply_b(c, &mut b, c.r);
+            match c.b {
+                Partner::Grain(j) => self.body[j as usize] = b,
+                Partner::Wall(w) => self.wall_motion[w as usize].vel = b.vel,
+            }
         }
-        let mut report = SolveReport { contacts: contacts.len(), ..Default::default() };
+        let mut report = SolveReport { contacts: contacts.len(), colours: self.schedule.starts.len().saturating_sub(1), largest_colour: self.schedule.colours().map(|r| r.len()).max().unwrap_or(0), serial: contacts.len() - self.schedule.tail(), ..Default::default() };
         while report.iterations < self.params.max_iterations {
             report.iterations += 1;
-            let (mut change, mut total) = (0.0f64, 0.0f64);
-            for c in contacts.iter_mut() {
-                let r_old = c.r;
-                // The contact's velocity without its own impulse.
-                let u = self.relative_velocity(c);
-                let own_n = r_old.dot(c.n);
-                let own_t = r_old - c.n * own_n;
-                let u_other = u - c.n * (c.w_n * own_n) - own_t * c.w_t;
-                let u_n = u_other.dot(c.n);
-                let r_n = ((c.u_min - u_n) / c.w_n).max(T::ZERO);
-                let u_t = u_other - c.n * u_n;
-                let stick = u_t * (-T::ONE / c.w_t);
-                let cap = c.mu * r_n;
-                let r_t = if stick.norm2() <= cap * cap {
-                    stick
-                } else {
-                    let s = u_t.norm();
-                    if s > T::ZERO { u_t * (-cap / s) } else { Vec3::ZERO }
-                };
-                let r = c.n * r_n + r_t;
-                self.apply(c, r - r_old);
-                c.r = r;
-                change += (r - r_old).norm().f64();
-                total += r.norm().f64();
-            }
-            report.relative_change = if total > 0.0 { change / total } else { 0.0 };
+            report.relative_change = solve::sweep(&mut contacts, &self.schedule, &mut self.body, &mut self.wall_motion, &mut self.scratch);
             if report.relative_change <= self.params.tolerance {
                 report.converged = true;
                 break;

@@ -18,7 +18,7 @@ mod pairs;
 #[cfg(feature = "mpi")]
 mod parts;
 mod profile;
-mod reduce;
+pub(crate) mod reduce;
 mod reorder;
 mod snapshot;
 pub mod simd;

@@ -1,0 +1,170 @@
+//! One sweep of nonsmooth Gauss-Seidel: each contact's local problem solved exactly (see the
+//! module text of [`super`]), colour by colour in parallel, then the serial tail.
+
+use super::colour::Schedule;
+use super::{Contact, Partner, WallMotion};
+use crate::cpu::reduce::PAR_MIN_PAIRS;
+use crate::cpu::Body;
+use crate::real::{Real, Vec3};
+use rayon::prelude::*;
+
+/// Velocity of `b` against `a` at contact `c` (m/s): `v_b + w_b x (-R_b n) - v_a - w_a x (R_a n)`.
+pub(super) fn relative_velocity<T: Real>(c: &Contact<T>, a: &Body<T>, b: &Body<T>) -> Vec3<T> {
+    (b.vel + b.omega.cross(c.n * -c.radius_b)) - (a.vel + a.omega.cross(c.n * c.radius_a))
+}
+
+/// Applies `-dr` to `a`, the first body of contact `c`.
+pub(super) fn apply_a<T: Real>(c: &Contact<T>, a: &mut Body<T>, dr: Vec3<T>) {
+    a.vel -= dr * c.inv_mass_a;
+    a.omega -= (c.n * c.radius_a).cross(dr) * c.inv_inertia_a;
+}
+
+/// Applies `dr` to `b`, the second body of contact `c`. A wall (`b` standing for its motion)
+/// moves along the contact normal only, guided in the other directions.
+pub(super) fn apply_b<T: Real>(c: &Contact<T>, b: &mut Body<T>, dr: Vec3<T>) {
+    match c.b {
+        Partner::Grain(_) => {
+            b.vel += dr * c.inv_mass_b;
+            b.omega += (c.n * -c.radius_b).cross(dr) * c.inv_inertia_b;
+        }
+        Partner::Wall(_) => b.vel += c.n * (c.n.dot(dr) * c.inv_mass_b),
+    }
+}
+
+/// Contact `c`'s impulse (N s, on `b`) solving its local problem exactly against the other
+/// contacts' impulses, which the bodies' velocities hold with its own.
+fn local<T: Real>(c: &Contact<T>, a: &Body<T>, b: &Body<T>) -> Vec3<T> {
+    let r_old = c.r;
+    // The contact's velocity without its own impulse.
+    let u = relative_velocity(c, a, b);
+    let own_n = r_old.dot(c.n);
+    let own_t = r_old - c.n * own_n;
+    let u_other = u - c.n * (c.w_n * own_n) - own_t * c.w_t;
+    let u_n = u_other.dot(c.n);
+    let r_n = ((c.u_min - u_n) / c.w_n).max(T::ZERO);
+    let u_t = u_other - c.n * u_n;
+    let stick = u_t * (-T::ONE / c.w_t);
+    let cap = c.mu * r_n;
+    let r_t = if stick.norm2() <= cap * cap {
+        stick
+    } else {
+        let s = u_t.norm();
+        if s > T::ZERO {
+            u_t * (-cap / s)
+        } else {
+            Vec3::ZERO
+        }
+    };
+    c.n * r_n + r_t
+}
+
+/// Solves contact `c` between bodies `a` and `b` one after the other: its new impulse, applied;
+/// returns its share of the convergence measure.
+fn solve_serial<T: Real>(c: &mut Contact<T>, a: &mut Body<T>, b: &mut Body<T>) -> (f64, f64) {
+    let r = local(c, a, b);
+    apply_a(c, a, r - c.r);
+    apply_b(c, b, r - c.r);
+    let sum = measure(r, c.r);
+    c.r = r;
+    sum
+}
+
+/// `(|r - r_old|, |r|)` (N s), a contact's share of the convergence measure.
+fn measure<T: Real>(r: Vec3<T>, r_old: Vec3<T>) -> (f64, f64) {
+    ((r - r_old).norm().f64(), r.norm().f64())
+}
+
+/// Grains per task when a colour's impulse changes are applied.
+const APPLY_CHUNK: usize = 4096;
+
+/// A sweep's per-contact scratch.
+#[derive(Default)]
+pub(super) struct Scratch<T> {
+    /// `(|r - r_old|, |r|)` (N s).
+    sums: Vec<(f64, f64)>,
+    /// `r - r_old` (N s).
+    change: Vec<Vec3<T>>,
+}
+
+/// One sweep over every contact in the schedule's order; returns the relative change of the
+/// impulses, `sum |r - r_old| / sum |r|` (0 when no contact carries any), summed in the
+/// schedule's order whatever the thread count.
+///
+/// A colour large enough to share is solved in two passes: every contact's new impulse from the bodies as the colour
+/// found them (in parallel over the contacts), then the changes applied (in parallel over
+/// chunks of grains, each grain touched by one contact of the colour at most). Since no two
+/// contacts of a colour share a grain, this gives the bits of solving them one after the other.
+pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], scratch: &mut Scratch<T>) -> f64 {
+    let n = contacts.len();
+    scratch.sums.clear();
+    scratch.sums.resize(n, (0.0, 0.0));
+    scratch.change.clear();
+    scratch.change.resize(n, Vec3::ZERO);
+    for (k, range) in schedule.colours().enumerate() {
+        if range.len() < PAR_MIN_PAIRS || rayon::current_num_threads() == 1 {
+            // One thread: solved and applied contact by contact, the same bits.
+            for (c, sum) in contacts[range.clone()].iter_mut().zip(&mut scratch.sums[range]) {
+                let Partner::Grain(j) = c.b else { unreachable!("colours hold grain pairs") };
+                let (a, b) = two(body, c.a as usize, j as usize);
+                *sum = solve_serial(c, a, b);
+            }
+            continue;
+        }
+        let grains: &[Body<T>] = body;
+        contacts[range.clone()].par_iter_mut().zip(scratch.sums[range.clone()].par_iter_mut()).zip(scratch.change[range].par_iter_mut()).with_min_len(PAR_MIN_PAIRS).for_each(|((c, sum), change)| {
+            let Partner::Grain(j) = c.b else { unreachable!("colours hold grain pairs") };
+            let r = local(c, &grains[c.a as usize], &grains[j as usize]);
+            (*sum, *change) = (measure(r, c.r), r - c.r);
+            c.r = r;
+        });
+        let touches = schedule.touches(k);
+        let (contacts, change) = (&*contacts, &scratch.change);
+        body.par_chunks_mut(APPLY_CHUNK).enumerate().for_each(|(chunk, grains)| {
+            let lo = chunk * APPLY_CHUNK;
+            let first = touches.partition_point(|t| (t.grain as usize) < lo);
+            let last = touches.partition_point(|t| (t.grain as usize) < lo + grains.len());
+            for t in &touches[first..last] {
+                let (c, dr, g) = (&contacts[t.contact as usize], change[t.contact as usize], &mut grains[t.grain as usize - lo]);
+                if t.second {
+                    apply_b(c, g, dr);
+                } else {
+                    apply_a(c, g, dr);
+                }
+            }
+        });
+    }
+    let tail = schedule.tail();
+    for (c, sum) in contacts[tail..].iter_mut().zip(&mut scratch.sums[tail..]) {
+        *sum = match c.b {
+            Partner::Grain(j) => {
+                let (a, b) = two(body, c.a as usize, j as usize);
+                solve_serial(c, a, b)
+            }
+            Partner::Wall(w) => {
+                let wall = &mut walls[w as usize];
+                let mut b = Body { pos: Vec3::ZERO, vel: wall.vel, omega: Vec3::ZERO };
+                let sum = solve_serial(c, &mut body[c.a as usize], &mut b);
+                wall.vel = b.vel;
+                sum
+            }
+        };
+    }
+    let (change, total) = scratch.sums.iter().fold((0.0, 0.0), |(c, t), &(dc, dt)| (c + dc, t + dt));
+    if total > 0.0 {
+        change / total
+    } else {
+        0.0
+    }
+}
+
+/// Two different grains, mutably.
+pub(super) fn two<T>(body: &mut [Body<T>], a: usize, b: usize) -> (&mut Body<T>, &mut Body<T>) {
+    assert_ne!(a, b, "a contact joins two grains");
+    if a < b {
+        let (lo, hi) = body.split_at_mut(b);
+        (&mut lo[a], &mut hi[0])
+    } else {
+        let (lo, hi) = body.split_at_mut(a);
+        (&mut hi[0], &mut lo[b])
+    }
+}
