@@ -1,11 +1,14 @@
 //! Contact dynamics (`src/cd`) against exact answers: a sphere resting on a plane carries its
 //! weight, a sphere on an incline rolls or slides as rigid-body mechanics says, a column of
 //! spheres carries the weight above each contact, a frictionless head-on collision rebounds at
-//! `e v`; and a box of colliding grains gives the same bits on one and two threads.
+//! `e v`; a servo box at pressure `p` around a cubic lattice comes to rest holding `p` times
+//! its faces through columns in balance; and a box of colliding grains gives the same
+//! bits on one and two threads.
 
 mod common;
 
 use grains::cd::{CdParams, ContactDynamics, Partner};
+use grains::engine::Engine;
 use grains::scene::Scene;
 
 /// Relative error allowed where the answer is exact up to round-off and the solver's
@@ -13,7 +16,7 @@ use grains::scene::Scene;
 const EXACT: f64 = 1e-9;
 
 /// Tight solver settings for exact answers.
-const PARAMS: CdParams = CdParams { theta: 0.5, tolerance: 1e-13, max_iterations: 10_000, gap_allowance: 1e-6 };
+const PARAMS: CdParams = CdParams { theta: 0.5, tolerance: 1e-13, max_iterations: 10_000, gap_allowance: 1e-6, wall_mass: None };
 
 const G: f64 = 9.81;
 const RADIUS: f64 = 0.5e-3;
@@ -164,6 +167,108 @@ fn a_frictionless_head_on_collision_rebounds_at_e_v() {
 }
 
 #[test]
+fn a_servo_box_holds_a_cubic_lattice_at_its_pressure_through_balanced_columns() {
+    // n^3 frictionless equal spheres on a simple cubic lattice of spacing d, the servo box 2%
+    // wider than the lattice on each axis: the walls, pushed by p over their faces, close in,
+    // strike the lattice (restitution 0.1) and come to rest. Then each wall carries p times
+    // its face, each column along an axis carries one force at its every contact (walls and
+    // bonds), and the columns' forces sum to p A. (How p A splits among the columns is not
+    // fixed: rigid grains between rigid walls are hyperstatic.)
+    const N: usize = 3;
+    const PRESSURE: f64 = 100.0;
+    let d = 2.0 * RADIUS;
+    let (side, half_gap) = (N as f64 * d * 1.02, N as f64 * d * 0.01);
+    let mut grains = String::new();
+    for i in 0..N {
+        for j in 0..N {
+            for k in 0..N {
+                let x = [i, j, k].map(|a| half_gap + (a as f64 + 0.5) * d);
+                grains += &grain(x, [0.0; 3]);
+            }
+        }
+    }
+    let mut s = common::parse(&format!(
+        r#"
+[[material]]
+name = "glass"
+density = {DENSITY:e}
+youngs_modulus = 7.0e10
+poisson_ratio = 0.25
+mu_s = 0.0
+restitution = 0.1
+
+[[wall]]
+type = "servo_box"
+material = "glass"
+min = [0.0, 0.0, 0.0]
+max = [{side:e}, {side:e}, {side:e}]
+pressure = {PRESSURE:e}
+max_speed = 0.05
+
+[simulation]
+gravity = [0.0, 0.0, 0.0]
+
+[[stage]]
+kind = "run"
+duration = 1.0e-3
+
+{grains}
+"#
+    ));
+    s.time_step.dt = 1e-5;
+    let mut cd = ContactDynamics::<f64>::new(&s, CdParams { gap_allowance: 0.05 * d, ..PARAMS }).unwrap();
+    cd.advance(3000).unwrap();
+    let stats = cd.stats().unwrap();
+    let frame = cd.frame(true).unwrap();
+    let plane = |w: usize| match frame.walls[w] {
+        grains::walls::WallGeom::Plane { point, .. } => [point.x, point.y, point.z],
+        _ => unreachable!(),
+    };
+    let extent: Vec<f64> = (0..3).map(|a| plane(2 * a + 1)[a] - plane(2 * a)[a]).collect();
+    println!("extents {extent:?} (lattice {}), KE {:e} J, {} sweeps, walls {:?}", N as f64 * d, stats.ke_translational, cd.report().iterations, stats.walls.iter().map(|w| w.force).collect::<Vec<_>>());
+    assert!(stats.ke_translational < 1e-20, "the box comes to rest: KE {:e} J", stats.ke_translational);
+    for (w, wall) in stats.walls.iter().enumerate() {
+        let a = w / 2;
+        let area = extent[(a + 1) % 3] * extent[(a + 2) % 3];
+        let load = wall.force[a].abs();
+        assert!(relative(load, PRESSURE * area) < EXACT, "wall {w} carries {load:e} N against p A = {:e} N", PRESSURE * area);
+        assert_eq!(wall.contacts, (N * N) as u64, "wall {w} touches every column");
+    }
+    let pairs = frame.contacts.as_ref().unwrap();
+    assert_eq!(pairs.len(), 3 * N * N * (N - 1), "every lattice bond is a loaded contact");
+    // Each column along each axis: its two wall contacts and its bonds, by lattice index.
+    let index = |x: f64, a: usize| ((x - plane(2 * a)[a]) / d).floor() as usize;
+    let column = |g: u32, axis: usize| {
+        let x = frame.position[g as usize];
+        (index(x[(axis + 1) % 3], (axis + 1) % 3), index(x[(axis + 2) % 3], (axis + 2) % 3))
+    };
+    let mut loads = vec![vec![Vec::new(); N * N]; 3];
+    for c in pairs {
+        let (p, q) = (frame.position[c.i as usize], frame.position[c.j as usize]);
+        let axis = (0..3).max_by(|&a, &b| (q[a] - p[a]).abs().total_cmp(&(q[b] - p[b]).abs())).unwrap();
+        let (u, v) = column(c.i, axis);
+        loads[axis][u * N + v].push(c.normal_force);
+    }
+    for c in frame.wall_contacts.as_ref().unwrap() {
+        let axis = c.wall as usize / 2;
+        let (u, v) = column(c.grain, axis);
+        loads[axis][u * N + v].push(c.force[axis].abs());
+    }
+    for (axis, columns) in loads.iter().enumerate() {
+        let area = extent[(axis + 1) % 3] * extent[(axis + 2) % 3];
+        let mut total = 0.0;
+        for (k, column) in columns.iter().enumerate() {
+            assert_eq!(column.len(), N + 1, "column {k} along {axis}: two walls and {} bonds", N - 1);
+            for f in column {
+                assert!(relative(*f, column[0]) < EXACT, "column {k} along {axis} carries {f:e} N at one contact, {:e} N at another", column[0]);
+            }
+            total += column[0];
+        }
+        assert!(relative(total, PRESSURE * area) < EXACT, "the columns along {axis} carry {total:e} N against p A = {:e} N", PRESSURE * area);
+    }
+}
+
+#[test]
 fn impulses_are_bitwise_equal_on_one_and_two_threads() {
     // 5,000 grains in a box, colliding and falling: thousands of contacts per step, sticking
     // and sliding, and more grains than one chunk of the parallel pair detection takes.
@@ -246,6 +351,67 @@ fn the_shipped_pile_runs_by_contact_dynamics_and_resumes_from_a_checkpoint_bit_f
     assert_eq!(sa, sb, "the resumed run's statistics differ");
     assert_eq!(sa.solver.unwrap().steps_total, 180);
     assert!(!a.wall_contacts.unwrap().is_empty());
+}
+
+#[test]
+fn a_servo_box_resumes_from_a_checkpoint_bit_for_bit_through_a_triaxial_switch() {
+    // 600 grains compacted by the servo box for 150 steps, then its z walls switched to a
+    // strain rate (triaxial): a checkpoint taken after the switch carries the walls' places,
+    // velocities, targets and work, so the resumed run is the uninterrupted one.
+    let s = common::parse(
+        r#"
+seed = 11
+[[material]]
+name = "glass"
+density = 2500.0
+youngs_modulus = 7.0e10
+poisson_ratio = 0.25
+mu_s = 0.4
+restitution = 0.3
+
+[[generate]]
+material = "glass"
+count = 600
+diameter = { min = 0.7e-3, max = 1.4e-3 }
+region = { shape = "box", min = [0.0, 0.0, 0.0], max = [12.0e-3, 12.0e-3, 12.0e-3] }
+
+[[wall]]
+type = "servo_box"
+material = "glass"
+min = [0.0, 0.0, 0.0]
+max = [12.0e-3, 12.0e-3, 12.0e-3]
+pressure = 100.0
+max_speed = 0.05
+
+[simulation]
+method = "contact_dynamics"
+gravity = [0.0, 0.0, 0.0]
+dt = 1.0e-4
+
+[contact_dynamics]
+tolerance = 1.0e-4
+max_iterations = 200
+
+[[stage]]
+kind = "run"
+duration = 0.02
+"#,
+    );
+    let engine = || grains::runner::cpu_engine(&s, "f64").unwrap();
+    let mut first = engine();
+    first.advance(150).unwrap();
+    first.set_servo(None, Some(0.5));
+    first.advance(20).unwrap();
+    let saved = first.save().unwrap();
+    first.advance(30).unwrap();
+    let mut resumed = engine();
+    resumed.restore(&saved).unwrap();
+    resumed.advance(30).unwrap();
+    let (sa, sb) = (first.stats().unwrap(), resumed.stats().unwrap());
+    println!("after 200 steps: {} contacts, {} on walls, wall work {:e} J", sa.contacts, sa.wall_contacts, sa.external_work);
+    assert!(sa.wall_contacts > 0 && sa.external_work > 0.0, "the walls reach the grains and work on them");
+    assert_eq!(first.frame(true).unwrap(), resumed.frame(true).unwrap(), "the resumed run differs from the uninterrupted one");
+    assert_eq!(sa, sb, "the resumed run's statistics differ");
 }
 
 #[test]

@@ -4,6 +4,7 @@
 use super::{ContactDynamics, Partner};
 use crate::engine::{ContactRecord, Engine, EngineState, Frame, SimError, Stats, WallContactRecord, WallStats, RATTLER_CONTACTS};
 use crate::real::{Real, Vec3};
+use crate::walls::WallGeom;
 
 /// Encodes a contact's second body for a checkpoint: a grain as its slot, a wall as
 /// `WALL_TAG + index`.
@@ -53,7 +54,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
     fn stats(&mut self) -> Result<Stats, SimError> {
         let n = self.body.len();
         let g = self.gravity.f64();
-        let mut s = Stats { step: self.steps, time: self.time(), rebuilds: self.steps, ..Default::default() };
+        let mut s = Stats { step: self.steps, time: self.time(), rebuilds: self.steps, external_work: self.external_work, ..Default::default() };
         for (b, p) in self.body.iter().zip(&self.prop) {
             let (m, v, w) = (p.mass.f64(), b.vel.f64(), b.omega.f64());
             s.ke_translational += 0.5 * m * b.vel.norm2().f64();
@@ -167,6 +168,14 @@ impl<T: Real> Engine for ContactDynamics<T> {
         s.put_ints("warm_b", warm.iter().map(|((_, b), _)| code(*b)));
         s.put_reals("warm_r", warm.iter().flat_map(|(_, r)| v3(**r)));
         s.put_ints("steps", [self.steps]);
+        // The walls that move: planes' points and every wall's velocity; the servo's targets.
+        s.put_reals("wall_points", self.walls.iter().flat_map(|(g, _)| match g {
+            WallGeom::Plane { point, .. } => v3(*point),
+            _ => [0.0; 3],
+        }));
+        s.put_reals("wall_velocities", self.wall_motion.iter().flat_map(|m| v3(m.vel)));
+        s.put_reals("external_work", [self.external_work]);
+        s.put_reals("servo", self.servo.map_or(Vec::new(), |sv| vec![sv.pressure.f64(), sv.strain_rate.map_or(f64::NAN, |r| r.f64())]));
         // The solver's record since the last statistics read, so that a resumed run's
         // statistics are the uninterrupted run's.
         let r = &self.since_read;
@@ -190,6 +199,20 @@ impl<T: Real> Engine for ContactDynamics<T> {
         let r = s.reals("warm_r", 3 * a.len())?;
         self.warm = a.iter().zip(b).zip(r.chunks_exact(3)).map(|((&a, &b), r)| ((a as u32, if b >= WALL_TAG { Partner::Wall((b - WALL_TAG) as u32) } else { Partner::Grain(b as u32) }), of(r))).collect();
         self.steps = s.ints("steps", Some(1))?[0];
+        let walls = self.walls.len();
+        let (points, velocities) = (s.reals("wall_points", 3 * walls)?, s.reals("wall_velocities", 3 * walls)?);
+        for (w, ((geom, _), motion)) in self.walls.iter_mut().zip(&mut self.wall_motion).enumerate() {
+            if let WallGeom::Plane { point, .. } = geom {
+                *point = of(&points[3 * w..3 * w + 3]);
+            }
+            motion.vel = of(&velocities[3 * w..3 * w + 3]);
+        }
+        self.external_work = s.reals("external_work", 1)?[0];
+        if let Some(sv) = &mut self.servo {
+            let v = s.reals("servo", 2)?;
+            sv.pressure = T::of(v[0]);
+            sv.strain_rate = (!v[1].is_nan()).then(|| T::of(v[1]));
+        }
         let (counts, reals) = (s.ints("solver_counts", Some(5))?, s.reals("solver_reals", 4)?);
         self.since_read = crate::engine::SolverStats {
             steps: counts[0],
@@ -205,8 +228,13 @@ impl<T: Real> Engine for ContactDynamics<T> {
         Ok(())
     }
 
-    fn set_servo(&mut self, _pressure: Option<f64>, _axial_strain_rate: Option<f64>) {
-        // Contact-dynamics scenes have no servo walls (refused at `ContactDynamics::new`).
+    fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
+        if let Some(s) = &mut self.servo {
+            if let Some(p) = pressure {
+                s.pressure = T::of(p);
+            }
+            s.strain_rate = axial_strain_rate.map(T::of);
+        }
     }
 
     fn wet(&mut self, _volume: f64) -> anyhow::Result<()> {

@@ -29,7 +29,8 @@
 //!    falls to the tolerance or the iteration cap is reached; the statistics say which.
 //!    Impulses start from the previous step's (warm start), carried per contact by (grain
 //!    id, partner id or wall) like the DEM engine's history.
-//! 4. Positions by the theta-method: `x += h (theta v^+ + (1 - theta) v^-)`.
+//! 4. Positions by the theta-method: `x += h (theta v^+ + (1 - theta) v^-)`, the servo box's
+//!    walls' too (`servo`: they are bodies pushed by the target pressure).
 //!
 //! The sweep solves the grain pairs colour by colour (`colour`: no two contacts of a colour
 //! share a grain), each colour's contacts at once on the engine's threads, then the wall
@@ -47,6 +48,7 @@ use std::collections::HashMap;
 
 mod colour;
 mod engine;
+mod servo;
 mod solve;
 
 pub use colour::{Schedule, MAX_COLOURS};
@@ -143,6 +145,9 @@ pub struct ContactDynamics<T: Real> {
     prop: Vec<Props<T>>,
     walls: Vec<(WallGeom<T>, u32)>,
     wall_motion: Vec<WallMotion<T>>,
+    servo: Option<servo::ServoWalls<T>>,
+    /// Work of the moving walls on the grains since the start (J).
+    external_work: f64,
     /// `(mu, e)` per pair of materials, row-major.
     coeffs: Vec<(T, T)>,
     n_materials: usize,
@@ -188,8 +193,8 @@ impl<T: Real> ContactDynamics<T> {
         if scene.periodic.iter().any(Option::is_some) {
             return unsupported("a periodic boundary", "bound the grains with walls");
         }
-        if scene.servo.is_some() || scene.walls.iter().any(|w| matches!(w.shape, WallShape::Piston { .. })) {
-            return unsupported("a moving wall (servo box or piston)", "use static walls");
+        if scene.walls.iter().any(|w| matches!(w.shape, WallShape::Piston { .. })) {
+            return unsupported("a piston", "use static walls or a servo box");
         }
         if !matches!(scene.model.cohesion, crate::model::CohesionLaw::None) {
             return unsupported("capillary cohesion", "drop [model] cohesion");
@@ -209,6 +214,13 @@ impl<T: Real> ContactDynamics<T> {
         let prop = (0..n)
             .map(|i| Props { radius: T::of(g.radius[i]), mass: T::of(g.mass[i]), inertia: T::of(0.4 * g.mass[i] * g.radius[i] * g.radius[i]), material: g.material[i] as u32 })
             .collect();
+        let servo = scene.servo.as_ref().map(|b| servo::ServoWalls {
+            walls: b.walls,
+            pressure: T::of(b.pressure),
+            max_speed: T::of(b.max_speed),
+            mass: T::of(params.wall_mass.unwrap_or_else(|| g.mass.iter().sum())),
+            strain_rate: None,
+        });
         Ok(ContactDynamics {
             params,
             h: T::of(scene.time_step.dt),
@@ -219,6 +231,8 @@ impl<T: Real> ContactDynamics<T> {
             prop,
             walls: scene.walls.iter().map(|w| (WallGeom::of(&w.shape), w.material as u32)).collect(),
             wall_motion: vec![WallMotion::default(); scene.walls.len()],
+            servo,
+            external_work: 0.0,
             coeffs,
             n_materials,
             r_max: T::of(g.radius.iter().copied().fold(0.0, f64::max)),
@@ -331,14 +345,17 @@ impl<T: Real> ContactDynamics<T> {
 
     /// Advances one step (see the module's text).
     pub fn step(&mut self) {
+        self.servo_prepare();
         self.detect();
         let h = self.h;
         let theta = T::of(self.params.theta);
         let u_minus = self.normal_velocities();
         let before: Vec<Body<T>> = self.body.clone();
+        let walls_before = self.wall_motion.clone();
         for b in &mut self.body {
             b.vel += self.gravity * h;
         }
+        self.servo_kick();
         self.set_laws(&u_minus);
         let mut contacts = std::mem::take(&mut self.contacts);
         for c in &contacts {
@@ -387,6 +404,7 @@ impl<T: Real> ContactDynamics<T> {
                 self.residual[i] = r;
             }
         }
+        self.servo_move(&walls_before);
         self.steps += 1;
     }
 }

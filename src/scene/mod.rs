@@ -697,7 +697,8 @@ fn validate_method(c: &Complainer, sim: &SimulationSpec, spec: Option<&ContactDy
                 Some(v) => non_negative(c, "contact_dynamics.gap_allowance", v, "give a length in metres, e.g. 0.1 x the mean diameter")?,
                 None => 0.1 * d_mean,
             };
-            Ok(Method::ContactDynamics(CdParams { theta, tolerance, max_iterations, gap_allowance }))
+            let wall_mass = given.wall_mass.map(|m| positive(c, "contact_dynamics.wall_mass", m, "give a mass in kg, or leave it out for the grains' total mass")).transpose()?;
+            Ok(Method::ContactDynamics(CdParams { theta, tolerance, max_iterations, gap_allowance, wall_mass }))
         }
         other => Err(c.invalid("simulation.method", format!("\"{other}\""), "unknown method", "use \"dem\" or \"contact_dynamics\"")),
     }

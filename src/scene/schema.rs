@@ -62,6 +62,8 @@ pub struct ContactDynamicsSpec {
     pub max_iterations: Option<u32>,
     /// Surfaces closer than this (m) are contacts of a step. Default 0.1 x the mean diameter.
     pub gap_allowance: Option<f64>,
+    /// Mass of each servo wall (kg). Default: the grains' total mass.
+    pub wall_mass: Option<f64>,
 }
 
 /// `[[material]]`: one grain or wall material.

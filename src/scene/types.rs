@@ -327,11 +327,13 @@ pub struct CdParams {
     pub max_iterations: u32,
     /// Surfaces closer than this are contacts of the step (m).
     pub gap_allowance: f64,
+    /// Mass of each servo wall (kg); `None`: the grains' total mass.
+    pub wall_mass: Option<f64>,
 }
 
 impl Default for CdParams {
     fn default() -> Self {
-        CdParams { theta: 0.5, tolerance: 1e-6, max_iterations: 1000, gap_allowance: 0.0 }
+        CdParams { theta: 0.5, tolerance: 1e-6, max_iterations: 1000, gap_allowance: 0.0, wall_mass: None }
     }
 }
 
