@@ -2,9 +2,7 @@
 
 use crate::cli::{Backend, BenchBackend, BenchPart, Cli, Command, E0Choice, ExportFormat, FitLaw, Precision, Reorder};
 use anyhow::Context;
-use grains::cpu::CpuEngine;
 use grains::engine::Engine;
-use grains::gpu::GpuEngine;
 use grains::output::Summary;
 use grains::protocol::Progress;
 use grains::scene::{self, Scene};
@@ -214,10 +212,10 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             let scene = scene::load(&scene)?;
             let gpu = grains::gpu::open(adapter.as_deref())?;
             let name = gpu.info.name.clone();
-            let mut g = GpuEngine::new(gpu, &scene)?;
-            let mut c32 = CpuEngine::<f32>::new(&scene)?;
-            let mut c64 = CpuEngine::<f64>::new(&scene)?;
-            let report = grains::compare::compare(&scene, &name, &mut g, &mut c32, &mut c64, steps, checkpoints)?;
+            let mut g = grains::runner::gpu_engine(gpu, &scene)?;
+            let mut c32 = grains::runner::cpu_engine(&scene, "f32")?;
+            let mut c64 = grains::runner::cpu_engine(&scene, "f64")?;
+            let report = grains::compare::compare(&scene, &name, g.as_mut(), c32.as_mut(), c64.as_mut(), steps, checkpoints)?;
             if json {
                 println!("{}", serde_json::to_string(&report)?);
             } else {
@@ -253,7 +251,7 @@ fn progress_bar(json: bool) -> bool {
 
 /// The engine `--backend` and `--precision` ask for.
 fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision: Option<Precision>, quiet: bool) -> anyhow::Result<Box<dyn Engine>> {
-    let gpu = |gpu| -> anyhow::Result<Box<dyn Engine>> { Ok(Box::new(GpuEngine::new(gpu, scene)?)) };
+    let gpu = |gpu| grains::runner::gpu_engine(gpu, scene);
     let cpu = |precision: Option<Precision>| grains::runner::cpu_engine(scene, if precision == Some(Precision::F32) { "f32" } else { "f64" });
     let rigid = matches!(scene.method, grains::scene::Method::ContactDynamics(_));
     if grains::runner::processes() > 1 {
@@ -264,6 +262,8 @@ fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision:
     }
     match backend {
         Backend::Cpu => cpu(precision),
+        // Contact dynamics takes the GPU only when asked: its contacts are found on the host
+        // and crossed over every step, and the wall contacts are swept on one invocation.
         Backend::Auto if rigid => cpu(precision),
         Backend::Gpu => {
             if precision == Some(Precision::F64) {

@@ -45,6 +45,7 @@ pub fn shared(name: &str) -> &'static str {
         "reduce" => include_str!("../shaders/shared/reduce.wgsl"),
         "kick" => include_str!("../shaders/shared/kick.wgsl"),
         "position" => include_str!("../shaders/shared/position.wgsl"),
+        "cd" => include_str!("../shaders/shared/cd.wgsl"),
         other => panic!("no shared WGSL file {other}"),
     }
 }
@@ -71,6 +72,7 @@ const GRID: &[&str] = &["types", "dispatch", "position", "grid"];
 const DETECT: &[&str] = &["types", "dispatch", "position", "grid", "neighbours"];
 const FORCES: &[&str] = &["types", "dispatch", "position", "grid", "model"];
 const WALLS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls"];
+const CD: &[&str] = &["types", "dispatch", "cd"];
 const STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "reduce"];
 
 macro_rules! kernel {
@@ -107,6 +109,14 @@ pub const KERNELS: &[Kernel] = &[
     kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "wall_force": Read, "wall_torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": ReadWrite]),
     kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "control": Read, "pair_rows": ReadWrite]),
     kernel!("reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": ReadWrite]),
+];
+
+/// Contact dynamics' sweep kernels ([`crate::gpu::GpuSweeps`]), in the order a sweep runs them.
+pub const CD_KERNELS: &[Kernel] = &[
+    kernel!("cd_sweep_colour", CD, ["cd": Uniform, "phase": Phase, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "measure": ReadWrite, "sweeps": Read]),
+    kernel!("cd_sweep_tail", CD, ["cd": Uniform, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "wall_vel": ReadWrite, "measure": ReadWrite, "sweeps": Read]),
+    kernel!("cd_measure", CD, ["cd": Uniform, "measure": Read, "blocks": ReadWrite, "sweeps": Read]),
+    kernel!("cd_decide", CD, ["cd": Uniform, "blocks": Read, "sweeps": ReadWrite]),
 ];
 
 /// The kernel of a name.

@@ -47,12 +47,22 @@ pub fn cpu_engine(scene: &Scene, precision: &str) -> anyhow::Result<Box<dyn Engi
     })
 }
 
+/// A GPU engine on an opened device (f32): the DEM kernels, or for a contact-dynamics scene
+/// the host's contact detection with the sweeps on the device.
+pub fn gpu_engine(gpu: crate::gpu::Gpu, scene: &Scene) -> anyhow::Result<Box<dyn Engine>> {
+    if let Method::ContactDynamics(params) = scene.method {
+        let sweeps = crate::gpu::GpuSweeps::new(gpu, scene.grains.len(), scene.walls.len());
+        return Ok(Box::new(ContactDynamics::<f32>::new(scene, params)?.with_sweeps(Box::new(sweeps))));
+    }
+    Ok(Box::new(crate::gpu::GpuEngine::new(gpu, scene)?))
+}
+
 /// The engine a checkpoint was written by: its backend ("cpu" or "gpu", on the adapter whose
 /// name contains `adapter`, or the best one) and precision.
 fn engine_of(scene: &Scene, id: &RunIdentity, adapter: Option<&str>) -> anyhow::Result<Box<dyn Engine>> {
     match id.backend.as_str() {
         "cpu" => cpu_engine(scene, &id.precision),
-        "gpu" => Ok(Box::new(crate::gpu::GpuEngine::new(crate::gpu::open(adapter)?, scene)?)),
+        "gpu" => gpu_engine(crate::gpu::open(adapter)?, scene),
         other => anyhow::bail!("the checkpoint was written by a `{other}` backend, which this grains lacks; fix: resume with the grains that wrote it"),
     }
 }

@@ -73,7 +73,7 @@ fn a_sphere_resting_on_a_plane_carries_exactly_its_weight() {
     let s = scene(0.4, 0.5, [0.0, 0.0, -G], true, dt, &grain([0.0, 0.0, RADIUS], [0.0; 3]));
     let mut cd = ContactDynamics::<f64>::new(&s, PARAMS).unwrap();
     for _ in 0..100 {
-        cd.step();
+        cd.step().unwrap();
     }
     let c = cd.contacts()[0];
     assert_eq!(c.b, Partner::Wall(0));
@@ -91,7 +91,7 @@ fn incline(angle: f64, mu: f64, steps: u64) -> (f64, f64, f64) {
     let s = scene(mu, 0.5, [G * angle.sin(), 0.0, -G * angle.cos()], true, dt, &grain([0.0, 0.0, RADIUS], [0.0; 3]));
     let mut cd = ContactDynamics::<f64>::new(&s, PARAMS).unwrap();
     for _ in 0..steps {
-        cd.step();
+        cd.step().unwrap();
     }
     let b = cd.bodies()[0];
     (b.vel.x, b.omega.y * RADIUS, steps as f64 * dt)
@@ -127,7 +127,7 @@ fn a_column_of_spheres_carries_the_weight_above_each_contact() {
     }
     let mut cd = ContactDynamics::<f64>::new(&s, PARAMS).unwrap();
     for _ in 0..20 {
-        cd.step();
+        cd.step().unwrap();
     }
     let report = cd.report();
     println!("{report:?}");
@@ -156,7 +156,7 @@ fn a_frictionless_head_on_collision_rebounds_at_e_v() {
         let s = scene(0.0, e, [0.0; 3], false, dt, &grains);
         let mut cd = ContactDynamics::<f64>::new(&s, PARAMS).unwrap();
         for _ in 0..10 {
-            cd.step();
+            cd.step().unwrap();
         }
         let (a, b) = (cd.bodies()[0].vel.x, cd.bodies()[1].vel.x);
         println!("e = {e}: velocities {a:e}, {b:e} m/s after the impact");
@@ -271,48 +271,16 @@ duration = 1.0e-3
 #[test]
 fn impulses_are_bitwise_equal_on_one_and_two_threads() {
     // 5,000 grains in a box, colliding and falling: thousands of contacts per step, sticking
-    // and sliding, and more grains than one chunk of the parallel pair detection takes.
-    let mut s = common::parse(
-        r#"
-seed = 3
-[[material]]
-name = "glass"
-density = 2500.0
-youngs_modulus = 7.0e10
-poisson_ratio = 0.25
-mu_s = 0.4
-restitution = 0.5
-
-[[generate]]
-material = "glass"
-count = 5000
-diameter = { min = 0.8e-3, max = 1.2e-3 }
-region = { shape = "box", min = [0.0, 0.0, 0.0], max = [20.0e-3, 20.0e-3, 26.0e-3] }
-random_speed = 0.2
-
-[[wall]]
-type = "box"
-material = "glass"
-min = [0.0, 0.0, 0.0]
-max = [20.0e-3, 20.0e-3, 26.0e-3]
-
-[simulation]
-gravity = [0.0, 0.0, -9.81]
-
-[[stage]]
-kind = "run"
-duration = 1.0e-3
-"#,
-    );
-    s.time_step.dt = 5e-5;
-    // A wide gap allowance lists thousands of contacts per colour, open ones included, so that
-    // each colour is solved on both threads.
-    let params = CdParams { tolerance: 1e-4, max_iterations: 200, gap_allowance: 3e-4, ..CdParams::default() };
+    // and sliding, and more grains than one chunk of the parallel pair detection takes; the
+    // wide gap allowance lists thousands of contacts per colour, so that each colour is solved
+    // on both threads.
+    let s = common::cd::falling_box(5000, [20.0e-3, 20.0e-3, 26.0e-3]);
+    let grains::scene::Method::ContactDynamics(params) = s.method else { panic!("falling_box is a contact-dynamics scene") };
     let run = || {
         let mut cd = ContactDynamics::<f64>::new(&s, params).unwrap();
         let mut loaded = 0;
         for _ in 0..400 {
-            cd.step();
+            cd.step().unwrap();
             loaded += cd.report().loaded;
         }
         let bits: Vec<u64> = cd.bodies().iter().flat_map(|b| [b.pos.x, b.pos.y, b.pos.z, b.vel.x, b.omega.z]).map(f64::to_bits).collect();
@@ -358,45 +326,7 @@ fn a_servo_box_resumes_from_a_checkpoint_bit_for_bit_through_a_triaxial_switch()
     // 600 grains compacted by the servo box for 150 steps, then its z walls switched to a
     // strain rate (triaxial): a checkpoint taken after the switch carries the walls' places,
     // velocities, targets and work, so the resumed run is the uninterrupted one.
-    let s = common::parse(
-        r#"
-seed = 11
-[[material]]
-name = "glass"
-density = 2500.0
-youngs_modulus = 7.0e10
-poisson_ratio = 0.25
-mu_s = 0.4
-restitution = 0.3
-
-[[generate]]
-material = "glass"
-count = 600
-diameter = { min = 0.7e-3, max = 1.4e-3 }
-region = { shape = "box", min = [0.0, 0.0, 0.0], max = [12.0e-3, 12.0e-3, 12.0e-3] }
-
-[[wall]]
-type = "servo_box"
-material = "glass"
-min = [0.0, 0.0, 0.0]
-max = [12.0e-3, 12.0e-3, 12.0e-3]
-pressure = 100.0
-max_speed = 0.05
-
-[simulation]
-method = "contact_dynamics"
-gravity = [0.0, 0.0, 0.0]
-dt = 1.0e-4
-
-[contact_dynamics]
-tolerance = 1.0e-4
-max_iterations = 200
-
-[[stage]]
-kind = "run"
-duration = 0.02
-"#,
-    );
+    let s = common::cd::servo_box();
     let engine = || grains::runner::cpu_engine(&s, "f64").unwrap();
     let mut first = engine();
     first.advance(150).unwrap();

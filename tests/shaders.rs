@@ -3,7 +3,7 @@
 //! and field offsets.
 
 use grains::gpu::layout;
-use grains::kernels::{Access, KERNELS};
+use grains::kernels::{Access, CD_KERNELS, KERNELS};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::mem::{offset_of, size_of};
 
@@ -13,7 +13,7 @@ fn module(wgsl: &str, name: &str) -> naga::Module {
 
 #[test]
 fn every_kernel_parses_and_validates() {
-    for k in KERNELS {
+    for k in KERNELS.iter().chain(CD_KERNELS) {
         let src = k.wgsl();
         let m = module(&src, k.name);
         Validator::new(ValidationFlags::all(), Capabilities::default())
@@ -27,7 +27,7 @@ fn every_kernel_parses_and_validates() {
 
 #[test]
 fn the_kernel_table_matches_each_shaders_bindings() {
-    for k in KERNELS {
+    for k in KERNELS.iter().chain(CD_KERNELS) {
         let m = module(&k.wgsl(), k.name);
         let mut declared: Vec<(u32, String, Access)> = m
             .global_variables
@@ -111,6 +111,21 @@ fn rust_mirrors_match_the_wgsl_structures() {
     assert_eq!(constant("NONE"), layout::NONE);
     for (name, slot) in [("ARGS_GRAINS", layout::args::GRAINS), ("ARGS_HASH", layout::args::HASH), ("ARGS_HASH_BLOCKS", layout::args::HASH_BLOCKS), ("ARGS_GRAIN_BLOCKS", layout::args::GRAIN_BLOCKS), ("ARGS_ONE", layout::args::ONE), ("ARGS_OLD_PAIRS", layout::args::OLD_PAIRS), ("ARGS_PAIRS", layout::args::PAIRS), ("ARGS_NEW_PAIRS", layout::args::NEW_PAIRS), ("ARGS_GRAIN_STARTS", layout::args::GRAIN_STARTS), ("ARGS_SLOTS", layout::args::SLOTS)] {
         assert_eq!(constant(name) as u64, slot, "{name}");
+    }
+}
+
+#[test]
+fn contact_dynamics_mirrors_match_the_wgsl_structures() {
+    let src = format!("{}\n{}", grains::kernels::shared("types"), grains::kernels::shared("cd"));
+    let m = module(&format!("{src}\n@group(0) @binding(0) var<storage, read_write> c: array<CdContact>;\n@group(0) @binding(1) var<uniform> p: CdParams;\n@group(0) @binding(2) var<uniform> k: CdColour;\n@group(0) @binding(3) var<storage, read_write> s: CdControl;\n@compute @workgroup_size(1) fn main() {{ s.iterations = p.n_contacts + k.start + c[0].a; }}"), "cd");
+    check_struct!(&m, layout::CdContact, "CdContact", [a, b, to_wall, _pad0, n, radius_a, radius_b, mu, w_n, w_t, inv_mass_a, inv_inertia_a, inv_mass_b, inv_inertia_b, _pad1, _pad2, _pad3]);
+    check_struct!(&m, layout::CdParams, "CdParams", [n_contacts, tail, n_blocks, max_iterations, tolerance, _pad0, _pad1, _pad2]);
+    check_struct!(&m, layout::CdColour, "CdColour", [start, end, _pad0, _pad1]);
+    check_struct!(&m, layout::CdControl, "CdControl", [iterations, converged, done, _pad0, relative_change, _pad1, _pad2, _pad3]);
+    let (_, c) = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some("MEASURE_BLOCK")).expect("MEASURE_BLOCK");
+    match m.global_expressions[c.init] {
+        naga::Expression::Literal(naga::Literal::U32(v)) => assert_eq!(v as usize, grains::cd::MEASURE_BLOCK),
+        ref e => panic!("MEASURE_BLOCK: {e:?}"),
     }
 }
 

@@ -26,7 +26,7 @@ impl<T: Real> ContactDynamics<T> {
 
 impl<T: Real> Engine for ContactDynamics<T> {
     fn backend(&self) -> &'static str {
-        "cpu"
+        self.sweeps.backend()
     }
     fn precision(&self) -> &'static str {
         T::NAME
@@ -43,7 +43,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
 
     fn advance(&mut self, n: u64) -> Result<(), SimError> {
         for _ in 0..n {
-            self.step();
+            self.step()?;
         }
         match self.first_non_finite() {
             Some(grain) => Err(SimError::Unstable { step: self.steps, time: self.time(), what: "the state is not finite".into(), grain, suggested_dt: 0.5 * self.h.f64(), also: ", or raise contact_dynamics.max_iterations" }),

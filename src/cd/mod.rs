@@ -38,6 +38,7 @@
 //! the same bits on any thread count.
 
 use crate::cpu::{Body, PairList, Props};
+use crate::engine::SimError;
 use crate::periodic::Periodic;
 use crate::position;
 use crate::real::{Real, Vec3};
@@ -52,6 +53,7 @@ mod servo;
 mod solve;
 
 pub use colour::{Schedule, MAX_COLOURS};
+pub use solve::{CpuSweeps, MEASURE_BLOCK};
 
 /// The second body of a contact.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -133,6 +135,31 @@ pub struct SolveReport {
     pub unbalanced: f64,
 }
 
+/// What the sweeps of one step did.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Solved {
+    /// Sweeps run.
+    pub iterations: u32,
+    /// Whether the relative change fell to the tolerance within the cap.
+    pub converged: bool,
+    /// Relative change of the impulses in the last sweep (-).
+    pub relative_change: f64,
+}
+
+/// Where a step's Gauss-Seidel sweeps run: on the CPU's threads ([`CpuSweeps`]) or on a GPU
+/// (`crate::gpu::GpuSweeps`). Both sweep the contacts in the schedule's order (colour by
+/// colour, then the serial tail) and sum the convergence measure as
+/// [`MEASURE_BLOCK`] says, so they give the same bits wherever the arithmetic is IEEE's.
+pub trait Sweeps<T: Real>: Send {
+    /// "cpu" or "gpu".
+    fn backend(&self) -> &'static str;
+    /// Sweeps the contacts, whose impulses (the warm start) the bodies' velocities already
+    /// hold, until the impulses' relative change falls to `tolerance` or `max_iterations`
+    /// sweeps have run; leaves the impulses in `contacts` and the velocities in `body` and
+    /// `walls`.
+    fn solve(&mut self, contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], tolerance: T, max_iterations: u32) -> Result<Solved, SimError>;
+}
+
 /// A contact-dynamics system: rigid spheres, static walls, the step's contacts.
 pub struct ContactDynamics<T: Real> {
     params: CdParams,
@@ -154,7 +181,7 @@ pub struct ContactDynamics<T: Real> {
     r_max: T,
     contacts: Vec<Contact<T>>,
     schedule: Schedule,
-    scratch: solve::Scratch<T>,
+    sweeps: Box<dyn Sweeps<T>>,
     /// Last step's impulses by (grain id, partner grain id or wall), for the warm start.
     warm: HashMap<(u32, Partner), Vec3<T>>,
     report: SolveReport,
@@ -238,13 +265,18 @@ impl<T: Real> ContactDynamics<T> {
             r_max: T::of(g.radius.iter().copied().fold(0.0, f64::max)),
             contacts: Vec::new(),
             schedule: Schedule::default(),
-            scratch: solve::Scratch::default(),
+            sweeps: Box::new(CpuSweeps::default()),
             warm: HashMap::new(),
             report: SolveReport::default(),
             since_read: Default::default(),
             steps: 0,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
         })
+    }
+
+    /// The same system with its sweeps run by `sweeps` (a GPU's, say).
+    pub fn with_sweeps(self, sweeps: Box<dyn Sweeps<T>>) -> Self {
+        ContactDynamics { sweeps, ..self }
     }
 
     /// The grains' states, by id (slots are ids here).
@@ -343,8 +375,9 @@ impl<T: Real> ContactDynamics<T> {
         }
     }
 
-    /// Advances one step (see the module's text).
-    pub fn step(&mut self) {
+    /// Advances one step (see the module's text); fails only when a GPU running the sweeps
+    /// does.
+    pub fn step(&mut self) -> Result<(), SimError> {
         self.servo_prepare();
         self.detect();
         let h = self.h;
@@ -368,14 +401,8 @@ impl<T: Real> ContactDynamics<T> {
             }
         }
         let mut report = SolveReport { contacts: contacts.len(), colours: self.schedule.starts.len().saturating_sub(1), largest_colour: self.schedule.colours().map(|r| r.len()).max().unwrap_or(0), serial: contacts.len() - self.schedule.tail(), ..Default::default() };
-        while report.iterations < self.params.max_iterations {
-            report.iterations += 1;
-            report.relative_change = solve::sweep(&mut contacts, &self.schedule, &mut self.body, &mut self.wall_motion, &mut self.scratch);
-            if report.relative_change <= self.params.tolerance {
-                report.converged = true;
-                break;
-            }
-        }
+        let solved = self.sweeps.solve(&mut contacts, &self.schedule, &mut self.body, &mut self.wall_motion, T::of(self.params.tolerance), self.params.max_iterations)?;
+        (report.iterations, report.converged, report.relative_change) = (solved.iterations, solved.converged, solved.relative_change);
         // Force balance of the grains, and the warm start of the next step.
         let loaded: Vec<T> = contacts.iter().map(|c| c.r.dot(c.n)).filter(|&r_n| r_n > T::ZERO).collect();
         report.loaded = loaded.len();
@@ -406,5 +433,6 @@ impl<T: Real> ContactDynamics<T> {
         }
         self.servo_move(&walls_before);
         self.steps += 1;
+        Ok(())
     }
 }

@@ -2,7 +2,8 @@
 //! module text of [`super`]), colour by colour in parallel, then the serial tail.
 
 use super::colour::Schedule;
-use super::{Contact, Partner, WallMotion};
+use super::{Contact, Partner, Solved, Sweeps, WallMotion};
+use crate::engine::SimError;
 use crate::cpu::reduce::PAR_MIN_PAIRS;
 use crate::cpu::Body;
 use crate::real::{Real, Vec3};
@@ -60,7 +61,7 @@ fn local<T: Real>(c: &Contact<T>, a: &Body<T>, b: &Body<T>) -> Vec3<T> {
 
 /// Solves contact `c` between bodies `a` and `b` one after the other: its new impulse, applied;
 /// returns its share of the convergence measure.
-fn solve_serial<T: Real>(c: &mut Contact<T>, a: &mut Body<T>, b: &mut Body<T>) -> (f64, f64) {
+fn solve_serial<T: Real>(c: &mut Contact<T>, a: &mut Body<T>, b: &mut Body<T>) -> (T, T) {
     let r = local(c, a, b);
     apply_a(c, a, r - c.r);
     apply_b(c, b, r - c.r);
@@ -70,8 +71,25 @@ fn solve_serial<T: Real>(c: &mut Contact<T>, a: &mut Body<T>, b: &mut Body<T>) -
 }
 
 /// `(|r - r_old|, |r|)` (N s), a contact's share of the convergence measure.
-fn measure<T: Real>(r: Vec3<T>, r_old: Vec3<T>) -> (f64, f64) {
-    ((r - r_old).norm().f64(), r.norm().f64())
+fn measure<T: Real>(r: Vec3<T>, r_old: Vec3<T>) -> (T, T) {
+    ((r - r_old).norm(), r.norm())
+}
+
+/// Contacts per block of the convergence measure's sum: each block is summed in contact order,
+/// then the blocks' sums in order (the GPU's `cd_measure` and `cd_decide` add the same way).
+pub const MEASURE_BLOCK: usize = 256;
+
+/// The relative change `sum |r - r_old| / sum |r|` of a sweep's per-contact measures, summed
+/// block by block ([`MEASURE_BLOCK`]) in contact order; 0 when no contact carries an impulse.
+pub(super) fn relative_change<T: Real>(sums: &[(T, T)]) -> T {
+    let add = |(c, t): (T, T), &(dc, dt): &(T, T)| (c + dc, t + dt);
+    let blocks: Vec<(T, T)> = sums.chunks(MEASURE_BLOCK).map(|b| b.iter().fold((T::ZERO, T::ZERO), add)).collect();
+    let (change, total) = blocks.iter().fold((T::ZERO, T::ZERO), add);
+    if total > T::ZERO {
+        change / total
+    } else {
+        T::ZERO
+    }
 }
 
 /// Grains per task when a colour's impulse changes are applied.
@@ -81,23 +99,22 @@ const APPLY_CHUNK: usize = 4096;
 #[derive(Default)]
 pub(super) struct Scratch<T> {
     /// `(|r - r_old|, |r|)` (N s).
-    sums: Vec<(f64, f64)>,
+    sums: Vec<(T, T)>,
     /// `r - r_old` (N s).
     change: Vec<Vec3<T>>,
 }
 
 /// One sweep over every contact in the schedule's order; returns the relative change of the
-/// impulses, `sum |r - r_old| / sum |r|` (0 when no contact carries any), summed in the
-/// schedule's order whatever the thread count.
+/// impulses ([`relative_change`]), summed in the schedule's order whatever the thread count.
 ///
 /// A colour large enough to share is solved in two passes: every contact's new impulse from the bodies as the colour
 /// found them (in parallel over the contacts), then the changes applied (in parallel over
 /// chunks of grains, each grain touched by one contact of the colour at most). Since no two
 /// contacts of a colour share a grain, this gives the bits of solving them one after the other.
-pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], scratch: &mut Scratch<T>) -> f64 {
+pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], scratch: &mut Scratch<T>) -> T {
     let n = contacts.len();
     scratch.sums.clear();
-    scratch.sums.resize(n, (0.0, 0.0));
+    scratch.sums.resize(n, (T::ZERO, T::ZERO));
     scratch.change.clear();
     scratch.change.resize(n, Vec3::ZERO);
     for (k, range) in schedule.colours().enumerate() {
@@ -149,11 +166,32 @@ pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, b
             }
         };
     }
-    let (change, total) = scratch.sums.iter().fold((0.0, 0.0), |(c, t), &(dc, dt)| (c + dc, t + dt));
-    if total > 0.0 {
-        change / total
-    } else {
-        0.0
+    relative_change(&scratch.sums)
+}
+
+/// The sweeps on the CPU's threads.
+#[derive(Default)]
+pub struct CpuSweeps<T> {
+    scratch: Scratch<T>,
+}
+
+impl<T: Real> Sweeps<T> for CpuSweeps<T> {
+    fn backend(&self) -> &'static str {
+        "cpu"
+    }
+
+    fn solve(&mut self, contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], tolerance: T, max_iterations: u32) -> Result<Solved, SimError> {
+        let mut solved = Solved::default();
+        while solved.iterations < max_iterations {
+            solved.iterations += 1;
+            let change = sweep(contacts, schedule, body, walls, &mut self.scratch);
+            solved.relative_change = change.f64();
+            if change <= tolerance {
+                solved.converged = true;
+                break;
+            }
+        }
+        Ok(solved)
     }
 }
 

@@ -1,7 +1,7 @@
 //! Adapters and devices: listing, choosing the best (or a named) adapter, opening it with its
 //! own limits rather than WebGPU's defaults.
 
-use crate::kernels::{Access, KERNELS};
+use crate::kernels::{Access, CD_KERNELS, KERNELS};
 
 /// Backends tried: Vulkan (every desktop OS, and lavapipe without a GPU), Metal, DX12. GL is
 /// left out: it lacks the storage-buffer counts the kernels need, and with it a missing
@@ -81,7 +81,7 @@ fn rank(t: wgpu::DeviceType) -> u32 {
 
 /// Storage buffers the busiest kernel binds.
 pub fn storage_buffers_needed() -> u64 {
-    KERNELS.iter().map(|k| k.bindings.iter().filter(|(_, a)| matches!(a, Access::Read | Access::ReadWrite)).count() as u64).max().unwrap_or(0)
+    KERNELS.iter().chain(CD_KERNELS).map(|k| k.bindings.iter().filter(|(_, a)| matches!(a, Access::Read | Access::ReadWrite)).count() as u64).max().unwrap_or(0)
 }
 
 /// Opens the best adapter, or the first whose name contains `name` (case-insensitive).

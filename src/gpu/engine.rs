@@ -14,7 +14,7 @@ use super::device::Gpu;
 use encode::Size;
 use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, SCAN_BLOCK, STAT_ROW};
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
-use crate::kernels::{Access, KERNELS};
+use crate::kernels::KERNELS;
 use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness};
 use super::plan::{Dispatch, Entry, Plans};
 use crate::schedule::{Op, Schedule, Trace};
@@ -107,7 +107,7 @@ impl GpuEngine {
             if need > have { Err(GpuSetupError::Limit { adapter: adapter.clone(), what, need, have, fix }) } else { Ok(()) }
         };
         if let crate::scene::Method::ContactDynamics(_) = scene.method {
-            anyhow::bail!("{}: simulation.method = \"contact_dynamics\" runs on the CPU only so far; fix: use --backend cpu", scene.path.display());
+            anyhow::bail!("{}: simulation.method = \"contact_dynamics\" has no DEM kernels; fix: build its engine with grains::runner::gpu_engine", scene.path.display());
         }
         let binding = gpu.limits.max_storage_buffer_binding_size;
         limit("walls", scene.walls.len() as u64, MAX_WALLS as u64, "split the container into at most 8 walls or use --backend cpu")?;
@@ -404,43 +404,13 @@ impl GpuEngine {
         let orientation = ("TRACK_ORIENTATION", self.track_orientation as u8 as f64);
         let wall_response = ("WALL_RESPONSE", self.servo.is_some() as u8 as f64);
         for k in KERNELS {
-            let entries: Vec<wgpu::BindGroupLayoutEntry> = k
-                .bindings
-                .iter()
-                .enumerate()
-                .map(|(i, (_, access))| wgpu::BindGroupLayoutEntry {
-                    binding: i as u32,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: match access {
-                            Access::Uniform | Access::Phase => wgpu::BufferBindingType::Uniform,
-                            Access::Read => wgpu::BufferBindingType::Storage { read_only: true },
-                            Access::ReadWrite => wgpu::BufferBindingType::Storage { read_only: false },
-                        },
-                        has_dynamic_offset: *access == Access::Phase,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                })
-                .collect();
-            let device = &self.gpu.device;
-            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(k.name), entries: &entries });
-            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor { label: Some(k.name), bind_group_layouts: &[Some(&layout)], ..Default::default() });
-            let module = device.create_shader_module(wgpu::ShaderModuleDescriptor { label: Some(k.name), source: wgpu::ShaderSource::Wgsl(k.wgsl().into()) });
             let mut constants: Vec<(&str, f64)> = if k.includes.contains(&"model") { model_constants.to_vec() } else { Vec::new() };
             match k.name {
                 "integrate" => constants.push(orientation),
                 "wall_contacts" => constants.push(wall_response),
                 _ => {}
             }
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(k.name),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(k.name),
-                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, zero_initialize_workgroup_memory: true },
-                cache: None,
-            });
+            let (layout, pipeline) = super::pipeline::compute_pipeline(&self.gpu.device, k, &constants);
             self.layouts.insert(k.name, layout);
             self.pipelines.insert(k.name, pipeline);
         }
@@ -465,22 +435,11 @@ impl GpuEngine {
                 vec![(k.name.to_string(), vec![])]
             };
             for (key, aliases) in instances {
-                let entries: Vec<wgpu::BindGroupEntry> = k
-                    .bindings
-                    .iter()
-                    .enumerate()
-                    .map(|(i, (name, access))| {
-                        let buffer_name = aliases.iter().find(|(a, _)| a == name).map_or(*name, |(_, b)| *b);
-                        let buffer = self.buffers.get(buffer_name).unwrap_or_else(|| panic!("kernel {} binds {buffer_name}, which the engine lacks", k.name));
-                        let resource = if *access == Access::Phase {
-                            wgpu::BindingResource::Buffer(wgpu::BufferBinding { buffer, offset: 0, size: wgpu::BufferSize::new(std::mem::size_of::<Phase>() as u64) })
-                        } else {
-                            buffer.as_entire_binding()
-                        };
-                        wgpu::BindGroupEntry { binding: i as u32, resource }
-                    })
-                    .collect();
-                let bg = self.gpu.device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(&key), layout: &self.layouts[k.name], entries: &entries });
+                let buffer = |name: &str| {
+                    let buffer_name = aliases.iter().find(|(a, _)| *a == name).map_or(name, |(_, b)| *b);
+                    self.buffers.get(buffer_name).unwrap_or_else(|| panic!("kernel {} binds {buffer_name}, which the engine lacks", k.name))
+                };
+                let bg = super::pipeline::bind_group(&self.gpu.device, &key, k, &self.layouts[k.name], buffer, std::mem::size_of::<Phase>() as u64);
                 self.bind_groups.insert(key, bg);
             }
         }

@@ -283,3 +283,101 @@ pub mod args {
     /// Slots.
     pub const SLOTS: u64 = 9;
 }
+
+/// A contact of contact dynamics' sweeps (WGSL `CdContact`, `shaders/shared/cd.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CdContact {
+    /// First body: a grain.
+    pub a: u32,
+    /// Second body: a grain, or a wall's index when `to_wall` is 1.
+    pub b: u32,
+    /// 1 when `b` is a wall.
+    pub to_wall: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Unit normal from `a` to `b` (xyz); w: `u_min` (m/s).
+    pub n: [f32; 4],
+    /// m.
+    pub radius_a: f32,
+    /// m (0 for a wall).
+    pub radius_b: f32,
+    /// Friction coefficient.
+    pub mu: f32,
+    /// Normal Delassus diagonal (1/kg).
+    pub w_n: f32,
+    /// Tangential Delassus diagonal (1/kg).
+    pub w_t: f32,
+    /// 1/kg.
+    pub inv_mass_a: f32,
+    /// 1/(kg m^2).
+    pub inv_inertia_a: f32,
+    /// 1/kg.
+    pub inv_mass_b: f32,
+    /// 1/(kg m^2).
+    pub inv_inertia_b: f32,
+    /// Padding.
+    pub _pad1: f32,
+    /// Padding.
+    pub _pad2: f32,
+    /// Padding.
+    pub _pad3: f32,
+}
+
+/// The sweeps' constants (WGSL `CdParams`, a uniform).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CdParams {
+    /// Contacts.
+    pub n_contacts: u32,
+    /// First contact of the serial tail.
+    pub tail: u32,
+    /// Blocks of the convergence measure.
+    pub n_blocks: u32,
+    /// Sweeps at most.
+    pub max_iterations: u32,
+    /// Relative change at which the sweeps stop (-).
+    pub tolerance: f32,
+    /// Padding.
+    pub _pad0: f32,
+    /// Padding.
+    pub _pad1: f32,
+    /// Padding.
+    pub _pad2: f32,
+}
+
+/// A colour's contacts `start..end` (WGSL `CdColour`, a uniform at a dynamic offset).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CdColour {
+    /// First contact.
+    pub start: u32,
+    /// One past the last.
+    pub end: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+}
+
+/// Where the sweeps stand (WGSL `CdControl`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CdControl {
+    /// Sweeps run.
+    pub iterations: u32,
+    /// 1: the relative change fell to the tolerance.
+    pub converged: u32,
+    /// 1: converged or at the cap.
+    pub done: u32,
+    /// Padding.
+    pub _pad0: u32,
+    /// Relative change of the last sweep (-).
+    pub relative_change: f32,
+    /// Padding.
+    pub _pad1: f32,
+    /// Padding.
+    pub _pad2: f32,
+    /// Padding.
+    pub _pad3: f32,
+}

@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code, reason = "each test binary uses a different subset")]
 
+pub mod cd;
+
 use grains::checkpoint::EngineState;
 use grains::cpu::CpuEngine;
 use grains::engine::{Engine, Frame, Stats};

@@ -21,36 +21,8 @@ impl GpuEngine {
     /// (every type the kernels share is 4-byte aligned); a device that fails to answer is a
     /// [`SimError::Device`] naming the buffers.
     pub(super) fn read(&self, parts: &[(&str, u64, u64)]) -> Result<Vec<Vec<u32>>, SimError> {
-        let failed = |reason: String| SimError::Device { what: parts.iter().map(|p| p.0).collect::<Vec<_>>().join(", "), reason };
-        let total: u64 = parts.iter().map(|p| p.2.next_multiple_of(4)).sum();
-        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: total.max(4),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        let mut at = 0;
-        for &(name, offset, bytes) in parts {
-            encoder.copy_buffer_to_buffer(&self.buffers[name], offset, &staging, at, bytes.next_multiple_of(4));
-            at += bytes.next_multiple_of(4);
-        }
-        self.gpu.queue.submit([encoder.finish()]);
-        let (sent, mapped) = std::sync::mpsc::channel();
-        staging.slice(..).map_async(wgpu::MapMode::Read, move |r| {
-            // The receiver waits below; a send fails only if it is gone, and then nobody asks.
-            sent.send(r).ok();
-        });
-        self.gpu.device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| failed(e.to_string()))?;
-        mapped.recv().map_err(|e| failed(e.to_string()))?.map_err(|e| failed(e.to_string()))?;
-        let view = staging.slice(..).get_mapped_range().map_err(|e| failed(e.to_string()))?;
-        let mut out = Vec::new();
-        let mut at = 0usize;
-        for &(_, _, bytes) in parts {
-            out.push(bytemuck::pod_collect_to_vec(&view[at..at + bytes as usize]));
-            at += bytes.next_multiple_of(4) as usize;
-        }
-        Ok(out)
+        let buffers: Vec<(&wgpu::Buffer, u64, u64)> = parts.iter().map(|&(name, offset, bytes)| (&self.buffers[name], offset, bytes)).collect();
+        super::super::pipeline::read_back(&self.gpu, &buffers).map_err(|reason| SimError::Device { what: parts.iter().map(|p| p.0).collect::<Vec<_>>().join(", "), reason })
     }
 
     /// Reads the control flags and counters back (and keeps them).

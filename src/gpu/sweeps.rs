@@ -1,0 +1,192 @@
+//! Contact dynamics' Gauss-Seidel sweeps on the GPU: the host detects the step's contacts,
+//! colours them and sets their laws (`crate::cd`), then this uploads them with the grains'
+//! velocities and runs the sweeps as the CPU does: per sweep one dispatch per colour
+//! (`cd_sweep_colour`, a colour's contacts at once), the serial tail on one invocation
+//! (`cd_sweep_tail`), the convergence measure summed by blocks (`cd_measure`) and the decision
+//! (`cd_decide`), which stops every later dispatch once the tolerance or the cap is reached.
+//! Sweeps are submitted in batches that double from one (a warm-started step often converges
+//! in a few) up to [`MAX_SWEEPS_PER_SUBMIT`]; the host reads four words between batches. The
+//! arithmetic is the CPU's f32 in its order, so on an IEEE device (lavapipe) the impulses and
+//! velocities are the CPU's bits.
+
+use super::device::Gpu;
+use super::layout::{CdColour, CdContact, CdControl, CdParams};
+use super::pipeline::{bind_group, compute_pipeline, read_back};
+use crate::cd::{Contact, Partner, Schedule, Solved, Sweeps, WallMotion, MAX_COLOURS, MEASURE_BLOCK};
+use crate::cpu::Body;
+use crate::engine::SimError;
+use crate::kernels::CD_KERNELS;
+use crate::real::Vec3;
+use std::collections::HashMap;
+
+/// Most sweeps recorded in one submission.
+pub const MAX_SWEEPS_PER_SUBMIT: u32 = 32;
+
+/// The sweeps on a GPU (f32).
+pub struct GpuSweeps {
+    gpu: Gpu,
+    pipelines: HashMap<&'static str, (wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
+    buffers: HashMap<&'static str, wgpu::Buffer>,
+    bind_groups: HashMap<&'static str, wgpu::BindGroup>,
+    /// Contacts the contact buffers hold.
+    capacity: u64,
+    /// Bytes between colours in the `phase` uniform (the device's uniform offset alignment).
+    colour_stride: u64,
+}
+
+impl GpuSweeps {
+    /// The sweeps of a system of `grains` grains and `walls` walls on an opened device.
+    pub fn new(gpu: Gpu, grains: usize, walls: usize) -> Self {
+        let pipelines = CD_KERNELS.iter().map(|k| (k.name, compute_pipeline(&gpu.device, k, &[]))).collect();
+        let colour_stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<CdColour>() as u64);
+        let mut sweeps = GpuSweeps { gpu, pipelines, buffers: HashMap::new(), bind_groups: HashMap::new(), capacity: 0, colour_stride };
+        let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
+        sweeps.buffer("cd", std::mem::size_of::<CdParams>() as u64, uniform);
+        sweeps.buffer("phase", MAX_COLOURS as u64 * colour_stride, uniform);
+        sweeps.buffer("vel", 16 * grains.max(1) as u64, Self::STORAGE);
+        sweeps.buffer("omega", 16 * grains.max(1) as u64, Self::STORAGE);
+        sweeps.buffer("wall_vel", 16 * walls.max(1) as u64, Self::STORAGE);
+        sweeps.buffer("sweeps", std::mem::size_of::<CdControl>() as u64, Self::STORAGE);
+        sweeps.grow(1024);
+        sweeps
+    }
+
+    const STORAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_DST).union(wgpu::BufferUsages::COPY_SRC);
+
+    fn buffer(&mut self, name: &'static str, bytes: u64, usage: wgpu::BufferUsages) {
+        let b = self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size: bytes.max(16), usage, mapped_at_creation: false });
+        self.buffers.insert(name, b);
+    }
+
+    /// Contact buffers for `capacity` contacts, and the bind groups over them.
+    fn grow(&mut self, capacity: u64) {
+        self.capacity = capacity;
+        self.buffer("contacts", capacity * std::mem::size_of::<CdContact>() as u64, Self::STORAGE);
+        self.buffer("impulse", 16 * capacity, Self::STORAGE);
+        self.buffer("measure", 8 * capacity, Self::STORAGE);
+        self.buffer("blocks", 8 * capacity.div_ceil(MEASURE_BLOCK as u64), Self::STORAGE);
+        for k in CD_KERNELS {
+            let bg = bind_group(&self.gpu.device, k.name, k, &self.pipelines[k.name].0, |name| &self.buffers[name], std::mem::size_of::<CdColour>() as u64);
+            self.bind_groups.insert(k.name, bg);
+        }
+    }
+
+    fn write<T: bytemuck::NoUninit>(&self, name: &str, offset: u64, data: &[T]) {
+        if !data.is_empty() {
+            self.gpu.queue.write_buffer(&self.buffers[name], offset, bytemuck::cast_slice(data));
+        }
+    }
+
+    /// Records `sweeps` sweeps over colours of the given sizes.
+    fn record(&self, sweeps: u32, colour_sizes: &[usize], tail: bool, blocks: u64) {
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            let mut dispatch = |name: &str, items: u64, offset: Option<u32>| {
+                let (x, y) = crate::workgroup::groups(items);
+                pass.set_pipeline(&self.pipelines[name].1);
+                pass.set_bind_group(0, &self.bind_groups[name], offset.as_slice());
+                pass.dispatch_workgroups(x, y, 1);
+            };
+            for _ in 0..sweeps {
+                for (k, &size) in colour_sizes.iter().enumerate() {
+                    dispatch("cd_sweep_colour", size as u64, Some((k as u64 * self.colour_stride) as u32));
+                }
+                if tail {
+                    dispatch("cd_sweep_tail", 1, None);
+                }
+                if blocks > 0 {
+                    dispatch("cd_measure", blocks, None);
+                }
+                dispatch("cd_decide", 1, None);
+            }
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+    }
+
+    fn read(&self, parts: &[(&str, u64)]) -> Result<Vec<Vec<u32>>, SimError> {
+        let buffers: Vec<(&wgpu::Buffer, u64, u64)> = parts.iter().map(|&(name, bytes)| (&self.buffers[name], 0, bytes)).collect();
+        read_back(&self.gpu, &buffers).map_err(|reason| SimError::Device { what: parts.iter().map(|p| p.0).collect::<Vec<_>>().join(", "), reason })
+    }
+}
+
+/// A contact as the kernels read it.
+fn pack(c: &Contact<f32>) -> CdContact {
+    let (b, to_wall) = match c.b {
+        Partner::Grain(j) => (j, 0),
+        Partner::Wall(w) => (w, 1),
+    };
+    CdContact {
+        a: c.a,
+        b,
+        to_wall,
+        n: [c.n.x, c.n.y, c.n.z, c.u_min],
+        radius_a: c.radius_a,
+        radius_b: c.radius_b,
+        mu: c.mu,
+        w_n: c.w_n,
+        w_t: c.w_t,
+        inv_mass_a: c.inv_mass_a,
+        inv_inertia_a: c.inv_inertia_a,
+        inv_mass_b: c.inv_mass_b,
+        inv_inertia_b: c.inv_inertia_b,
+        ..Default::default()
+    }
+}
+
+fn vec4(v: Vec3<f32>) -> [f32; 4] {
+    [v.x, v.y, v.z, 0.0]
+}
+
+fn vec3(w: &[u32]) -> Vec3<f32> {
+    Vec3::new(f32::from_bits(w[0]), f32::from_bits(w[1]), f32::from_bits(w[2]))
+}
+
+impl Sweeps<f32> for GpuSweeps {
+    fn backend(&self) -> &'static str {
+        "gpu"
+    }
+
+    fn solve(&mut self, contacts: &mut [Contact<f32>], schedule: &Schedule, body: &mut [Body<f32>], walls: &mut [WallMotion<f32>], tolerance: f32, max_iterations: u32) -> Result<Solved, SimError> {
+        let n = contacts.len() as u64;
+        if n > self.capacity {
+            self.grow(n.next_power_of_two());
+        }
+        let blocks = n.div_ceil(MEASURE_BLOCK as u64);
+        let tail = schedule.tail();
+        let params = CdParams { n_contacts: n as u32, tail: tail as u32, n_blocks: blocks as u32, max_iterations, tolerance, ..Default::default() };
+        self.write("cd", 0, &[params]);
+        let colour_sizes: Vec<usize> = schedule.colours().map(|r| r.len()).collect();
+        for (k, range) in schedule.colours().enumerate() {
+            self.write("phase", k as u64 * self.colour_stride, &[CdColour { start: range.start as u32, end: range.end as u32, ..Default::default() }]);
+        }
+        self.write("contacts", 0, &contacts.iter().map(pack).collect::<Vec<_>>());
+        self.write("impulse", 0, &contacts.iter().map(|c| vec4(c.r)).collect::<Vec<_>>());
+        self.write("vel", 0, &body.iter().map(|b| vec4(b.vel)).collect::<Vec<_>>());
+        self.write("omega", 0, &body.iter().map(|b| vec4(b.omega)).collect::<Vec<_>>());
+        self.write("wall_vel", 0, &walls.iter().map(|w| vec4(w.vel)).collect::<Vec<_>>());
+        self.write("sweeps", 0, &[CdControl::default()]);
+        let mut batch = 1;
+        let control = loop {
+            self.record(batch, &colour_sizes, tail < contacts.len(), blocks);
+            let words = self.read(&[("sweeps", std::mem::size_of::<CdControl>() as u64)])?;
+            let control: CdControl = *bytemuck::from_bytes(bytemuck::cast_slice(&words[0]));
+            if control.done != 0 {
+                break control;
+            }
+            batch = (2 * batch).min(MAX_SWEEPS_PER_SUBMIT);
+        };
+        let (grains, nw) = (16 * body.len() as u64, 16 * walls.len() as u64);
+        let out = self.read(&[("impulse", 16 * n), ("vel", grains), ("omega", grains), ("wall_vel", nw)])?;
+        for (c, w) in contacts.iter_mut().zip(out[0].chunks_exact(4)) {
+            c.r = vec3(w);
+        }
+        for ((b, v), o) in body.iter_mut().zip(out[1].chunks_exact(4)).zip(out[2].chunks_exact(4)) {
+            (b.vel, b.omega) = (vec3(v), vec3(o));
+        }
+        for (m, v) in walls.iter_mut().zip(out[3].chunks_exact(4)) {
+            m.vel = vec3(v);
+        }
+        Ok(Solved { iterations: control.iterations, converged: control.converged != 0, relative_change: control.relative_change as f64 })
+    }
+}
