@@ -61,7 +61,10 @@ pub enum BenchPart {
     Ladder,
     /// Steps per second of small scenes (280, 1200 and 10^4 grains), dispatch-bound on a GPU.
     Small,
-    /// Throughput and ladder (not the small scenes).
+    /// Seed 001's isotropic compaction to 100 Pa by DEM and by contact dynamics
+    /// (`--compaction-grains`): wall times, sweeps and contact updates per second.
+    Compaction,
+    /// Throughput and ladder (not the small scenes or the compaction).
     All,
 }
 
@@ -183,6 +186,10 @@ pub enum Command {
         /// Which parts to run.
         #[arg(long, value_enum, default_value = "all")]
         part: BenchPart,
+        /// Grains of the compaction part (its box scaled to hold them as the 8,000-grain sample's
+        /// does).
+        #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u64).range(1..))]
+        compaction_grains: u64,
         /// Folder of the cached bed (default: $XDG_CACHE_HOME/grains or ~/.cache/grains).
         #[arg(long)]
         cache: Option<PathBuf>,

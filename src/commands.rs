@@ -159,7 +159,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Bench { sizes, backend, adapter, precision, threads, reorder, work, repeats, part, cache, bed, out, json } => {
+        Command::Bench { sizes, backend, adapter, precision, threads, reorder, work, repeats, part, compaction_grains, cache, bed, out, json } => {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             let mut threads = if threads.is_empty() { vec![1, cores] } else { threads };
             threads.dedup();
@@ -182,6 +182,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 throughput: matches!(part, BenchPart::Throughput | BenchPart::All),
                 ladder: matches!(part, BenchPart::Ladder | BenchPart::All),
                 small: part == BenchPart::Small,
+                compaction: (part == BenchPart::Compaction).then_some(compaction_grains as usize),
                 cache: cache.unwrap_or_else(grains::bench::bed::default_cache),
                 bed,
                 adapter,

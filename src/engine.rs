@@ -179,6 +179,10 @@ pub struct SolverStats {
     /// Of those, the steps whose solve hit the cap.
     #[serde(default)]
     pub unconverged_total: u64,
+    /// Contact updates (each step's contacts times its sweeps) summed over the steps since the
+    /// last read: the solver's work.
+    #[serde(default)]
+    pub contact_updates: u64,
 }
 
 /// Grains with fewer contacts than this are rattlers: they carry no load, and a rattler

@@ -91,7 +91,7 @@ pub fn load(file: &Path) -> anyhow::Result<Sweep> {
 }
 
 /// Sets `path` (dotted) to `value` in a TOML document.
-fn set(doc: &mut toml::Table, path: &str, value: toml::Value) -> Result<(), String> {
+pub(crate) fn set(doc: &mut toml::Table, path: &str, value: toml::Value) -> Result<(), String> {
     let parts: Vec<&str> = path.split('.').collect();
     let mut here: &mut toml::Table = doc;
     let mut i = 0;

@@ -91,6 +91,6 @@ fn grains_falling_in_a_box_on_the_gpu_follow_the_cpu_f32_twin() {
 #[test]
 fn a_servo_box_on_the_gpu_follows_the_cpu_f32_twin_through_a_triaxial_switch() {
     let s = common::cd::servo_box();
-    let Some(worst) = step_by_step(&s, 200, Some(100)) else { return };
-    assert_tracks(&worst, 200);
+    let Some(worst) = step_by_step(&s, 400, Some(300)) else { return };
+    assert_tracks(&worst, 400);
 }

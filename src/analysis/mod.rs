@@ -24,12 +24,32 @@ pub const BULK_MARGIN_DIAMETERS: f64 = 2.0;
 /// than [`BULK_MIN_HEIGHT_DIAMETERS`] is measured in its bulk, as the peers' benchmark does:
 /// the volume of grains whose centres lie more than [`BULK_MARGIN_DIAMETERS`] from the floor
 /// and the top, over the band's volume. Shallower beds count every grain over the whole span.
+///
+/// A servo box's planes move: its bed is measured in the box where the frame has them, up to
+/// its top plane.
 pub fn packing_fraction(scene: &Scene, frame: &Frame, piston_z: Option<f64>) -> Option<f64> {
-    let area = cross_section(scene.walls.iter().map(|w| &w.shape), &scene.periodic)?;
-    let floor = scene.walls.iter().find_map(|w| match w.shape {
-        WallShape::Plane { point, normal: [0.0, 0.0, 1.0] } => Some(point[2]),
-        _ => None,
-    })?;
+    let shapes: Vec<WallShape> = if scene.servo.is_some() && frame.walls.len() == scene.walls.len() {
+        frame
+            .walls
+            .iter()
+            .zip(&scene.walls)
+            .map(|(now, w)| match now {
+                crate::walls::WallGeom::Plane { point, normal } => WallShape::Plane { point: [point.x, point.y, point.z], normal: [normal.x, normal.y, normal.z] },
+                _ => w.shape.clone(),
+            })
+            .collect()
+    } else {
+        scene.walls.iter().map(|w| w.shape.clone()).collect()
+    };
+    let plane_at = |facing: [f64; 3]| {
+        shapes.iter().find_map(|s| match *s {
+            WallShape::Plane { point, normal } if normal == facing => Some(point[2]),
+            _ => None,
+        })
+    };
+    let area = cross_section(shapes.iter(), &scene.periodic)?;
+    let floor = plane_at([0.0, 0.0, 1.0])?;
+    let piston_z = piston_z.or_else(|| scene.servo.and_then(|_| plane_at([0.0, 0.0, -1.0])));
     let n = frame.radius.len();
     if n == 0 {
         return None;

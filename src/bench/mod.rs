@@ -4,6 +4,7 @@
 
 pub mod bandwidth;
 pub mod bed;
+pub mod compaction;
 pub mod ladder;
 pub mod memory;
 pub mod small;
@@ -40,6 +41,9 @@ pub struct BenchOptions {
     pub ladder: bool,
     /// Run the small-scene part (steps per second at 280, 1200 and 10^4 grains).
     pub small: bool,
+    /// Run the compaction part at this many grains: seed 001's isotropic compaction to 100 Pa
+    /// by DEM and by contact dynamics.
+    pub compaction: Option<usize>,
     /// Where the poured bed is cached.
     pub cache: PathBuf,
     /// A scene whose grains are the bed, in place of the pour (e.g. LAMMPS' settled bed read
@@ -71,8 +75,8 @@ pub struct Machine {
 pub struct BenchReport {
     /// Where it ran.
     pub machine: Machine,
-    /// The bed (poured once, cached).
-    pub bed: BedInfo,
+    /// The bed (poured once, cached); absent when no part ran on it.
+    pub bed: Option<BedInfo>,
     /// Throughput runs.
     pub throughput: Vec<Throughput>,
     /// Speed against error.
@@ -81,6 +85,8 @@ pub struct BenchReport {
     pub small: Vec<small::SmallScene>,
     /// This machine's memory bandwidth at each CPU thread count of the throughput runs.
     pub memory_bandwidth: Vec<Bandwidth>,
+    /// The same compaction by DEM and by contact dynamics.
+    pub compaction: Vec<compaction::Compaction>,
 }
 
 /// The STREAM triad's bandwidth on some threads ([`bandwidth::triad`]).
@@ -125,10 +131,17 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
         }
     };
     let all = pool(0)?;
-    let (base, bed) = match &opts.bed {
-        Some(path) => all.install(|| bed::given_bed(path))?,
-        None => all.install(|| bed::settled_bed(&opts.cache, opts.progress))?,
+    // The bed, for the parts that run on it.
+    let (base, bed) = if opts.throughput || opts.ladder || opts.small {
+        let (base, info) = match &opts.bed {
+            Some(path) => all.install(|| bed::given_bed(path))?,
+            None => all.install(|| bed::settled_bed(&opts.cache, opts.progress))?,
+        };
+        (Some(base), Some(info))
+    } else {
+        (None, None)
     };
+    let base = || base.as_ref().ok_or_else(|| anyhow::anyhow!("the bench bed was not prepared"));
     let machine = machine();
     let mut rows = Vec::new();
     let mut memory_bandwidth = Vec::new();
@@ -156,13 +169,13 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
                         let gpu = crate::gpu::open(opts.adapter.as_deref())?;
                         let device = gpu.info.name.clone();
                         let mut engine = {
-                            let scene = bed::bed_of(&base, n)?;
+                            let scene = bed::bed_of(base()?, n)?;
                             crate::gpu::GpuEngine::new(gpu, &scene)?
                         };
                         throughput::measure(&mut engine, &device, 1, None, warmup, steps, opts.repeats, peak_reset)?
                     } else {
                         pool(threads)?.install(|| -> anyhow::Result<Throughput> {
-                            let mut scene = bed::shuffled(&bed::bed_of(&base, n)?);
+                            let mut scene = bed::shuffled(&bed::bed_of(base()?, n)?);
                             scene.reorder_every = match (reorder, scene.reorder_every) {
                                 (false, _) => 0,
                                 (true, 0) => crate::scene::DEFAULT_REORDER_EVERY,
@@ -178,11 +191,11 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
             }
         }
     }
-    let ladder = if opts.ladder { Some(all.install(|| ladder::ladder(&base, &say))?) } else { None };
+    let ladder = if opts.ladder { Some(all.install(|| ladder::ladder(base()?, &say))?) } else { None };
     let mut small_rows = Vec::new();
     if opts.small {
         let mut scenes: Vec<(String, crate::scene::Scene)> = small::oedometer_scenes()?.into_iter().map(|s| (s.path.display().to_string(), s)).collect();
-        scenes.push(("bench_bed.toml".into(), base.clone()));
+        scenes.push(("bench_bed.toml".into(), base()?.clone()));
         for (name, scene) in &scenes {
             for backend in &opts.backends {
                 let precisions: Vec<String> = if backend == "gpu" { vec!["f32".into()] } else { opts.precisions.clone() };
@@ -205,7 +218,24 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
             }
         }
     }
-    Ok(BenchReport { machine, bed, throughput: rows, ladder, small: small_rows, memory_bandwidth })
+    let mut compactions = Vec::new();
+    if let Some(grains) = opts.compaction {
+        for scene in compaction::scenes(grains)? {
+            for backend in &opts.backends {
+                say(&format!("compaction: {} at {grains} grains on {backend}", scene.path.display()));
+                let row = if backend == "gpu" {
+                    let mut engine = crate::runner::gpu_engine(crate::gpu::open(opts.adapter.as_deref())?, &scene)?;
+                    compaction::measure(&scene, engine.as_mut())?
+                } else {
+                    let threads = opts.threads.iter().copied().max().unwrap_or(1);
+                    pool(threads)?.install(|| compaction::measure(&scene, crate::runner::cpu_engine(&scene, "f64")?.as_mut()))?
+                };
+                say(&format!("  {} steps in {:.1} s, Z = {:.2}", row.steps, row.seconds, row.coordination));
+                compactions.push(row);
+            }
+        }
+    }
+    Ok(BenchReport { machine, bed, throughput: rows, ladder, small: small_rows, memory_bandwidth, compaction: compactions })
 }
 
 impl BenchReport {
@@ -213,16 +243,16 @@ impl BenchReport {
     pub fn human(&self) -> String {
         let m = &self.machine;
         let mut s = format!("machine: {} ({} cores; build features: {}; hot loops at level {})\n", m.cpu, m.cores, if m.build_features.is_empty() { "baseline".to_string() } else { m.build_features.join(", ") }, m.simd_level);
-        if self.bed.source.is_empty() {
-            s.push_str(&format!(
+        match &self.bed {
+            Some(bed) if bed.source.is_empty() => s.push_str(&format!(
                 "bed: the peers' pour, {:.3} s simulated ({}), Z = {:.3} at the end, poured in {:.0} s once and cached\n",
-                self.bed.time,
-                if self.bed.settled { "settled" } else { "not settled" },
-                self.bed.coordination,
-                self.bed.wall_seconds
-            ));
-        } else {
-            s.push_str(&format!("bed: the grains of {}, Z = {:.3} as read\n", self.bed.source, self.bed.coordination));
+                bed.time,
+                if bed.settled { "settled" } else { "not settled" },
+                bed.coordination,
+                bed.wall_seconds
+            )),
+            Some(bed) => s.push_str(&format!("bed: the grains of {}, Z = {:.3} as read\n", bed.source, bed.coordination)),
+            None => {}
         }
         if !self.throughput.is_empty() {
             s.push_str("\nthroughput (dense settled bed, Hertz-Mindlin, dt = 2e-6 s)\n");
@@ -287,6 +317,31 @@ impl BenchReport {
                     r.steps_per_second,
                     spread_percent(&r.repeats, r.steps_per_second),
                     r.dispatches_per_step.map_or("-".to_string(), |d| format!("{d:.1}"))
+                ));
+            }
+        }
+        if !self.compaction.is_empty() {
+            s.push_str("\nthe same compaction to 100 Pa by DEM and by contact dynamics (seed 001's sample scaled to the grains, each scene's settle criteria)\n");
+            s.push_str("method            backend prec thr grains        dt   steps   wall s  settled     Z  pressure Pa  sweeps/step  capped  contact updates/s  sweep share\n");
+            let opt = |x: Option<f64>, digits: usize| x.map_or("-".to_string(), |v| format!("{v:.digits$}"));
+            for r in &self.compaction {
+                s.push_str(&format!(
+                    "{:<17} {:<7} {:<4} {:>3} {:>6} {:>9.2e} {:>7} {:>8.1} {:>8} {:>5.2} {:>12.1} {:>12} {:>7} {:>18} {:>12}\n",
+                    r.method,
+                    r.backend,
+                    r.precision,
+                    r.threads,
+                    r.grains,
+                    r.dt,
+                    r.steps,
+                    r.seconds,
+                    r.settled,
+                    r.coordination,
+                    r.pressure,
+                    opt(r.mean_sweeps, 1),
+                    r.capped_steps.map_or("-".to_string(), |c| c.to_string()),
+                    r.contact_updates_per_second.map_or("-".to_string(), |u| format!("{u:.3e}")),
+                    r.sweep_share.map_or("-".to_string(), |f| format!("{:.0}%", 100.0 * f)),
                 ));
             }
         }

@@ -41,6 +41,14 @@ impl<T: Real> Engine for ContactDynamics<T> {
         self.steps as f64 * self.h.f64()
     }
 
+    fn set_profiling(&mut self, on: bool) {
+        self.clock.enable(on);
+    }
+
+    fn phase_seconds(&self) -> Vec<(&'static str, f64)> {
+        self.clock.totals()
+    }
+
     fn advance(&mut self, n: u64) -> Result<(), SimError> {
         for _ in 0..n {
             self.step()?;
@@ -101,6 +109,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
                 }
             }
         }
+        self.servo_stats(&mut s.walls);
         s.pairs = self.contacts.iter().filter(|c| matches!(c.b, Partner::Grain(_))).count() as u64;
         s.coordination = 2.0 * s.contacts as f64 / n as f64;
         (s.max_overlap, s.max_overlap_grain) = (most, most_grain);
@@ -179,7 +188,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
         // The solver's record since the last statistics read, so that a resumed run's
         // statistics are the uninterrupted run's.
         let r = &self.since_read;
-        s.put_ints("solver_counts", [r.steps, r.unconverged_steps, r.max_iterations as u64, r.steps_total, r.unconverged_total]);
+        s.put_ints("solver_counts", [r.steps, r.unconverged_steps, r.max_iterations as u64, r.steps_total, r.unconverged_total, r.contact_updates]);
         s.put_reals("solver_reals", [r.mean_iterations, r.relative_change, r.unbalanced, self.report.unbalanced]);
         Ok(s)
     }
@@ -213,13 +222,18 @@ impl<T: Real> Engine for ContactDynamics<T> {
             sv.pressure = T::of(v[0]);
             sv.strain_rate = (!v[1].is_nan()).then(|| T::of(v[1]));
         }
-        let (counts, reals) = (s.ints("solver_counts", Some(5))?, s.reals("solver_reals", 4)?);
+        // Five counts in checkpoints from before the contact updates were counted.
+        let (counts, reals) = (s.ints("solver_counts", None)?, s.reals("solver_reals", 4)?);
+        if counts.len() < 5 {
+            anyhow::bail!("the checkpoint's solver record holds {} counts, not 5 or 6; fix: resume with the grains that wrote it", counts.len());
+        }
         self.since_read = crate::engine::SolverStats {
             steps: counts[0],
             unconverged_steps: counts[1],
             max_iterations: counts[2] as u32,
             steps_total: counts[3],
             unconverged_total: counts[4],
+            contact_updates: counts.get(5).copied().unwrap_or(0),
             mean_iterations: reals[0],
             relative_change: reals[1],
             unbalanced: reals[2],

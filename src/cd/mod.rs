@@ -37,6 +37,7 @@
 //! contacts one after the other; the schedule depends on the contacts alone, so a step gives
 //! the same bits on any thread count.
 
+use crate::cpu::profile::{PhaseClock, Phases};
 use crate::cpu::{Body, PairList, Props};
 use crate::engine::SimError;
 use crate::periodic::Periodic;
@@ -189,6 +190,26 @@ pub struct ContactDynamics<T: Real> {
     since_read: crate::engine::SolverStats,
     steps: u64,
     wall_names: Vec<String>,
+    /// Time per phase of the step, when profiling.
+    clock: PhaseClock<CdPhase>,
+}
+
+/// The phases of a contact-dynamics step, for `grains bench`.
+#[derive(Clone, Copy, Debug)]
+pub enum CdPhase {
+    /// The servo's preparation, contact detection, colouring, the warm start and the laws.
+    Detect,
+    /// The Gauss-Seidel sweeps.
+    Sweeps,
+    /// Force balance, the warm start's record, positions and the walls' motion.
+    Integrate,
+}
+
+impl Phases for CdPhase {
+    const NAMES: &'static [&'static str] = &["detect", "sweeps", "integrate"];
+    fn index(self) -> usize {
+        self as usize
+    }
 }
 
 /// Why a scene cannot run by contact dynamics.
@@ -271,6 +292,7 @@ impl<T: Real> ContactDynamics<T> {
             since_read: Default::default(),
             steps: 0,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
+            clock: PhaseClock::default(),
         })
     }
 
@@ -378,6 +400,7 @@ impl<T: Real> ContactDynamics<T> {
     /// Advances one step (see the module's text); fails only when a GPU running the sweeps
     /// does.
     pub fn step(&mut self) -> Result<(), SimError> {
+        let started = self.clock.start();
         self.servo_prepare();
         self.detect();
         let h = self.h;
@@ -400,9 +423,13 @@ impl<T: Real> ContactDynamics<T> {
                 Partner::Wall(w) => self.wall_motion[w as usize].vel = b.vel,
             }
         }
+        self.clock.stop(CdPhase::Detect, started);
+        let started = self.clock.start();
         let mut report = SolveReport { contacts: contacts.len(), colours: self.schedule.starts.len().saturating_sub(1), largest_colour: self.schedule.colours().map(|r| r.len()).max().unwrap_or(0), serial: contacts.len() - self.schedule.tail(), ..Default::default() };
         let solved = self.sweeps.solve(&mut contacts, &self.schedule, &mut self.body, &mut self.wall_motion, T::of(self.params.tolerance), self.params.max_iterations)?;
         (report.iterations, report.converged, report.relative_change) = (solved.iterations, solved.converged, solved.relative_change);
+        self.clock.stop(CdPhase::Sweeps, started);
+        let started = self.clock.start();
         // Force balance of the grains, and the warm start of the next step.
         let loaded: Vec<T> = contacts.iter().map(|c| c.r.dot(c.n)).filter(|&r_n| r_n > T::ZERO).collect();
         report.loaded = loaded.len();
@@ -419,6 +446,7 @@ impl<T: Real> ContactDynamics<T> {
         r.steps_total += 1;
         r.unconverged_total += u64::from(!report.converged);
         r.max_iterations = r.max_iterations.max(report.iterations);
+        r.contact_updates += report.contacts as u64 * u64::from(report.iterations);
         r.relative_change = r.relative_change.max(report.relative_change);
         r.unbalanced = report.unbalanced;
         // Positions by the theta-method.
@@ -433,6 +461,7 @@ impl<T: Real> ContactDynamics<T> {
         }
         self.servo_move(&walls_before);
         self.steps += 1;
+        self.clock.stop(CdPhase::Integrate, started);
         Ok(())
     }
 }

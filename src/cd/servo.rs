@@ -1,10 +1,14 @@
 //! The servo box under contact dynamics. Rigid grains leave no stiffness for a velocity servo
 //! to act through (the DEM engine's servo reads a pressure that a rigid packing would jump
-//! from 0 to anything); so, as in LMGC90's stress-controlled walls, each of the six planes is
-//! a body of mass `M` that translates along its normal, pushed inwards by the target pressure
-//! times its face, and the contacts' impulses hold it: the solve finds the walls' velocities
-//! with the grains', and a wall at rest carries exactly the target pressure. In triaxial mode
-//! the z planes instead close at the strain rate, as prescribed motion (infinite mass).
+//! from 0 to anything); so, as in LMGC90's stress-controlled boxes, the three planes at the
+//! low ends of the axes stand still and each of the other three is a body of mass `M` that
+//! translates along its normal, pushed inwards by the target pressure times its face, and the
+//! contacts' impulses hold it: the solve finds those walls' velocities with the grains', and
+//! a wall at rest carries exactly the target pressure. Three fixed planes hold the packing in
+//! place: with all six free, grains and walls together could drift at any constant velocity
+//! (nothing anchors their momentum), a motion no dissipation stops, and the packing would
+//! never come to rest. In triaxial mode the z_max plane instead closes at the strain rate, as
+//! prescribed motion (infinite mass).
 
 use super::{ContactDynamics, Partner, WallMotion};
 use crate::real::{Real, Vec3};
@@ -21,7 +25,8 @@ pub(super) struct ServoWalls<T> {
     pub(super) max_speed: T,
     /// Each wall's mass (kg).
     pub(super) mass: T,
-    /// Strain rate of the z walls (1/s, positive closing), when they are strain-controlled.
+    /// Strain rate of the box along z (1/s, positive closing), when the z_max wall is
+    /// strain-controlled.
     pub(super) strain_rate: Option<T>,
 }
 
@@ -44,17 +49,35 @@ impl<T: Real> ContactDynamics<T> {
     }
 
     /// Sets the walls' laws for the step (before the contacts are listed: a wall's mass enters
-    /// their Delassus diagonals): each pressure-held wall yields with `1/M`; a strain-controlled
-    /// one moves as prescribed.
+    /// their Delassus diagonals): the low planes stand still, each pressure-held wall yields
+    /// with `1/M`, a strain-controlled one moves as prescribed.
     pub(super) fn servo_prepare(&mut self) {
         let Some(s) = self.servo else { return };
         let extents = self.extents(&s);
         for (k, &w) in s.walls.iter().enumerate() {
             let normal = self.plane(w).1;
             self.wall_motion[w] = match s.strain_rate {
-                Some(rate) if k >= 4 => WallMotion { vel: normal * (rate * extents[2] * T::of(0.5)), inv_mass: T::ZERO },
+                _ if k % 2 == 0 => WallMotion { vel: Vec3::ZERO, inv_mass: T::ZERO },
+                Some(rate) if k == 5 => WallMotion { vel: normal * (rate * extents[2]), inv_mass: T::ZERO },
                 _ => WallMotion { vel: self.wall_motion[w].vel, inv_mass: T::ONE / s.mass },
             };
+        }
+    }
+
+    /// The servo walls' places along their axes (m) and the pressures the grains exert on them
+    /// (Pa): each wall's force (N, on the wall, from `stats`) against its inward normal, over
+    /// its face.
+    pub(super) fn servo_stats(&self, walls: &mut [crate::engine::WallStats]) {
+        let Some(s) = self.servo else { return };
+        let extents = self.extents(&s);
+        for (k, &w) in s.walls.iter().enumerate() {
+            let (point, normal) = self.plane(w);
+            let a = k / 2;
+            let area = (extents[(a + 1) % 3] * extents[(a + 2) % 3]).f64();
+            let n = normal.f64();
+            let f = walls[w].force;
+            walls[w].position = Some([point.x, point.y, point.z][a].f64());
+            walls[w].pressure = Some(-(f[0] * n[0] + f[1] * n[1] + f[2] * n[2]) / area);
         }
     }
 

@@ -17,7 +17,7 @@ mod pairs;
 // What a run over several processes reads and writes of the engine (src/ranks).
 #[cfg(feature = "mpi")]
 mod parts;
-mod profile;
+pub(crate) mod profile;
 pub(crate) mod reduce;
 mod reorder;
 mod snapshot;
@@ -137,7 +137,7 @@ pub struct CpuEngine<T: Real> {
     renumberings: u64,
     external_work: f64,
     /// Time per phase, when profiling.
-    clock: PhaseClock,
+    clock: PhaseClock<Phase>,
 }
 
 impl<T: Real> CpuEngine<T> {
