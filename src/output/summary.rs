@@ -261,10 +261,15 @@ pub fn check_report(scene: &Scene) -> String {
             );
         }
     }
-    let _ = writeln!(s, "Rayleigh time t_R = {:.4e} s", ts.times.rayleigh);
-    let _ = writeln!(s, "Hertz time t_c = {:.4e} s at {:.3e} m/s", ts.times.collision, ts.times.expected_speed);
-    let _ = writeln!(s, "dt = {:.4e} s ({}; {:.3} t_R, t_c/{:.1})", ts.dt, if ts.auto { "auto" } else { "given" }, ts.dt / ts.times.rayleigh, ts.times.collision / ts.dt);
-    let _ = writeln!(s, "skin = {:.4e} m, stats every {} steps, neighbour capacity {}", scene.skin, scene.stats_interval, scene.max_neighbours);
+    if matches!(scene.method, crate::scene::Method::ContactDynamics(_)) {
+        // Rigid grains have no contact time and no neighbour list to keep.
+        let _ = writeln!(s, "dt = {:.4e} s (given; rigid grains: no contact time bounds it), stats every {} steps", ts.dt, scene.stats_interval);
+    } else {
+        let _ = writeln!(s, "Rayleigh time t_R = {:.4e} s", ts.times.rayleigh);
+        let _ = writeln!(s, "Hertz time t_c = {:.4e} s at {:.3e} m/s", ts.times.collision, ts.times.expected_speed);
+        let _ = writeln!(s, "dt = {:.4e} s ({}; {:.3} t_R, t_c/{:.1})", ts.dt, if ts.auto { "auto" } else { "given" }, ts.dt / ts.times.rayleigh, ts.times.collision / ts.dt);
+        let _ = writeln!(s, "skin = {:.4e} m, stats every {} steps, neighbour capacity {}", scene.skin, scene.stats_interval, scene.max_neighbours);
+    }
     for st in &scene.stages {
         let _ = writeln!(s, "stage {}: {:?} for at most {:e} s ({} steps)", st.name, st.kind, st.duration, st.max_steps(ts.dt));
     }
