@@ -73,32 +73,43 @@ fn stats_row(stage: &str, s: &Stats) -> String {
     row
 }
 
-/// A CSV file written row by row and flushed at every stage end.
+/// Wall seconds a written row may wait in memory: a long run's `stats.csv` can be followed
+/// (`tail -f`) while it runs.
+const FLUSH_SECONDS: u64 = 10;
+
+/// A CSV file written row by row, flushed at every stage end and checkpoint and at least every
+/// [`FLUSH_SECONDS`].
 struct Csv {
     path: PathBuf,
     out: BufWriter<File>,
     header_written: bool,
+    flushed: std::time::Instant,
 }
 
 impl Csv {
     fn create(path: PathBuf) -> anyhow::Result<Self> {
         let out = BufWriter::new(File::create(&path).with_context(|| format!("cannot create {}", path.display()))?);
-        Ok(Csv { path, out, header_written: false })
+        Ok(Csv { path, out, header_written: false, flushed: std::time::Instant::now() })
     }
     /// Opens an existing CSV to add rows after a resume.
     fn append(path: PathBuf) -> anyhow::Result<Self> {
         let header_written = path.exists();
         let file = std::fs::OpenOptions::new().create(true).append(true).open(&path).with_context(|| format!("cannot open {}", path.display()))?;
-        Ok(Csv { path, out: BufWriter::new(file), header_written })
+        Ok(Csv { path, out: BufWriter::new(file), header_written, flushed: std::time::Instant::now() })
     }
     fn row(&mut self, stage: &str, s: &Stats) -> anyhow::Result<()> {
         if !self.header_written {
             writeln!(self.out, "{}", stats_header(s))?;
             self.header_written = true;
         }
-        writeln!(self.out, "{}", stats_row(stage, s)).with_context(|| format!("cannot write {}", self.path.display()))
+        writeln!(self.out, "{}", stats_row(stage, s)).with_context(|| format!("cannot write {}", self.path.display()))?;
+        if self.flushed.elapsed().as_secs() >= FLUSH_SECONDS {
+            self.flush()?;
+        }
+        Ok(())
     }
     fn flush(&mut self) -> anyhow::Result<()> {
+        self.flushed = std::time::Instant::now();
         self.out.flush().with_context(|| format!("cannot write {}", self.path.display()))
     }
     /// Flushes and returns the file's name and length (bytes).
