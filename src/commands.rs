@@ -150,7 +150,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             let a = grains::output::network::write(&scene, &frame, &stats, &run)?;
             if let Some(other) = &beside {
                 let (_, other_scene, other_frame) = finished_run(other)?;
-                grains::output::network::write_beside(&scene, &a, &other_scene.name, &other_frame, &run)?;
+                grains::output::network::write_beside(&scene, &a, &other_scene, &other_frame, &run)?;
             }
             if json {
                 println!("{}", serde_json::to_string(&a)?);

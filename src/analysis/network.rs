@@ -123,6 +123,12 @@ pub fn forces_over(frame: &Frame, scale: f64) -> Vec<f64> {
     frame.contacts.as_deref().unwrap_or(&[]).iter().map(|c| c.normal_force).filter(|f| *f != 0.0).map(|f| f / scale.max(1e-300)).collect()
 }
 
+/// The mean of a frame's compressive normal forces (N; 0 without any).
+pub fn mean_compressive_force(frame: &Frame) -> f64 {
+    let compressive: Vec<f64> = forces_over(frame, 1.0).into_iter().filter(|f| *f > 0.0).collect();
+    compressive.iter().sum::<f64>() / compressive.len().max(1) as f64
+}
+
 /// The PDF of normalised forces, on [`PDF_BINS`] bins from the most tensile (or 0) to the
 /// largest (or 1).
 pub fn force_density(normalised: &[f64]) -> Pdf {
@@ -166,7 +172,7 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
     let contacts = frame.contacts.as_deref().unwrap_or(&[]);
     let forces = forces_over(frame, 1.0);
     let compressive: Vec<f64> = forces.iter().copied().filter(|f| *f > 0.0).collect();
-    let mean_c = compressive.iter().sum::<f64>() / compressive.len().max(1) as f64;
+    let mean_c = mean_compressive_force(frame);
     let (scale, scale_is) = match f0 {
         Some(f0) => (f0, "f0 = kappa R_max"),
         None => (mean_c, "mean force"),

@@ -1,6 +1,6 @@
 //! The force-transmission report of a packing: `analysis.json` and its pictures.
 
-use crate::analysis::network::{analyze, force_density, forces_over, NetworkAnalysis};
+use crate::analysis::network::{analyze, force_density, forces_over, mean_compressive_force, NetworkAnalysis};
 use crate::analysis::seed001;
 use crate::analysis::tail::TailFit;
 use crate::analysis::sample_bounds;
@@ -56,14 +56,20 @@ fn force_tails(a: &NetworkAnalysis, wet: bool) -> Vec<Tail> {
     tails
 }
 
-/// Seed 001's Fig. 7: the force PDF of this run and of `other` (named `other_name`, its
-/// frame taken with contacts), both over this run's force scale, as `force_pdf_beside.png`
-/// and `.svg` in `dir`.
-pub fn write_beside(scene: &Scene, a: &NetworkAnalysis, other_name: &str, other: &Frame, dir: &Path) -> anyhow::Result<()> {
-    let theirs = force_density(&forces_over(other, a.force_scale));
-    let densities = [Density { label: scene.name.clone(), pdf: &a.force_pdf }, Density { label: other_name.to_string(), pdf: &theirs }];
-    let tails: Vec<Tail> = force_tails(a, scene.model.cohesion != CohesionLaw::None).into_iter().filter(|t| !t.published).collect();
-    plot::pdf(&dir.join("force_pdf_beside"), &format!("{} and {}: normal forces", scene.name, other_name), &format!("normal force / ({} of {})", a.force_scale_is, scene.name), &densities, &tails)
+/// This run's force PDF beside `other`'s (its scene and frame, taken with contacts), as
+/// `force_pdf_beside.png` and `.svg` in `dir`. Two dry packings (seed 001's Figs. 2-3: MD
+/// beside CD, isotropic beside anisotropic) are each over their own mean force, which compares
+/// the shapes; otherwise both are over this run's force scale (Fig. 7: wet and dry over the
+/// wet run's `f0`).
+pub fn write_beside(scene: &Scene, a: &NetworkAnalysis, other_scene: &Scene, other: &Frame, dir: &Path) -> anyhow::Result<()> {
+    let wet = scene.model.cohesion != CohesionLaw::None;
+    let each_own = !wet && other_scene.model.cohesion == CohesionLaw::None;
+    let other_scale = if each_own { mean_compressive_force(other) } else { a.force_scale };
+    let theirs = force_density(&forces_over(other, other_scale));
+    let densities = [Density { label: scene.name.clone(), pdf: &a.force_pdf }, Density { label: other_scene.name.clone(), pdf: &theirs }];
+    let tails: Vec<Tail> = force_tails(a, wet).into_iter().filter(|t| !t.published).collect();
+    let axis = if each_own { "normal force / (mean force of each)".to_string() } else { format!("normal force / ({} of {})", a.force_scale_is, scene.name) };
+    plot::pdf(&dir.join("force_pdf_beside"), &format!("{} and {}: normal forces", scene.name, other_scene.name), &axis, &densities, &tails)
 }
 
 /// A few lines for a person.
