@@ -1,7 +1,8 @@
 // Contact dynamics' sweeps (src/cd/solve.rs, src/gpu/sweeps.rs): the structures and a
 // contact's exact local problem. Every dot and cross product is written out in the order the
-// CPU twin adds in (Vec3::dot, Vec3::cross), so that f32 gives its bits where the device's
-// arithmetic is IEEE's (lavapipe). Keep the structures in sync with src/gpu/layout.rs.
+// CPU twin adds in (Vec3::dot, Vec3::cross), so that f32 gives its bits where the device
+// neither fuses nor reorders (lavapipe fuses a multiply and an add now and then). Keep the
+// structures in sync with src/gpu/layout.rs.
 
 // Contacts per block of the convergence measure's sum (src/cd/solve.rs MEASURE_BLOCK).
 const MEASURE_BLOCK: u32 = 256u;

@@ -150,7 +150,8 @@ pub struct Solved {
 /// Where a step's Gauss-Seidel sweeps run: on the CPU's threads ([`CpuSweeps`]) or on a GPU
 /// (`crate::gpu::GpuSweeps`). Both sweep the contacts in the schedule's order (colour by
 /// colour, then the serial tail) and sum the convergence measure as
-/// [`MEASURE_BLOCK`] says, so they give the same bits wherever the arithmetic is IEEE's.
+/// [`MEASURE_BLOCK`] says, so they give the same bits where the device neither fuses nor
+/// reorders f32 operations.
 pub trait Sweeps<T: Real>: Send {
     /// "cpu" or "gpu".
     fn backend(&self) -> &'static str;

@@ -5,9 +5,10 @@
 //! (`cd_sweep_tail`), the convergence measure summed by blocks (`cd_measure`) and the decision
 //! (`cd_decide`), which stops every later dispatch once the tolerance or the cap is reached.
 //! Sweeps are submitted in batches that double from one (a warm-started step often converges
-//! in a few) up to [`MAX_SWEEPS_PER_SUBMIT`]; the host reads four words between batches. The
-//! arithmetic is the CPU's f32 in its order, so on an IEEE device (lavapipe) the impulses and
-//! velocities are the CPU's bits.
+//! in a few) up to [`MAX_SWEEPS_PER_SUBMIT`]; the host reads the 32-byte control record
+//! ([`CdControl`]) between batches. The arithmetic is the CPU's f32 in its order; a device
+//! that fuses a multiply and an add (lavapipe does) moves an impulse by an ulp now and then
+//! (`tests/contact_dynamics_gpu.rs` bounds a step's difference).
 
 use super::device::Gpu;
 use super::layout::{CdColour, CdContact, CdControl, CdParams};
