@@ -17,6 +17,7 @@ use super::pair_force::ForceContext;
 use super::pairs::PairList;
 use super::state::{Body, Props};
 use crate::model::{contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, Regime, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+use crate::position::{complete, residual_at};
 use crate::real::{Real, Vec3};
 
 /// Pairs per lane group.
@@ -65,7 +66,10 @@ impl<T: Real> V3s<T> {
 
 /// What one lane group reads.
 struct Inputs<T> {
+    /// `pos_i - pos_j`, before the periodic fold.
     d: V3s<T>,
+    /// `residual_i - residual_j` (zero unless compensated).
+    dr: V3s<T>,
     r_i: [T; LANES],
     r_j: [T; LANES],
     m_i: [T; LANES],
@@ -99,15 +103,30 @@ struct Outputs<T> {
 /// Pairs sorted into touching and open at a time.
 const WINDOW: usize = 256;
 
-/// The pair pass for pairs `first..first + out.len()` under `model` (from [`hertz_mindlin`]);
-/// `hist` holds their tangential springs (three reals per pair) and, in capillary scenes, their
-/// bridge volumes (a fourth).
+/// Where the lane kernel hands each pair's force.
+pub trait PairSink<T> {
+    /// Takes the force of the block's pair `m` (counted from its first pair). Without cohesion
+    /// the pairs come in pair order; in capillary scenes each window's open pairs come first.
+    fn put(&mut self, m: usize, f: &ContactForce<T>);
+}
+
+impl<T: Copy> PairSink<T> for [ContactForce<T>] {
+    #[inline(always)]
+    fn put(&mut self, m: usize, f: &ContactForce<T>) {
+        self[m] = *f;
+    }
+}
+
+/// The pair pass for pairs `first..first + n` under `model` (from [`hertz_mindlin`]), handed to
+/// `sink`; `hist` holds their tangential springs (three reals per pair) and, in capillary
+/// scenes, their bridge volumes (a fourth).
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
+pub fn hertz_mindlin_block<T: Real, S: PairSink<T> + ?Sized>(model: &ContactModel<T>, first: usize, n: usize, sink: &mut S, hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
     debug_assert!(ctx.slots.tangential == 0 && (!ctx.slots.layout.bridge || ctx.slots.bridge == 3), "the spring first, the bridge after it");
     match ctx.model.cohesion {
-        CohesionLaw::Capillary { kappa, .. } => lanes::<T, 4, true>(model, Some(kappa), first, out, hist, pairs, body, prop, ctx),
-        CohesionLaw::None => lanes::<T, 3, false>(model, None, first, out, hist, pairs, body, prop, ctx),
+        CohesionLaw::Capillary { kappa, .. } => lanes::<T, S, 4, true>(model, Some(kappa), first, n, sink, hist, pairs, body, prop, ctx),
+        CohesionLaw::None => lanes::<T, S, 3, false>(model, None, first, n, sink, hist, pairs, body, prop, ctx),
     }
 }
 
@@ -121,9 +140,10 @@ pub fn hertz_mindlin_block<T: Real>(model: &ContactModel<T>, first: usize, out: 
 /// unsorted, 57 s sorted; the wet stage of wet_iso_0pa: 392 s sorted, 442 s unsorted).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn lanes<T: Real, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>, kappa: Option<T>, first: usize, out: &mut [ContactForce<T>], hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
+fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>, kappa: Option<T>, first: usize, n: usize, sink: &mut S, hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
     let mut inp = Inputs {
         d: V3s::ZERO,
+        dr: V3s::ZERO,
         r_i: [T::ZERO; LANES],
         r_j: [T::ZERO; LANES],
         m_i: [T::ONE; LANES],
@@ -142,10 +162,10 @@ fn lanes<T: Real, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>
     let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], f_c: [T::ZERO; LANES], clamped: [false; LANES], sliding: [false; LANES], xi: V3s::ZERO };
     let mut listed = [0u16; WINDOW];
     let mut open = [true; WINDOW];
-    for (w, (out, hist)) in out.chunks_mut(WINDOW).zip(hist.chunks_mut(STRIDE * WINDOW)).enumerate() {
-        let base = first + w * WINDOW;
+    for (w, hist) in hist[..STRIDE * n].chunks_mut(STRIDE * WINDOW).enumerate() {
+        let (base, len) = (first + w * WINDOW, hist.len() / STRIDE);
         let mut n_listed = 0;
-        for (m, is_open) in open[..out.len()].iter_mut().enumerate() {
+        for (m, is_open) in open[..len].iter_mut().enumerate() {
             let keep = if SORT {
                 let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
                 let d = ctx.separation(body, i, j);
@@ -159,18 +179,24 @@ fn lanes<T: Real, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>
             *is_open = !keep;
         }
         if SORT {
-            for m in (0..out.len()).filter(|&m| open[m]) {
-                out[m] = super::pair_force::pair_force(base + m, pairs, body, prop, ctx, &mut hist[STRIDE * m..STRIDE * (m + 1)]);
+            for m in (0..len).filter(|&m| open[m]) {
+                sink.put(w * WINDOW + m, &super::pair_force::pair_force(base + m, pairs, body, prop, ctx, &mut hist[STRIDE * m..STRIDE * (m + 1)]));
             }
         }
         for group in listed[..n_listed].chunks(LANES) {
-            // Load: the scattered reads, one pair at a time.
+            // Load: the scattered reads, one pair at a time; first the positions alone, in a
+            // short loop that keeps many of the partners' cache misses in flight.
+            for (l, &m) in group.iter().enumerate() {
+                let m = m as usize;
+                let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
+                inp.d.set(l, body[i].pos - body[j].pos);
+                inp.dr.set(l, residual_at(ctx.residual, i) - residual_at(ctx.residual, j));
+            }
             for (l, &m) in group.iter().enumerate() {
                 let m = m as usize;
                 let i = pairs.owner[base + m] as usize;
                 let j = pairs.partner[base + m] as usize;
                 let (bi, bj, pi, pj) = (&body[i], &body[j], &prop[i], &prop[j]);
-                inp.d.set(l, ctx.separation(body, i, j));
                 (inp.r_i[l], inp.r_j[l], inp.m_i[l], inp.m_j[l]) = (pi.radius, pj.radius, pi.mass, pj.mass);
                 inp.v_i.set(l, bi.vel);
                 inp.v_j.set(l, bj.vel);
@@ -186,7 +212,7 @@ fn lanes<T: Real, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>
             // into a select (unsorted, the result of a pair that does not touch is dropped;
             // lanes past the end of a short group recompute stale inputs, unstored).
             for l in 0..LANES {
-                let d = inp.d.get(l);
+                let d = complete(ctx.periodic.min_image(inp.d.get(l)), inp.dr.get(l));
                 let dist2 = d.norm2();
                 let reach = inp.r_i[l] + inp.r_j[l];
                 let touching = dist2 < reach * reach;
@@ -217,7 +243,7 @@ fn lanes<T: Real, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>
             // Store.
             for (l, &m) in group.iter().enumerate() {
                 let m = m as usize;
-                out[m] = ContactForce { f_i: res.f_i.get(l), f_j: res.f_j.get(l), t_i: res.t_i.get(l), t_j: res.t_j.get(l), f_n: res.f_n[l], f_c: res.f_c[l], clamped: res.clamped[l], regime: if res.sliding[l] { Regime::Sliding } else { Regime::Static } };
+                sink.put(w * WINDOW + m, &ContactForce { f_i: res.f_i.get(l), f_j: res.f_j.get(l), t_i: res.t_i.get(l), t_j: res.t_j.get(l), f_n: res.f_n[l], f_c: res.f_c[l], clamped: res.clamped[l], regime: if res.sliding[l] { Regime::Sliding } else { Regime::Static } });
                 let xi = res.xi.get(l);
                 hist[STRIDE * m..STRIDE * m + 3].copy_from_slice(&[xi.x, xi.y, xi.z]);
             }
@@ -288,7 +314,7 @@ duration = 1.0e-3
         let (mut hist_one, mut hist_lanes) = (e.hist.clone(), e.hist.clone());
         let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[stride * k..stride * (k + 1)])).collect();
         let mut lanes = vec![ContactForce::default(); n];
-        hertz_mindlin_block(&model, 0, &mut lanes, &mut hist_lanes, &e.pairs, &e.body, &e.prop, &ctx);
+        hertz_mindlin_block(&model, 0, n, lanes.as_mut_slice(), &mut hist_lanes, &e.pairs, &e.body, &e.prop, &ctx);
         let touching = one.iter().filter(|f| f.f_n > T::ZERO).count();
         let springs = e.hist.chunks(stride).filter(|s| s[..3].iter().any(|x| *x != T::ZERO)).count();
         let open_bridges = one.iter().filter(|f| f.f_n == T::ZERO && f.f_c < T::ZERO).count();

@@ -2,14 +2,17 @@
 //! order (owner = lower permanent id = i), and reads and writes its history.
 //!
 //! The pass runs in tasks of [`OWNERS`] owner grains, each compiled for the widest instruction
-//! set the CPU has (see `simd`); under the standard Hertz-Mindlin model their pairs run
-//! [`BLOCK`] at a time in vector lanes (see `lanes`), with the same bits, into a scratch record
-//! that stays in cache, and otherwise one at a time. Of each pair's force only the partner's
-//! share and a small report go back to memory: the owner's share is summed into the owner's
-//! load on the spot, in the order the gather used to sum it.
+//! set the CPU has (see `simd`); under the standard Hertz-Mindlin model their pairs run in
+//! vector lanes (see `lanes`), with the same bits, and otherwise one at a time. Of each pair's
+//! force only the partner's share and a small report go back to memory: the owner's share is
+//! summed into the owner's load on the spot, in the order the gather used to sum it. Dry, the
+//! lanes hand each pair over as they store it; in capillary scenes, whose lanes take a
+//! window's open pairs first, [`BLOCK`] pairs at a time go through a scratch record that stays
+//! in cache and are handed over from it in pair order.
 
 use super::pairs::PairList;
 use super::state::{Body, HistorySlots, Load, PairFlags, Props};
+use super::lanes::PairSink;
 use crate::model::{capillary_force, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs, TangentialLaw};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
@@ -73,8 +76,9 @@ pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &
     f
 }
 
-/// Pairs the lane kernel computes at a time into a task's scratch record, before each is split
-/// into the owner's share (summed into its load), the partner's share and the report.
+/// Pairs the lane kernel computes at a time into a task's scratch record in capillary scenes,
+/// before each is split into the owner's share (summed into its load), the partner's share and
+/// the report.
 pub const BLOCK: usize = 256;
 
 /// Owner grains per task of the pair pass: a task takes every pair these grains own, so each
@@ -129,33 +133,79 @@ fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut Vec
     }
     let first_pair = pairs.owner_start[first] as usize;
     let (stride, n_pairs) = (ctx.slots.stride, block.f_n.len());
-    if let Some(model) = super::lanes::hertz_mindlin(ctx.model) {
-        debug_assert!(!ctx.slots.layout.sliding && !ctx.slots.layout.rolling, "Hertz-Mindlin keeps one spring per pair");
-        scratch.resize(BLOCK, ContactForce::default());
-        for start in (0..n_pairs).step_by(scratch.len()) {
-            let n = scratch.len().min(n_pairs - start);
-            let h = &mut block.hist[start * stride..(start + n) * stride];
-            super::lanes::hertz_mindlin_block(&model, first_pair + start, &mut scratch[..n], h, pairs, body, prop, ctx);
-            for (q, f) in scratch[..n].iter().enumerate() {
-                block.deposit(start + q, pairs.owner[first_pair + start + q] as usize, f);
+    let hist = std::mem::take(&mut block.hist);
+    let mut sink = Deposit::new(&mut block, &pairs.owner[first_pair..first_pair + n_pairs]);
+    match super::lanes::hertz_mindlin(ctx.model) {
+        // Without cohesion the lanes hand the pairs over in pair order.
+        Some(model) if matches!(ctx.model.cohesion, CohesionLaw::None) => super::lanes::hertz_mindlin_block(&model, first_pair, n_pairs, &mut sink, hist, pairs, body, prop, ctx),
+        Some(model) => {
+            scratch.resize(BLOCK, ContactForce::default());
+            for start in (0..n_pairs).step_by(scratch.len()) {
+                let n = scratch.len().min(n_pairs - start);
+                let h = &mut hist[start * stride..(start + n) * stride];
+                super::lanes::hertz_mindlin_block(&model, first_pair + start, n, &mut scratch[..n], h, pairs, body, prop, ctx);
+                for (q, f) in scratch[..n].iter().enumerate() {
+                    sink.put(start + q, f);
+                }
             }
         }
-    } else {
-        for k in 0..n_pairs {
-            let f = pair_force(first_pair + k, pairs, body, prop, ctx, &mut block.hist[k * stride..(k + 1) * stride]);
-            block.deposit(k, pairs.owner[first_pair + k] as usize, &f);
+        None => {
+            for k in 0..n_pairs {
+                sink.put(k, &pair_force(first_pair + k, pairs, body, prop, ctx, &mut hist[k * stride..(k + 1) * stride]));
+            }
+        }
+    }
+    sink.finish();
+}
+
+/// Hands out a block's pair forces, taken in pair order: the owner's share summed into a
+/// running load (kept out of memory while the owner stays the same, so each addition does not
+/// wait on the previous one's store), the rest stored per pair.
+struct Deposit<'b, 'a, T> {
+    block: &'b mut OwnerBlock<'a, T>,
+    /// The owner of each of the block's pairs.
+    owner: &'b [u32],
+    /// The owner being summed, as an index into the block's loads.
+    current: usize,
+    /// Its load so far.
+    sum: Load<T>,
+}
+
+impl<'b, 'a, T: Real> Deposit<'b, 'a, T> {
+    fn new(block: &'b mut OwnerBlock<'a, T>, owner: &'b [u32]) -> Self {
+        let sum = block.load.first().copied().unwrap_or_default();
+        Deposit { block, owner, current: 0, sum }
+    }
+
+    /// Stores the load being summed.
+    #[inline(always)]
+    fn finish(&mut self) {
+        if let Some(l) = self.block.load.get_mut(self.current) {
+            *l = self.sum;
         }
     }
 }
 
-impl<T: Real> OwnerBlock<'_, T> {
-    /// Hands out the force of the block's pair `k` (counted from its first pair), owned by
-    /// grain `owner`.
+impl<T: Real> PairSink<T> for Deposit<'_, '_, T> {
     #[inline(always)]
-    fn deposit(&mut self, k: usize, owner: usize, f: &ContactForce<T>) {
-        let l = &mut self.load[owner - self.first];
-        l.force += f.f_i;
-        l.torque += f.t_i;
+    fn put(&mut self, k: usize, f: &ContactForce<T>) {
+        let owner = self.owner[k] as usize - self.block.first;
+        if owner != self.current {
+            self.finish();
+            self.current = owner;
+            self.sum = self.block.load[owner];
+        }
+        self.sum.force += f.f_i;
+        self.sum.torque += f.t_i;
+        self.block.deposit(k, f);
+    }
+}
+
+impl<T: Real> OwnerBlock<'_, T> {
+    /// Stores all but the owner's share of the force of the block's pair `k` (counted from
+    /// its first pair).
+    #[inline(always)]
+    fn deposit(&mut self, k: usize, f: &ContactForce<T>) {
         // Field by field: a whole-struct store is assembled on the stack and read back in
         // wider words than it was written, which stalls store forwarding (a tenth of the
         // oedometer's step).
