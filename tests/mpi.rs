@@ -1,6 +1,6 @@
 //! One run over several processes (`mpirun -np K grains run`, feature `mpi`) against the same
 //! run on one process, bit for bit: statistics, frames (with every contact's force and
-//! springs) and the final checkpoint, on a pour and on an oedometer stage, on 2 and 3
+//! springs) and the final checkpoint, on a pour, an oedometer stage and a gas periodic along every axis, on 2 and 3
 //! processes, f64 and f32; a loaded spring kept through the migration of its grain; bad
 //! process counts refused in one line.
 //!
@@ -234,7 +234,7 @@ fn too_many_processes_for_the_slabs_is_a_one_line_error() {
 
 #[test]
 fn a_grain_is_held_by_its_owner_and_the_slabs_within_reach() {
-    let s = Slabs { axis: 0, cuts: vec![0.0, 1.0], reach: 0.25, skin: 0.05 };
+    let s = Slabs { axis: 0, cuts: vec![0.0, 1.0], reach: 0.25, skin: 0.05, period: None };
     assert_eq!(s.holders(-1.0), vec![0]);
     assert_eq!(s.holders(-0.1), vec![0, 1]);
     assert_eq!(s.holders(0.0), vec![1, 0]);
@@ -246,7 +246,7 @@ fn a_grain_is_held_by_its_owner_and_the_slabs_within_reach() {
 
 #[test]
 fn cuts_move_to_the_quantiles_unless_a_slab_would_be_too_narrow() {
-    let mut s = Slabs { axis: 0, cuts: vec![0.0, 1.0], reach: 0.25, skin: 0.05 };
+    let mut s = Slabs { axis: 0, cuts: vec![0.0, 1.0], reach: 0.25, skin: 0.05, period: None };
     let x: Vec<f64> = (0..90).map(|i| i as f64 / 30.0).collect();
     // Midway between the 30th and 31st, the 60th and 61st positions, to round-off.
     let expect = [29.5 / 30.0, 59.5 / 30.0];
@@ -256,4 +256,97 @@ fn cuts_move_to_the_quantiles_unless_a_slab_would_be_too_narrow() {
     let crowded: Vec<f64> = x.iter().map(|v| v / 10.0).collect();
     assert!(s.cut_at_quantiles(crowded, 3).is_err_and(|w| (w - 0.1).abs() < 1e-12));
     assert!(near(&s.cuts), "the cuts stay where they were");
+}
+
+/// A jostling gas periodic along every axis (Hertz-Mindlin, 1,300 grains in a 14 mm cube,
+/// contacts with their forces and springs in the frames): the slabs form a ring along x.
+fn periodic_gas(dir: &Path) -> PathBuf {
+    let text = r#"
+seed = 5
+[[material]]
+name = "sand"
+density = 2650.0
+youngs_modulus = 7.0e7
+poisson_ratio = 0.3
+mu_s = 0.5
+restitution = 0.5
+
+[[generate]]
+material = "sand"
+count = 1300
+diameter = { min = 0.8e-3, max = 1.2e-3 }
+region = { shape = "box", min = [0.0, 0.0, 0.0], max = [14.0e-3, 14.0e-3, 14.0e-3] }
+random_speed = 0.5
+
+[periodic]
+x = [0.0, 14.0e-3]
+y = [0.0, 14.0e-3]
+z = [0.0, 14.0e-3]
+
+[model]
+normal = "hertz"
+damping = "restitution"
+tangential = "mindlin"
+tangential_damping_ratio = 0.9075
+
+[[stage]]
+kind = "run"
+duration = 4.0e-3
+
+[output]
+frame_interval = 5.0e-4
+contact_forces = true
+"#;
+    let path = dir.join("periodic_gas.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Along a wrapping axis the last slab borders the first: grains cross from one to the other
+/// through the period's ends, and contacts straddle them, computed with a ghost across the
+/// period (counted here on one process); 2 and 3 processes give the lone run's bits.
+#[test]
+fn slabs_round_a_periodic_axis_give_the_same_bits() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = periodic_gas(dir.path());
+    let scene = grains::scene::load(&path).unwrap();
+    let slabs = Slabs::new(&scene, 3).unwrap();
+    assert_eq!(slabs.period, Some([0.0, 14.0e-3]), "the slabs cut a wrapping axis");
+    let (a, last) = (slabs.axis, 2);
+    let mut e = CpuEngine::<f64>::new(&scene).unwrap();
+    let (mut crossed, mut straddling) = (0, 0);
+    let mut before = e.frame(true).unwrap();
+    for _ in 0..40 {
+        e.advance(50).unwrap();
+        let after = e.frame(true).unwrap();
+        let side = |f: &grains::engine::Frame, i: usize| slabs.owner(f.position[i][a]);
+        crossed += (0..after.position.len()).filter(|&i| [side(&before, i), side(&after, i)] == [0, last] || [side(&before, i), side(&after, i)] == [last, 0]).count();
+        straddling += after.contacts.as_ref().unwrap().iter().filter(|c| c.tangential_spring != [0.0; 3] && (after.position[c.i as usize][a] - after.position[c.j as usize][a]).abs() > 7.0e-3).count();
+        before = after;
+    }
+    println!("grains crossing between the last slab and the first: {crossed}; loaded contacts across the period's ends, summed over 40 frames: {straddling}");
+    assert!(crossed > 0 && straddling > 0, "the gas must cross and touch across the period's ends");
+    same_bits_on(&[2, 3], &path, "f64");
+}
+
+#[test]
+fn a_ring_of_slabs_holds_ghosts_across_the_period() {
+    let s = Slabs { axis: 0, cuts: vec![1.0, 2.0], reach: 0.25, skin: 0.05, period: Some([0.0, 3.0]) };
+    assert_eq!(s.holders(0.1), vec![0, 2], "the last slab borders the first");
+    assert_eq!(s.holders(2.9), vec![2, 0]);
+    assert_eq!(s.holders(-0.1), vec![2, 0], "positions are taken within the period");
+    assert_eq!(s.holders(3.5), vec![0]);
+    assert_eq!(s.holders(1.1), vec![1, 0]);
+    let two = Slabs { cuts: vec![1.5], ..s.clone() };
+    assert_eq!(two.holders(0.1), vec![0, 1], "two slabs border each other twice; a ghost is held once");
+    let mut s = s;
+    let x: Vec<f64> = (0..90).map(|i| i as f64 / 30.0).collect();
+    assert_eq!(s.cut_at_quantiles(x.iter().map(|v| v + 3.0).collect(), 3), Ok(()), "positions a period away cut alike");
+    assert!(s.cuts.iter().zip([29.5 / 30.0, 59.5 / 30.0]).all(|(c, e)| (c - e).abs() < 1e-12), "{:?}", s.cuts);
+    // A third of the grains below 0.1, a third in [0.15, 0.2): the first slab, [0, 0.123), is
+    // too narrow in a ring, where it has a neighbour below; on a line it reaches to -infinity.
+    let crowded: Vec<f64> = (0..30).map(|i| i as f64 / 300.0).chain((0..30).map(|i| 0.15 + i as f64 / 600.0)).chain((0..30).map(|i| 1.0 + i as f64 / 15.0)).collect();
+    assert!(s.cut_at_quantiles(crowded.clone(), 3).is_err_and(|w| (w - 0.1234).abs() < 1e-3), "the first slab is a slab too in a ring");
+    let mut line = Slabs { period: None, ..s };
+    assert_eq!(line.cut_at_quantiles(crowded, 3), Ok(()));
 }

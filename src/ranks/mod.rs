@@ -25,8 +25,7 @@
 //!
 //! Limits of this first version: every process reads the whole scene and holds the whole
 //! state after each `advance` (memory and traffic O(N) per process per statistics read); the
-//! slabs cut one axis only; capillary scenes, contact dynamics and scenes periodic along every
-//! axis are refused.
+//! slabs cut one axis only; capillary scenes and contact dynamics are refused.
 
 mod slabs;
 

@@ -1,12 +1,14 @@
 //! How a distributed run cuts the domain: slabs along one axis, one per process, each
 //! holding about as many grains as the others: cut at the start, and again at a rebuild when
-//! the counts have drifted apart.
+//! the counts have drifted apart. Along a wrapping axis the slabs form a ring: the last one
+//! borders the first across the period.
 
 use crate::scene::Scene;
 
 /// Slabs along `axis`: process `r` owns the grains with `cuts[r - 1] <= x < cuts[r]` (the
-/// first and last slabs reach to infinity), and holds as ghosts the grains of its neighbours
-/// within `reach` of its slab.
+/// first and last slabs reach to infinity, or, along a wrapping axis, to the period's ends,
+/// positions taken within the period), and holds as ghosts the grains of its neighbours within
+/// `reach` of its slab.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Slabs {
     /// The axis cut (0 = x).
@@ -20,6 +22,9 @@ pub struct Slabs {
     /// and its moves between two rebuilds (at most half the skin) stay within the neighbouring
     /// slabs.
     pub skin: f64,
+    /// The axis's wrapping interval `[lo, hi)` (m) when it is periodic: the slabs then form a
+    /// ring, `[lo, cuts[0])` to `[cuts[K - 2], hi)`, and distances go round it.
+    pub period: Option<[f64; 2]>,
 }
 
 /// A grain count at which the slabs are cut anew, as a multiple of the mean: a rebuild that
@@ -27,24 +32,26 @@ pub struct Slabs {
 pub const REBALANCE_ABOVE: f64 = 1.2;
 
 impl Slabs {
-    /// The slabs of `scene` for `ranks` processes: along the non-periodic axis over which the
-    /// grains spread widest, cut at the quantiles of the grains' starting positions.
+    /// The slabs of `scene` for `ranks` processes: along the axis over which the grains spread
+    /// widest (a wrapping axis spans its period), cut at the quantiles of the grains' starting
+    /// positions.
     pub fn new(scene: &Scene, ranks: usize) -> anyhow::Result<Self> {
         let file = scene.path.display();
         let g = &scene.grains;
-        let extent = |a: usize| {
-            let (lo, hi) = g.position.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[a]), hi.max(p[a])));
-            hi - lo
+        let extent = |a: usize| match scene.periodic[a] {
+            Some([lo, hi]) => hi - lo,
+            None => {
+                let (lo, hi) = g.position.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[a]), hi.max(p[a])));
+                hi - lo
+            }
         };
-        let Some(axis) = (0..3).filter(|&a| scene.periodic[a].is_none()).max_by(|&a, &b| extent(a).total_cmp(&extent(b))) else {
-            anyhow::bail!("{file}: periodic = every axis: a run over several processes cuts the domain into slabs along an axis that does not wrap, and this scene has none; fix: run it on one process");
-        };
+        let axis = (0..3).max_by(|&a, &b| extent(a).total_cmp(&extent(b))).unwrap_or(0);
         let r_max = g.radius.iter().copied().fold(0.0, f64::max);
         let n = g.len();
         if ranks > n {
             anyhow::bail!("{file}: {ranks} processes for {n} grains; fix: run on at most {n} processes");
         }
-        let mut slabs = Slabs { axis, cuts: Vec::new(), reach: 2.0 * r_max + scene.skin + scene.bridges.reach, skin: scene.skin };
+        let mut slabs = Slabs { axis, cuts: Vec::new(), reach: 2.0 * r_max + scene.skin + scene.bridges.reach, skin: scene.skin, period: scene.periodic[axis] };
         let x: Vec<f64> = g.position.iter().map(|p| p[axis]).collect();
         if let Err(w) = slabs.cut_at_quantiles(x, ranks) {
             let (name, need) = (["x", "y", "z"][axis], slabs.reach + slabs.skin);
@@ -56,14 +63,31 @@ impl Slabs {
         Ok(slabs)
     }
 
+    /// `x` (m) brought into the period along a wrapping axis; `x` itself otherwise.
+    fn wrap(&self, x: f64) -> f64 {
+        match self.period {
+            Some([lo, hi]) => {
+                let y = x - (hi - lo) * ((x - lo) / (hi - lo)).floor();
+                if y >= hi { lo } else { y }
+            }
+            None => x,
+        }
+    }
+
     /// Cuts at the quantiles of the positions `x` (m) along the axis, so that each of `ranks`
     /// processes owns as many grains (within one); leaves the cuts as they were and returns
-    /// the narrowest inner slab (m) when one would be narrower than `reach + skin`.
-    pub fn cut_at_quantiles(&mut self, mut x: Vec<f64>, ranks: usize) -> Result<(), f64> {
+    /// the narrowest slab (m) when one would be narrower than `reach + skin` (an inner one;
+    /// along a wrapping axis, any one).
+    pub fn cut_at_quantiles(&mut self, x: Vec<f64>, ranks: usize) -> Result<(), f64> {
+        let mut x: Vec<f64> = x.into_iter().map(|x| self.wrap(x)).collect();
         x.sort_by(f64::total_cmp);
         let n = x.len();
         let cuts: Vec<f64> = (1..ranks).map(|k| 0.5 * (x[k * n / ranks - 1] + x[k * n / ranks])).collect();
-        if let Some(w) = cuts.windows(2).map(|c| c[1] - c[0]).min_by(f64::total_cmp).filter(|&w| !(w >= self.reach + self.skin)) {
+        let bounds: Vec<f64> = match self.period {
+            Some([lo, hi]) if ranks > 1 => [lo].into_iter().chain(cuts.iter().copied()).chain([hi]).collect(),
+            _ => cuts.clone(),
+        };
+        if let Some(w) = bounds.windows(2).map(|c| c[1] - c[0]).min_by(f64::total_cmp).filter(|&w| !(w >= self.reach + self.skin)) {
             return Err(w);
         }
         self.cuts = cuts;
@@ -72,22 +96,41 @@ impl Slabs {
 
     /// The process that owns a grain at `x` along the axis (m).
     pub fn owner(&self, x: f64) -> usize {
+        let x = self.wrap(x);
         self.cuts.partition_point(|&c| c <= x)
     }
 
-    /// True when a grain at `x` (m) lies within the reach of process `r`'s slab (in it or not).
+    /// True when a grain at `x` (m) lies within the reach of process `r`'s slab (in it or not),
+    /// round the ring along a wrapping axis.
     pub fn near(&self, x: f64, r: usize) -> bool {
-        let lo = if r == 0 { f64::NEG_INFINITY } else { self.cuts[r - 1] };
-        let hi = self.cuts.get(r).copied().unwrap_or(f64::INFINITY);
-        (lo - x).max(x - hi) < self.reach
+        let (lo, hi) = (self.period.map_or(f64::NEG_INFINITY, |p| p[0]), self.period.map_or(f64::INFINITY, |p| p[1]));
+        let a = if r == 0 { lo } else { self.cuts[r - 1] };
+        let b = self.cuts.get(r).copied().unwrap_or(hi);
+        let gap = |x: f64| (a - x).max(x - b);
+        let gap = match self.period {
+            Some([lo, hi]) => {
+                let x = self.wrap(x);
+                gap(x).min(gap(x - (hi - lo))).min(gap(x + (hi - lo)))
+            }
+            None => gap(x),
+        };
+        gap < self.reach
     }
 
     /// The processes that hold a grain at `x` (m): its owner first, then the neighbours it is
     /// a ghost of (a grain farther than a slab from its owner is a ghost of no one else).
     pub fn holders(&self, x: f64) -> Vec<usize> {
-        let o = self.owner(x);
+        let (o, k) = (self.owner(x), self.cuts.len() + 1);
         let mut h = vec![o];
-        h.extend([o.wrapping_sub(1), o + 1].into_iter().filter(|&r| r <= self.cuts.len() && self.near(x, r)));
+        let beside = match self.period {
+            Some(_) => [(o + k - 1) % k, (o + 1) % k],
+            None => [o.wrapping_sub(1), o + 1],
+        };
+        for r in beside {
+            if r < k && !h.contains(&r) && self.near(x, r) {
+                h.push(r);
+            }
+        }
         h
     }
 }
