@@ -1,8 +1,9 @@
 //! One run over several processes (`mpirun -np K grains run`, feature `mpi`) against the same
 //! run on one process, bit for bit: statistics, frames (with every contact's force and
-//! springs) and the final checkpoint, on a pour, an oedometer stage and a gas periodic along every axis, on 2 and 3
-//! processes, f64 and f32; a loaded spring kept through the migration of its grain; bad
-//! process counts refused in one line.
+//! springs) and the final checkpoint, on a pour, an oedometer stage and a gas periodic along
+//! every axis (dry and wet), on 2 and 3 processes, f64 and f32; a loaded spring kept through
+//! the migration of its grain; liquid moved between grains of different processes in
+//! canonical order; bad process counts refused in one line.
 //!
 //! Run with `cargo test --release --features mpi --test mpi` (needs `mpirun`: Debian
 //! openmpi-bin).
@@ -60,8 +61,8 @@ fn grains(ranks: usize, args: &[&str]) -> Output {
 }
 
 /// Runs `scene` alone and on each of `ranks` processes, and checks every run's files against
-/// the lone run's, byte for byte.
-fn same_bits_on(ranks: &[usize], scene: &Path, precision: &str) {
+/// the lone run's, byte for byte; returns the lone run's `stats.csv`.
+fn same_bits_on(ranks: &[usize], scene: &Path, precision: &str) -> String {
     let dir = tempfile::tempdir().unwrap();
     let out = |k: usize| dir.path().join(format!("np{k}"));
     let alone = run(1, scene, &out(1), precision);
@@ -82,6 +83,7 @@ fn same_bits_on(ranks: &[usize], scene: &Path, precision: &str) {
         let summary = |k: usize| -> serde_json::Value { serde_json::from_str(&std::fs::read_to_string(out(k).join("summary.json")).unwrap()).unwrap() };
         assert_eq!(summary(1)["final"], summary(k)["final"], "the summaries' final states differ on {k} processes");
     }
+    std::fs::read_to_string(out(1).join("stats.csv")).unwrap()
 }
 
 /// The quickstart's pour, shortened, with contact forces in its frames.
@@ -261,7 +263,13 @@ fn cuts_move_to_the_quantiles_unless_a_slab_would_be_too_narrow() {
 /// A jostling gas periodic along every axis (Hertz-Mindlin, 1,300 grains in a 14 mm cube,
 /// contacts with their forces and springs in the frames): the slabs form a ring along x.
 fn periodic_gas(dir: &Path) -> PathBuf {
-    let text = r#"
+    let path = dir.join("periodic_gas.toml");
+    std::fs::write(&path, PERIODIC_GAS).unwrap();
+    path
+}
+
+/// [`periodic_gas`]'s text.
+const PERIODIC_GAS: &str = r#"
 seed = 5
 [[material]]
 name = "sand"
@@ -297,10 +305,6 @@ duration = 4.0e-3
 frame_interval = 5.0e-4
 contact_forces = true
 "#;
-    let path = dir.join("periodic_gas.toml");
-    std::fs::write(&path, text).unwrap();
-    path
-}
 
 /// Along a wrapping axis the last slab borders the first: grains cross from one to the other
 /// through the period's ends, and contacts straddle them, computed with a ghost across the
@@ -349,4 +353,94 @@ fn a_ring_of_slabs_holds_ghosts_across_the_period() {
     assert!(s.cut_at_quantiles(crowded.clone(), 3).is_err_and(|w| (w - 0.1234).abs() < 1e-3), "the first slab is a slab too in a ring");
     let mut line = Slabs { period: None, ..s };
     assert_eq!(line.cut_at_quantiles(crowded, 3), Ok(()));
+}
+
+/// [`periodic_gas`] wetted at its start (w = 0.007) with capillary cohesion: bridges form at
+/// new contacts and rupture as the gas jostles, their liquid moving between grains of
+/// different processes.
+fn wet_periodic_gas(dir: &Path) -> PathBuf {
+    let text = common::edit(PERIODIC_GAS, &[("[[stage]]\nkind = \"run\"", "[[stage]]\nkind = \"run\"\nwater_content = 0.007"), ("tangential_damping_ratio = 0.9075", "tangential_damping_ratio = 0.9075\ncohesion = \"capillary\"")]);
+    let path = dir.join("wet_periodic_gas.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// Liquid bridges that form and rupture between grains of different processes (counted here
+/// on one process, frame to frame) move their liquid with the bits of one process: 2 and 3
+/// processes give the lone run's statistics (liquid on grains and in bridges among them) and
+/// frames (every bridge's volume), byte for byte.
+#[test]
+fn liquid_bridges_across_the_cuts_give_the_same_bits() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = wet_periodic_gas(dir.path());
+    let scene = grains::scene::load(&path).unwrap();
+    let slabs = Slabs::new(&scene, 3).unwrap();
+    let mut e = CpuEngine::<f64>::new(&scene).unwrap();
+    e.wet(scene.stages[0].wet_volume.unwrap()).unwrap();
+    let bridges = |f: &grains::engine::Frame| -> std::collections::BTreeSet<(u32, u32)> {
+        let side = |i: u32| slabs.owner(f.position[i as usize][slabs.axis]);
+        f.contacts.as_ref().unwrap().iter().filter(|c| c.bridge_volume > 0.0 && side(c.i) != side(c.j)).map(|c| (c.i, c.j)).collect()
+    };
+    let (mut formed, mut ruptured) = (0, 0);
+    let mut before = bridges(&e.frame(true).unwrap());
+    for _ in 0..40 {
+        e.advance(50).unwrap();
+        let after = bridges(&e.frame(true).unwrap());
+        formed += after.difference(&before).count();
+        ruptured += before.difference(&after).count();
+        before = after;
+    }
+    println!("bridges across a cut between 3 slabs, frame to frame over 40 frames: {formed} formed, {ruptured} ruptured");
+    assert!(formed > 0 && ruptured > 0, "bridges must form and rupture across the cuts");
+    same_bits_on(&[2, 3], &path, "f64");
+}
+
+/// Two grains hit a wet third one from both sides in the same step (seed of
+/// `tests/reorder.rs`'s twin), the left one on process 0, the middle and right ones on process
+/// 1, the right one beyond process 0's reach: both bridges form in one step from the middle
+/// grain's liquid, the first (by ids: right and middle) found on process 1, the second on
+/// process 0, which must take what the first left. On two processes: the lone run's bytes,
+/// both bridges and the liquid left on the grains included.
+#[test]
+fn two_bridges_formed_in_one_step_on_two_processes_take_their_liquid_in_id_order() {
+    let grain = |x: f64, v: f64| format!("[[grain]]\nmaterial = \"glass\"\nradius = 5.0e-4\nposition = [{x:e}, 0.0, 0.0]\nvelocity = [{v:e}, 0.0, 0.0]\n");
+    let text = format!(
+        r#"
+[[material]]
+name = "glass"
+density = 2500.0
+youngs_modulus = 1.0e8
+poisson_ratio = 0.3
+restitution = 0.5
+{}{}{}
+[model]
+damping = "restitution"
+cohesion = "capillary"
+[simulation]
+gravity = [0.0, 0.0, 0.0]
+dt = 2.0e-7
+stats_interval = 50
+[[stage]]
+kind = "run"
+duration = 6.0e-4
+water_content = 0.01
+[output]
+frame_interval = 1.0e-5
+contact_forces = true
+"#,
+        grain(2.0e-3, -2.0),
+        grain(-2.0e-3, 2.0),
+        grain(0.0, 0.0)
+    );
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("three.toml");
+    std::fs::write(&path, text).unwrap();
+    let scene = grains::scene::load(&path).unwrap();
+    let slabs = Slabs::new(&scene, 2).unwrap();
+    let owners: Vec<usize> = scene.grains.position.iter().map(|p| slabs.owner(p[slabs.axis])).collect();
+    assert_eq!(owners, vec![1, 0, 1], "the left grain alone on process 0");
+    let stats = same_bits_on(&[2], &path, "f64");
+    let bridges = |row: &str| row.split(',').nth(20).unwrap().parse::<u32>().unwrap();
+    println!("bridges at the end: {}", bridges(stats.lines().last().unwrap()));
+    assert!(stats.lines().skip(1).any(|r| bridges(r) == 2), "both bridges must form");
 }

@@ -30,7 +30,7 @@ mod wall_contacts;
 pub use integrate::rotate;
 pub use pairs::PairList;
 #[cfg(feature = "mpi")]
-pub(crate) use parts::{state_of_rows, touch_of_row, touches_state, RowWidths, Rows, TOUCH_ROW};
+pub(crate) use parts::{state_of_rows, touch_of_row, touches_state, RowWidths, Rows, BRIDGE_ROW, TOUCH_ROW};
 #[cfg(feature = "mpi")]
 pub(crate) use wall_contacts::WallTouch as WallContact;
 pub use pair_force::ForceContext;
@@ -395,12 +395,25 @@ impl<T: Real> CpuEngine<T> {
     /// to round-off.
     ///
     /// Whether a pair ruptures or may form a bridge depends on its own gap and volume alone,
-    /// so a parallel pass finds those events; the liquid then moves serially, in pair order,
-    /// so that a grain forming several bridges in one step gives its liquid out in a fixed
-    /// order (the same bits as one serial walk over every pair, which cost a quarter of a wet
-    /// scene's step on two threads).
+    /// so a parallel pass finds those events ([`Self::bridge_events`]); the liquid then moves
+    /// serially, in canonical order, so that a grain forming several bridges in one step gives
+    /// its liquid out in a fixed order (the same bits as one serial walk over every pair, which
+    /// cost a quarter of a wet scene's step on two threads).
     fn update_bridges(&mut self) {
-        let CohesionLaw::Capillary { theta, .. } = self.model.cohesion else { return };
+        let (stride, b) = (self.slots.stride, self.slots.bridge);
+        for (k, event) in self.bridge_events() {
+            let k = k as usize;
+            let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+            let (mut l_i, mut l_j) = (self.liquid[i], self.liquid[j]);
+            self.hist[k * stride + b] = move_liquid(event, self.hist[k * stride + b], self.bridge_cap, &mut l_i, &mut l_j);
+            (self.liquid[i], self.liquid[j]) = (l_i, l_j);
+        }
+    }
+
+    /// The pairs whose bridge ruptures or may form at this evaluation, in canonical order
+    /// (owner id, then partner id: the pair order within an owner); none without cohesion.
+    fn bridge_events(&self) -> Vec<(u32, BridgeEvent)> {
+        let CohesionLaw::Capillary { theta, .. } = self.model.cohesion else { return Vec::new() };
         let (stride, b) = (self.slots.stride, self.slots.bridge);
         let events: Vec<Vec<(u32, BridgeEvent)>> = chunked(self.pairs.len(), |range| {
             range
@@ -418,41 +431,13 @@ impl<T: Real> CpuEngine<T> {
         // Pair order by slot follows the numbering; the liquid moves in canonical order.
         let mut events: Vec<(u32, BridgeEvent)> = events.into_iter().flatten().collect();
         events.sort_by_key(|&(k, _)| (self.id[self.pairs.owner[k as usize] as usize], k));
-        let half = T::of(0.5);
-        for (k, event) in events {
-            let k = k as usize;
-            let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
-            let at = k * stride + b;
-            match event {
-                BridgeEvent::Rupture => {
-                    let v = self.hist[at];
-                    self.liquid[i] += v * half;
-                    self.liquid[j] += v * half;
-                    self.hist[at] = T::ZERO;
-                }
-                BridgeEvent::Touch if self.liquid[i] > T::ZERO || self.liquid[j] > T::ZERO => {
-                    let (mut a, mut c) = (self.liquid[i] * half, self.liquid[j] * half);
-                    if a + c > self.bridge_cap {
-                        let s = self.bridge_cap / (a + c);
-                        a *= s;
-                        c *= s;
-                    }
-                    self.liquid[i] -= a;
-                    self.liquid[j] -= c;
-                    self.hist[at] = a + c;
-                }
-                BridgeEvent::Touch => {}
-            }
-        }
+        events
     }
 
     /// Runs the force passes: `update_bridges` (capillary scenes), `pair_force`, `gather`,
     /// `wall_contacts`; the springs advance by `elapsed` (s).
     fn evaluate_forces(&mut self, elapsed: T) {
         let t = self.clock.start();
-        if self.slots.layout.bridge {
-            self.update_bridges();
-        }
         let ctx = ForceContext {
             model: &self.model,
             coeffs: &self.coeffs,
@@ -548,6 +533,11 @@ impl<T: Real> CpuEngine<T> {
             }
             Op::RebuildIfNeeded => hooks.rebuild_if_needed(self)?,
             Op::Forces { elapsed } => {
+                if self.slots.layout.bridge {
+                    let t = self.clock.start();
+                    hooks.bridges(self)?;
+                    self.clock.stop(Phase::Force, t);
+                }
                 self.evaluate_forces(T::of(elapsed));
                 hooks.forces_evaluated(self)?;
             }
@@ -625,6 +615,8 @@ pub(crate) trait StepHooks<T: Real> {
     fn drifted(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError>;
     /// In place of the rebuild check.
     fn rebuild_if_needed(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError>;
+    /// In place of `update_bridges`, before each force evaluation of a capillary scene.
+    fn bridges(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError>;
     /// After each force evaluation.
     fn forces_evaluated(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError>;
 }
@@ -639,18 +631,50 @@ impl<T: Real> StepHooks<T> for Alone {
     fn rebuild_if_needed(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
         e.rebuild_if_needed()
     }
+    fn bridges(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
+        e.update_bridges();
+        Ok(())
+    }
     fn forces_evaluated(&mut self, _: &mut CpuEngine<T>) -> Result<(), SimError> {
         Ok(())
     }
 }
 
 /// What `update_bridges` does to one pair.
-#[derive(Clone, Copy)]
-enum BridgeEvent {
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) enum BridgeEvent {
     /// Its bridge is stretched past its rupture distance.
     Rupture,
     /// It touches without a bridge: one forms if its grains hold liquid.
     Touch,
+}
+
+/// The bridge volume (m^3) a pair holds after `event`, from its volume before it, `bridge`, and
+/// the liquid waiting on its two grains (m^3), which the event changes: a rupture returns the
+/// bridge to them in halves; a touch forms a bridge from half of each one's liquid, scaled down
+/// to `cap` when more.
+#[inline]
+pub(crate) fn move_liquid<T: Real>(event: BridgeEvent, bridge: T, cap: T, liquid_i: &mut T, liquid_j: &mut T) -> T {
+    let half = T::of(0.5);
+    match event {
+        BridgeEvent::Rupture => {
+            *liquid_i += bridge * half;
+            *liquid_j += bridge * half;
+            T::ZERO
+        }
+        BridgeEvent::Touch if *liquid_i > T::ZERO || *liquid_j > T::ZERO => {
+            let (mut a, mut c) = (*liquid_i * half, *liquid_j * half);
+            if a + c > cap {
+                let s = cap / (a + c);
+                a *= s;
+                c *= s;
+            }
+            *liquid_i -= a;
+            *liquid_j -= c;
+            a + c
+        }
+        BridgeEvent::Touch => bridge,
+    }
 }
 
 /// What the walls receive from one force pass, per wall.

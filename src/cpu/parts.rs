@@ -13,6 +13,9 @@ const GRAIN_ARRAYS: [(&str, bool); 8] = [("body", false), ("load", false), ("res
 /// The per-pair arrays of a checkpoint, in row order, and whether each holds integers.
 const PAIR_ARRAYS: [(&str, bool); 6] = [("hist", false), ("share", false), ("f_n", false), ("f_c", false), ("pair_flags", true), ("force_i", false)];
 
+/// Values in a row of [`CpuEngine::bridge_rows`].
+pub(crate) const BRIDGE_ROW: usize = 6;
+
 /// The arrays that hold one value for the whole engine, not one per grain or pair.
 const GLOBAL_ARRAYS: [&str; 8] = ["wall_touch_ids", "wall_touches", "wall_reaction", "wall_count", "piston", "servo", "clock", "counters"];
 
@@ -285,6 +288,56 @@ impl<T: Real> CpuEngine<T> {
     pub(crate) fn needs_rebuild(&self) -> bool {
         let half = self.skin * T::of(0.5);
         !(self.max_moved2 < half * half)
+    }
+
+    /// The bridge events of this force evaluation on the pairs whose owner `keep` accepts (by
+    /// permanent id), as [`BRIDGE_ROW`]s `[owner id, partner id, event (0: rupture, 1: touch),
+    /// the pair's bridge volume, the owner's liquid, the partner's liquid]` (m^3) with the ids
+    /// `to_id` gives, in canonical order.
+    pub(crate) fn bridge_rows(&self, keep: impl Fn(u32) -> bool, to_id: impl Fn(u32) -> u32) -> Vec<f64> {
+        let (stride, b) = (self.slots.stride, self.slots.bridge);
+        let mut rows = Vec::new();
+        for (k, event) in self.bridge_events() {
+            let k = k as usize;
+            let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+            if keep(self.id[i]) {
+                let kind = if event == BridgeEvent::Rupture { 0.0 } else { 1.0 };
+                rows.extend([to_id(self.id[i]) as f64, to_id(self.id[j]) as f64, kind, self.hist[k * stride + b].f64(), self.liquid[i].f64(), self.liquid[j].f64()]);
+            }
+        }
+        rows
+    }
+
+    /// Moves the liquid of `rows`, every process's bridge events ([`Self::bridge_rows`]) in
+    /// canonical order: each grain's liquid starts from the first row that names it and
+    /// follows the events as `update_bridges` moves it, so every grain's liquid and every
+    /// pair's bridge come out with the bits of one process. The engine keeps those of its own
+    /// grains and pairs (`local` gives the id here of a row's id, if this engine holds it).
+    pub(crate) fn replay_bridges(&mut self, rows: &[f64], local: impl Fn(u32) -> Option<u32>) {
+        let (stride, b) = (self.slots.stride, self.slots.bridge);
+        let mut liquid: std::collections::HashMap<u32, T> = std::collections::HashMap::new();
+        for row in rows.chunks_exact(BRIDGE_ROW) {
+            let (gi, gj) = (row[0] as u32, row[1] as u32);
+            let event = if row[2] == 0.0 { BridgeEvent::Rupture } else { BridgeEvent::Touch };
+            let mut l_i = *liquid.entry(gi).or_insert(T::of(row[4]));
+            let mut l_j = *liquid.entry(gj).or_insert(T::of(row[5]));
+            let bridge = move_liquid(event, T::of(row[3]), self.bridge_cap, &mut l_i, &mut l_j);
+            liquid.insert(gi, l_i);
+            liquid.insert(gj, l_j);
+            if let (Some(i), Some(j)) = (local(gi), local(gj)) {
+                let owner = self.slot[i as usize] as usize;
+                let range = self.pairs.owner_start[owner] as usize..self.pairs.owner_start[owner + 1] as usize;
+                let partners = &self.pairs.partner[range.clone()];
+                if let Ok(m) = partners.binary_search_by_key(&j, |&p| self.id[p as usize]) {
+                    self.hist[(range.start + m) * stride + b] = bridge;
+                }
+            }
+        }
+        for (g, l) in liquid {
+            if let Some(i) = local(g) {
+                self.liquid[self.slot[i as usize] as usize] = l;
+            }
+        }
     }
 
     /// The wall contacts of the last force evaluation of the grains `keep` accepts (by

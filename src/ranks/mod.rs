@@ -14,6 +14,10 @@
 //!   process that owns it now, with its walls' history, and each pair's history goes from a
 //!   process that owned one of its grains (and so computed it every step) to every process
 //!   that holds both, before the local neighbour list is built and the history carried over;
+//! - before each force evaluation of a capillary scene, the bridge events (ruptures, touches)
+//!   each process finds on the pairs of its own grains are gathered and replayed by every
+//!   process in canonical order, so liquid moves between grains of different processes as on
+//!   one;
 //! - after each force evaluation, the walls' sums (piston, servo walls) are taken over every
 //!   process's wall contacts in permanent-id order, so every process moves its walls alike.
 //!
@@ -25,15 +29,14 @@
 //!
 //! Limits of this first version: every process reads the whole scene and holds the whole
 //! state after each `advance` (memory and traffic O(N) per process per statistics read); the
-//! slabs cut one axis only; capillary scenes and contact dynamics are refused.
+//! slabs cut one axis only; contact dynamics is refused.
 
 mod slabs;
 
 pub use slabs::Slabs;
 
-use crate::cpu::{touch_of_row, touches_state, CpuEngine, RowWidths, Rows, StepHooks, WallContact, TOUCH_ROW};
+use crate::cpu::{touch_of_row, touches_state, CpuEngine, RowWidths, Rows, StepHooks, WallContact, BRIDGE_ROW, TOUCH_ROW};
 use crate::engine::{Engine, EngineState, Frame, SimError, Stats};
-use crate::model::CohesionLaw;
 use crate::real::Real;
 use crate::scene::{Method, Scene};
 use mpi::collective::SystemOperation;
@@ -111,9 +114,6 @@ impl<T: Real> Distributed<T> {
         let file = scene.path.display();
         if !matches!(scene.method, Method::Dem) {
             anyhow::bail!("{file}: simulation.method = \"contact_dynamics\" runs on one process; fix: run it without mpirun");
-        }
-        if !matches!(scene.model.cohesion, CohesionLaw::None) {
-            anyhow::bail!("{file}: model.cohesion = \"capillary\" runs on one process in this version (its liquid moves in one global order); fix: run it without mpirun");
         }
         let world = SimpleCommunicator::world();
         let slabs = Slabs::new(scene, world.size() as usize)?;
@@ -381,6 +381,18 @@ impl<T: Real> StepHooks<T> for Net<T> {
         Ok(())
     }
 
+    fn bridges(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
+        // Each pair's events come from the process that owns its owner grain (it lists every
+        // pair of that grain); every process replays them all, in canonical order.
+        let mine = e.bridge_rows(|l| self.owned[l as usize], |l| self.gid[l as usize]);
+        let all = self.all_gather(&mine);
+        let mut rows: Vec<&[f64]> = all.chunks_exact(BRIDGE_ROW).collect();
+        rows.sort_by_key(|r| (r[0] as u32, r[1] as u32));
+        let gid = &self.gid;
+        e.replay_bridges(&rows.concat(), |g| gid.binary_search(&g).ok().map(|l| l as u32));
+        Ok(())
+    }
+
     fn forces_evaluated(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError> {
         if self.template.walls.is_empty() {
             return Ok(());
@@ -438,8 +450,11 @@ impl<T: Real> Engine for Distributed<T> {
         self.local.set_servo(pressure, axial_strain_rate);
         self.whole.get_mut().set_servo(pressure, axial_strain_rate);
     }
-    fn wet(&mut self, _volume: f64) -> anyhow::Result<()> {
-        anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\" and run it on one process")
+    fn wet(&mut self, volume: f64) -> anyhow::Result<()> {
+        // Shared over every pair in canonical order: on the whole state, then scattered anew.
+        self.whole.get_mut().wet(volume)?;
+        self.local = self.net.scatter(self.whole.get_mut())?;
+        Ok(())
     }
     fn place_piston(&mut self, z: f64) {
         self.local.place_piston(z);
