@@ -21,15 +21,17 @@
 //! - after each force evaluation, the walls' sums (piston, servo walls) are taken over every
 //!   process's wall contacts in permanent-id order, so every process moves its walls alike.
 //!
-//! After each `advance` every process gathers the whole state (grains by permanent id, each
-//! pair once), and statistics, frames and checkpoints are the one-process engine's, computed
-//! from it: they are the same on every process, so the host loop takes the same decisions
-//! everywhere and rank 0 writes the outputs. A checkpoint is a one-process checkpoint and
-//! resumes on any number of processes.
+//! After each `advance` rank 0 gathers the whole state (grains by permanent id, each pair
+//! once), and statistics, frames and checkpoints are the one-process engine's, computed from
+//! it there: rank 0 writes the outputs and sends the statistics to the others, so the host
+//! loop takes the same decisions everywhere (the piston's place too). The other processes hold
+//! their slab alone. A checkpoint is a one-process checkpoint and resumes on any number of
+//! processes; a restore and a wetting stage gather or spread the whole state on every process
+//! for a moment.
 //!
-//! Limits of this first version: every process reads the whole scene and holds the whole
-//! state after each `advance` (memory and traffic O(N) per process per statistics read); the
-//! slabs cut one axis only; contact dynamics is refused.
+//! Limits of this version: every process reads the whole scene (its grains' starting values,
+//! O(N)); rank 0 holds the whole state (O(N)); the slabs cut one axis only; contact dynamics
+//! is refused.
 
 mod slabs;
 
@@ -43,7 +45,6 @@ use mpi::collective::SystemOperation;
 use mpi::datatype::{Partition, PartitionMut};
 use mpi::topology::SimpleCommunicator;
 use mpi::traits::*;
-use std::cell::RefCell;
 use std::sync::OnceLock;
 
 /// This process's rank and the number of processes, once MPI has started.
@@ -74,8 +75,9 @@ pub struct Distributed<T: Real> {
     /// The grains this process owns and its ghosts, numbered in ascending permanent id.
     local: CpuEngine<T>,
     net: Net<T>,
-    /// The whole state, gathered after each `advance`: statistics, frames and checkpoints.
-    whole: RefCell<CpuEngine<T>>,
+    /// On rank 0, the whole state, gathered there after each `advance`: statistics, frames
+    /// and checkpoints. None on the other processes, which hold their slab alone.
+    whole: Option<CpuEngine<T>>,
 }
 
 /// What the hooks between a step's operations need: everything but the local engine.
@@ -132,21 +134,35 @@ impl<T: Real> Distributed<T> {
             touches: Vec::new(),
         };
         let local = net.scatter(&mut whole)?;
-        Ok(Distributed { local, net, whole: RefCell::new(whole) })
+        let whole = (net.rank == 0).then_some(whole);
+        Ok(Distributed { local, net, whole })
     }
 
-    /// Gathers the whole state from every process into `whole`.
-    fn gather(&mut self) -> Result<(), SimError> {
+    /// Gathers the whole state from every process into `whole` on rank 0, or, when
+    /// `everywhere`, on every process (made on those that hold none).
+    fn gather_whole(&mut self, everywhere: bool) -> Result<(), SimError> {
         let state = self.local.save()?;
         let net = &self.net;
         let mut rows = Rows::of_state(&state, &net.widths, |l| net.owned[l as usize], |a, _| net.owned[a as usize]);
         rows.renumber(&net.widths, |l| net.gid[l as usize]);
-        let all = Rows { grains: net.all_gather(&rows.grains), pairs: net.all_gather(&rows.pairs) };
-        let (whole_state, _) = crate::cpu::state_of_rows(&all, &net.widths, &state, &touches_state(&net.touches));
-        let whole = self.whole.get_mut();
+        let (grains, pairs) = if everywhere { (Some(net.all_gather(&rows.grains)), Some(net.all_gather(&rows.pairs))) } else { (net.gather_to_root(&rows.grains), net.gather_to_root(&rows.pairs)) };
+        let (Some(grains), Some(pairs)) = (grains, pairs) else { return Ok(()) };
+        let (whole_state, _) = crate::cpu::state_of_rows(&Rows { grains, pairs }, &net.widths, &state, &touches_state(&net.touches));
+        let whole = match &mut self.whole {
+            Some(w) => w,
+            None => self.whole.insert(net.whole_engine().map_err(|e| net.internal(&self.local, &format!("{e:#}")))?),
+        };
         whole.restore(&whole_state).map_err(|e| net.internal(&self.local, &format!("cannot gather the whole state: {e:#}")))?;
         // The walls' counts of sliding and rolling contacts are not in a state: from the contacts.
         whole.set_wall_sums(&net.touches, net.grains.len());
+        Ok(())
+    }
+
+    /// Makes the local engine anew from the whole state `whole`, which every process holds,
+    /// and keeps `whole` on rank 0 alone.
+    fn scatter_from(&mut self, mut whole: CpuEngine<T>) -> anyhow::Result<()> {
+        self.local = self.net.scatter(&mut whole)?;
+        self.whole = (self.net.rank == 0).then_some(whole);
         Ok(())
     }
 }
@@ -207,6 +223,36 @@ impl<T: Real> Net<T> {
         local.restore(&state)?;
         self.gid = gid;
         Ok(local)
+    }
+
+    /// An engine over every grain of the scene (its state to be restored).
+    fn whole_engine(&self) -> anyhow::Result<CpuEngine<T>> {
+        Ok(CpuEngine::new(&Scene { grains: self.grains.clone(), ..self.template.clone() })?)
+    }
+
+    /// Every process's `mine`, concatenated in rank order, on rank 0; None elsewhere.
+    fn gather_to_root(&self, mine: &[f64]) -> Option<Vec<f64>> {
+        let root = self.world.process_at_rank(0);
+        if self.rank != 0 {
+            root.gather_into(&(mine.len() as i32));
+            root.gather_varcount_into(mine);
+            return None;
+        }
+        let mut counts = vec![0i32; self.world.size() as usize];
+        root.gather_into_root(&(mine.len() as i32), &mut counts[..]);
+        let displs = offsets(&counts);
+        let mut all = vec![0.0; counts.iter().map(|&c| c as usize).sum()];
+        root.gather_varcount_into_root(mine, &mut PartitionMut::new(&mut all[..], &counts[..], &displs[..]));
+        Some(all)
+    }
+
+    /// Rank 0's `bytes`, on every process.
+    fn broadcast_bytes(&self, bytes: &mut Vec<u8>) {
+        let root = self.world.process_at_rank(0);
+        let mut len = bytes.len() as u64;
+        root.broadcast_into(&mut len);
+        bytes.resize(len as usize, 0);
+        root.broadcast_into(&mut bytes[..]);
     }
 
     /// Every process's `mine`, concatenated in rank order.
@@ -426,42 +472,69 @@ impl<T: Real> Engine for Distributed<T> {
         for _ in 0..n {
             self.local.step_with(&mut self.net)?;
         }
-        self.gather()
+        self.gather_whole(false)
     }
+    /// Rank 0's statistics of the whole state, on every process (so that each takes the same
+    /// decisions), carried as the JSON a checkpoint carries them in.
     fn stats(&mut self) -> Result<Stats, SimError> {
-        self.whole.get_mut().stats()
+        let mut bytes = match &mut self.whole {
+            Some(w) => serde_json::to_vec(&w.stats()?).map_err(|e| self.net.internal(&self.local, &format!("{e}")))?,
+            None => Vec::new(),
+        };
+        self.net.broadcast_bytes(&mut bytes);
+        serde_json::from_slice(&bytes).map_err(|e| self.net.internal(&self.local, &format!("cannot read rank 0's statistics: {e}")))
     }
+    /// The whole state's frame on rank 0; an empty one on the other processes, which write no
+    /// outputs (what a frame decides, the piston's place, comes from rank 0).
     fn frame(&self, contacts: bool) -> Result<Frame, SimError> {
-        self.whole.borrow().frame(contacts)
+        self.whole.as_ref().map_or(Ok(Frame::default()), |w| w.frame(contacts))
     }
     fn set_piston_pressure(&mut self, pressure: f64) {
         self.local.set_piston_pressure(pressure);
-        self.whole.get_mut().set_piston_pressure(pressure);
+        if let Some(w) = &mut self.whole {
+            w.set_piston_pressure(pressure);
+        }
     }
+    /// The whole state, on rank 0, which alone writes checkpoints.
     fn save(&self) -> Result<EngineState, SimError> {
-        self.whole.borrow().save()
+        match &self.whole {
+            Some(w) => w.save(),
+            None => Err(self.net.internal(&self.local, "only rank 0 holds the whole state to save")),
+        }
     }
     fn restore(&mut self, state: &EngineState) -> anyhow::Result<()> {
-        self.whole.get_mut().restore(state)?;
-        self.local = self.net.scatter(self.whole.get_mut())?;
-        Ok(())
+        let mut whole = match self.whole.take() {
+            Some(w) => w,
+            None => self.net.whole_engine()?,
+        };
+        whole.restore(state)?;
+        self.scatter_from(whole)
     }
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
         self.local.set_servo(pressure, axial_strain_rate);
-        self.whole.get_mut().set_servo(pressure, axial_strain_rate);
+        if let Some(w) = &mut self.whole {
+            w.set_servo(pressure, axial_strain_rate);
+        }
     }
     fn wet(&mut self, volume: f64) -> anyhow::Result<()> {
-        // Shared over every pair in canonical order: on the whole state, then scattered anew.
-        self.whole.get_mut().wet(volume)?;
-        self.local = self.net.scatter(self.whole.get_mut())?;
-        Ok(())
+        // Shared over every pair in canonical order: on the whole state, gathered on every
+        // process, then scattered anew.
+        self.gather_whole(true)?;
+        let Some(mut whole) = self.whole.take() else { anyhow::bail!(self.net.internal(&self.local, "the whole state was gathered on every process, yet is missing here")) };
+        whole.wet(volume)?;
+        self.scatter_from(whole)
     }
     fn place_piston(&mut self, z: f64) {
+        // Rank 0's place: the others' frames are empty.
+        let mut z = z;
+        self.net.world.process_at_rank(0).broadcast_into(&mut z);
         self.local.place_piston(z);
-        self.whole.get_mut().place_piston(z);
+        if let Some(w) = &mut self.whole {
+            w.place_piston(z);
+        }
     }
     fn memory_bytes(&self) -> u64 {
-        self.local.memory_bytes() + self.whole.borrow().memory_bytes()
+        self.local.memory_bytes() + self.whole.as_ref().map_or(0, |w| w.memory_bytes())
     }
     fn set_profiling(&mut self, on: bool) {
         self.local.set_profiling(on);
