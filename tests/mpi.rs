@@ -1,7 +1,7 @@
 //! One run over several processes (`mpirun -np K grains run`, feature `mpi`) against the same
 //! run on one process, bit for bit: statistics, frames (with every contact's force and
 //! springs) and the final checkpoint, on a pour, an oedometer stage and a gas periodic along
-//! every axis (dry and wet), on 2 and 3 processes, f64 and f32; a loaded spring kept through
+//! every axis (dry and wet), on 2 and 3 processes (the gas on 4: a 2 x 2 grid), f64 and f32; a loaded spring kept through
 //! the migration of its grain; liquid moved between grains of different processes in
 //! canonical order; bad process counts refused in one line.
 //!
@@ -13,7 +13,7 @@ mod common;
 
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
-use grains::ranks::Slabs;
+use grains::ranks::{Grid, Slabs};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -154,10 +154,10 @@ fn grains_migrate_with_loaded_springs_and_keep_the_same_bits() {
     let dir = tempfile::tempdir().unwrap();
     let path = tilted_pour(dir.path());
     let scene = grains::scene::load(&path).unwrap();
-    let slabs = Slabs::new(&scene, 2).unwrap();
-    assert_eq!(slabs.axis, 0, "the cut runs across x");
+    let grid = Grid::new(&scene, 2).unwrap();
+    assert_eq!(grid.axes.clone().map(|s| s.count()), [2, 1, 1], "the cut runs across x");
     let mut e = CpuEngine::<f64>::new(&scene).unwrap();
-    let side = |f: &grains::engine::Frame, i: u32| slabs.owner(f.position[i as usize][slabs.axis]);
+    let side = |f: &grains::engine::Frame, i: u32| grid.owner(f.position[i as usize]);
     let springs = |f: &grains::engine::Frame| -> std::collections::BTreeSet<(u32, u32)> {
         f.contacts.as_ref().unwrap().iter().filter(|c| c.tangential_spring != [0.0; 3]).map(|c| (c.i, c.j)).collect()
     };
@@ -211,12 +211,13 @@ fn a_checkpoint_written_on_one_process_resumes_on_two() {
 #[test]
 fn slabs_narrower_than_the_reach_are_a_one_line_error() {
     let dir = tempfile::tempdir().unwrap();
-    let o = run(16, &pour(dir.path()), &dir.path().join("out"), "f64");
+    // 17 processes: a prime, so slabs along one axis, all too narrow for the reach.
+    let o = run(17, &pour(dir.path()), &dir.path().join("out"), "f64");
     let err = String::from_utf8_lossy(&o.stderr);
     let line = err.lines().find(|l| l.starts_with("error: ")).expect("an error line");
     println!("{line}");
     assert!(!o.status.success());
-    assert!(line.contains("16 processes cut the grains into slabs along z as narrow as") && line.ends_with("fix: run on fewer processes"), "{line}");
+    assert!(line.contains("17 processes cut the grains into slabs along z as narrow as") && line.ends_with("fix: run on fewer processes"), "{line}");
 }
 
 #[test]
@@ -314,9 +315,11 @@ fn slabs_round_a_periodic_axis_give_the_same_bits() {
     let dir = tempfile::tempdir().unwrap();
     let path = periodic_gas(dir.path());
     let scene = grains::scene::load(&path).unwrap();
-    let slabs = Slabs::new(&scene, 3).unwrap();
+    let grid = Grid::new(&scene, 3).unwrap();
+    let a = (0..3).find(|&a| grid.axes[a].count() == 3).expect("three slabs along one axis");
+    let slabs = &grid.axes[a];
     assert_eq!(slabs.period, Some([0.0, 14.0e-3]), "the slabs cut a wrapping axis");
-    let (a, last) = (slabs.axis, 2);
+    let last = 2;
     let mut e = CpuEngine::<f64>::new(&scene).unwrap();
     let (mut crossed, mut straddling) = (0, 0);
     let mut before = e.frame(true).unwrap();
@@ -331,6 +334,9 @@ fn slabs_round_a_periodic_axis_give_the_same_bits() {
     println!("grains crossing between the last slab and the first: {crossed}; loaded contacts across the period's ends, summed over 40 frames: {straddling}");
     assert!(crossed > 0 && straddling > 0, "the gas must cross and touch across the period's ends");
     same_bits_on(&[2, 3], &path, "f64");
+    let grid = Grid::new(&scene, 4).unwrap();
+    assert_eq!(grid.axes.clone().map(|s| s.count()).iter().filter(|&&c| c == 2).count(), 2, "four processes cut the cube into 2 x 2 columns");
+    same_bits_on(&[4], &path, "f64");
 }
 
 #[test]
@@ -374,11 +380,11 @@ fn liquid_bridges_across_the_cuts_give_the_same_bits() {
     let dir = tempfile::tempdir().unwrap();
     let path = wet_periodic_gas(dir.path());
     let scene = grains::scene::load(&path).unwrap();
-    let slabs = Slabs::new(&scene, 3).unwrap();
+    let grid = Grid::new(&scene, 3).unwrap();
     let mut e = CpuEngine::<f64>::new(&scene).unwrap();
     e.wet(scene.stages[0].wet_volume.unwrap()).unwrap();
     let bridges = |f: &grains::engine::Frame| -> std::collections::BTreeSet<(u32, u32)> {
-        let side = |i: u32| slabs.owner(f.position[i as usize][slabs.axis]);
+        let side = |i: u32| grid.owner(f.position[i as usize]);
         f.contacts.as_ref().unwrap().iter().filter(|c| c.bridge_volume > 0.0 && side(c.i) != side(c.j)).map(|c| (c.i, c.j)).collect()
     };
     let (mut formed, mut ruptured) = (0, 0);
@@ -436,11 +442,24 @@ contact_forces = true
     let path = dir.path().join("three.toml");
     std::fs::write(&path, text).unwrap();
     let scene = grains::scene::load(&path).unwrap();
-    let slabs = Slabs::new(&scene, 2).unwrap();
-    let owners: Vec<usize> = scene.grains.position.iter().map(|p| slabs.owner(p[slabs.axis])).collect();
+    let grid = Grid::new(&scene, 2).unwrap();
+    let owners: Vec<usize> = scene.grains.position.iter().map(|&p| grid.owner(p)).collect();
     assert_eq!(owners, vec![1, 0, 1], "the left grain alone on process 0");
     let stats = same_bits_on(&[2], &path, "f64");
     let bridges = |row: &str| row.split(',').nth(20).unwrap().parse::<u32>().unwrap();
     println!("bridges at the end: {}", bridges(stats.lines().last().unwrap()));
     assert!(stats.lines().skip(1).any(|r| bridges(r) == 2), "both bridges must form");
+}
+
+#[test]
+fn a_grid_of_boxes_holds_ghosts_in_the_boxes_around_the_owner() {
+    let axis = |a: usize, cuts: Vec<f64>| Slabs { axis: a, cuts, reach: 0.25, skin: 0.05, period: None };
+    let grid = Grid { axes: [axis(0, vec![1.0]), axis(1, vec![1.0]), axis(2, vec![])] };
+    assert_eq!(grid.ranks(), 4);
+    // Boxes: 0 = (x < 1, y < 1), 1 = (x >= 1, y < 1), 2 = (x < 1, y >= 1), 3 = (x >= 1, y >= 1).
+    assert_eq!(grid.owner([0.5, 1.5, 7.0]), 2);
+    assert_eq!(grid.holders([0.5, 0.5, 0.0]), vec![0], "inside its box, beyond the reach of the others");
+    assert_eq!(grid.holders([0.9, 0.5, 0.0]), vec![0, 1], "near one face");
+    assert_eq!(grid.holders([0.9, 1.1, 0.0]), vec![2, 0, 1, 3], "near an edge: the diagonal box too");
+    assert!(grid.near([0.9, 1.1, 0.0], 1) && !grid.near([0.5, 1.1, 0.0], 1));
 }

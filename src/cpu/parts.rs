@@ -369,6 +369,11 @@ impl<T: Real> CpuEngine<T> {
         position::absolute(self.body[s].pos, position::residual_at(&self.residual, s))[axis]
     }
 
+    /// The position (m) of grain `id`: `pos + residual`.
+    pub(crate) fn position(&self, id: u32) -> [f64; 3] {
+        [0, 1, 2].map(|a| self.coordinate(id, a))
+    }
+
     /// The step at which an error is reported, and the step suggested after an instability.
     pub(crate) fn error_context(&self) -> (u64, f64, f64) {
         (self.step, self.time, self.suggested_dt)

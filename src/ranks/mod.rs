@@ -1,8 +1,8 @@
 //! One run over several processes (feature `mpi`): `mpirun -np K grains run SCENE`.
 //!
-//! The domain is cut into slabs ([`Slabs`]), one per process. Each process runs the CPU
-//! engine over the grains it owns and, as ghosts, the grains of its neighbours within the
-//! neighbour reach of its slab. A pair with a ghost is computed by both processes with the
+//! The domain is cut into boxes ([`Grid`]: slabs along one axis, or a grid of them along two
+//! or three), one per process. Each process runs the CPU engine over the grains it owns and,
+//! as ghosts, the grains of the boxes around it within the neighbour reach of its box. A pair with a ghost is computed by both processes with the
 //! same operations on the same bits, and every sum a grain's load takes runs in permanent-id
 //! order whatever the numbering (see `cpu`), so each owned grain's load, and so its motion,
 //! is the one process's to the bit. Between the operations of a step
@@ -25,16 +25,19 @@
 //! once), and statistics, frames and checkpoints are the one-process engine's, computed from
 //! it there: rank 0 writes the outputs and sends the statistics to the others, so the host
 //! loop takes the same decisions everywhere (the piston's place too). The other processes hold
-//! their slab alone. A checkpoint is a one-process checkpoint and resumes on any number of
+//! their box alone. A checkpoint is a one-process checkpoint and resumes on any number of
 //! processes; a restore and a wetting stage gather or spread the whole state on every process
 //! for a moment.
 //!
 //! Limits of this version: every process reads the whole scene (its grains' starting values,
-//! O(N)); rank 0 holds the whole state (O(N)); the slabs cut one axis only; contact dynamics
-//! is refused.
+//! O(N)); rank 0 holds the whole state (O(N)); the grid's cuts along an axis are the same
+//! for every box (a tensor grid: a packing denser in one corner balances poorly); contact
+//! dynamics is refused.
 
+mod grid;
 mod slabs;
 
+pub use grid::Grid;
 pub use slabs::Slabs;
 
 use crate::cpu::{touch_of_row, touches_state, CpuEngine, RowWidths, Rows, StepHooks, WallContact, BRIDGE_ROW, TOUCH_ROW};
@@ -76,7 +79,7 @@ pub struct Distributed<T: Real> {
     local: CpuEngine<T>,
     net: Net<T>,
     /// On rank 0, the whole state, gathered there after each `advance`: statistics, frames
-    /// and checkpoints. None on the other processes, which hold their slab alone.
+    /// and checkpoints. None on the other processes, which hold their box alone.
     whole: Option<CpuEngine<T>>,
 }
 
@@ -84,7 +87,7 @@ pub struct Distributed<T: Real> {
 struct Net<T: Real> {
     world: SimpleCommunicator,
     rank: usize,
-    slabs: Slabs,
+    grid: Grid,
     /// The scene with no grains: the local engines are made from it and their grains.
     template: Scene,
     /// The scene's grains, by permanent id.
@@ -118,13 +121,13 @@ impl<T: Real> Distributed<T> {
             anyhow::bail!("{file}: simulation.method = \"contact_dynamics\" runs on one process; fix: run it without mpirun");
         }
         let world = SimpleCommunicator::world();
-        let slabs = Slabs::new(scene, world.size() as usize)?;
+        let grid = Grid::new(scene, world.size() as usize)?;
         let mut whole = CpuEngine::<T>::new(scene)?;
         let template = Scene { grains: Default::default(), ..scene.clone() };
         let mut net = Net {
             rank: world.rank() as usize,
             world,
-            slabs,
+            grid,
             template,
             grains: scene.grains.clone(),
             widths: whole.row_widths(),
@@ -169,12 +172,11 @@ impl<T: Real> Distributed<T> {
 
 impl<T: Real> Net<T> {
     /// Makes the local engine from the whole state, which every process holds: this process
-    /// owns the grains in its slab and holds as ghosts their partners in the current list.
+    /// owns the grains in its box and holds as ghosts their partners in the current list.
     fn scatter(&mut self, whole: &mut CpuEngine<T>) -> anyhow::Result<CpuEngine<T>> {
         let state = whole.save()?;
         let n = self.grains.len();
-        let axis = self.slabs.axis;
-        let owner: Vec<usize> = (0..n as u32).map(|i| self.slabs.owner(whole.coordinate(i, axis))).collect();
+        let owner: Vec<usize> = (0..n as u32).map(|i| self.grid.owner(whole.position(i))).collect();
         let me = self.rank;
         // Each grain's holders: its owner and the owners of its partners.
         let mut held: Vec<Vec<usize>> = owner.iter().map(|&o| vec![o]).collect();
@@ -323,22 +325,21 @@ impl<T: Real> Net<T> {
         self.owned.iter().enumerate().filter(|(_, o)| **o).map(|(l, _)| l as u32)
     }
 
-    /// Cuts the slabs anew at the quantiles of the owned grains' positions when a process
-    /// owns more than [`slabs::REBALANCE_ABOVE`] times the mean (the same decision and cuts on
-    /// every process: from the gathered counts and positions).
+    /// Cuts the grid anew at the quantiles of the owned grains' positions when a process owns
+    /// more than [`grid::REBALANCE_ABOVE`] times the mean (the same decision and cuts on every
+    /// process: from the gathered counts and positions).
     fn rebalance(&mut self, e: &CpuEngine<T>) {
         let owned = self.owned_numbers().count() as u64;
         let size = self.world.size() as usize;
         let mut counts = vec![0u64; size];
         self.world.all_gather_into(&owned, &mut counts[..]);
         let mean = self.grains.len() as f64 / size as f64;
-        if (*counts.iter().max().unwrap_or(&0) as f64) <= slabs::REBALANCE_ABOVE * mean {
+        if (*counts.iter().max().unwrap_or(&0) as f64) <= grid::REBALANCE_ABOVE * mean {
             return;
         }
-        let axis = self.slabs.axis;
-        let mine: Vec<f64> = self.owned_numbers().map(|l| e.coordinate(l, axis)).collect();
-        // Too narrow slabs keep the cuts they had.
-        let _ = self.slabs.cut_at_quantiles(self.all_gather(&mine), size);
+        let mine: Vec<f64> = self.owned_numbers().flat_map(|l| e.position(l)).collect();
+        let all: Vec<[f64; 3]> = self.all_gather(&mine).chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+        self.grid.recut(&all);
     }
 
     /// Rebuilds on every process: grains to their owners, pairs' history to the processes
@@ -348,8 +349,7 @@ impl<T: Real> Net<T> {
         self.agree(e, bad.map(|l| SimError::Unstable { step: 0, time: 0.0, what: String::new(), grain: l, suggested_dt: 0.0, also: "" }))?;
         self.rebalance(e);
         let state = e.save()?;
-        let axis = self.slabs.axis;
-        let holders: Vec<Vec<usize>> = (0..self.gid.len() as u32).map(|l| self.slabs.holders(e.coordinate(l, axis))).collect();
+        let holders: Vec<Vec<usize>> = (0..self.gid.len() as u32).map(|l| self.grid.holders(e.position(l))).collect();
         let me = self.rank;
         // The rows each process gets from this one: the grains it will hold that this one
         // owns, and the pairs between two grains it will hold of which this one owns one.
@@ -359,7 +359,7 @@ impl<T: Real> Net<T> {
             rows.renumber(&self.widths, |l| self.gid[l as usize]);
             rows
         };
-        // Only the processes that hold one of this one's grains get rows (the slabs' neighbours):
+        // Only the processes that hold one of this one's grains get rows (the boxes' neighbours):
         // the others get no rows, without a pass over the state.
         let mut dest = vec![false; self.world.size() as usize];
         for l in self.owned_numbers() {
@@ -377,14 +377,14 @@ impl<T: Real> Net<T> {
         let mut local = self.make_local(&rows, &state).map_err(|err| self.internal(e, &format!("{err:#}")))?;
         let built = local.rebuild();
         self.agree(&local, built.err())?;
-        let x: Vec<f64> = (0..self.gid.len() as u32).map(|l| local.coordinate(l, axis)).collect();
-        let owner: Vec<usize> = x.iter().map(|&x| self.slabs.owner(x)).collect();
+        let x: Vec<[f64; 3]> = (0..self.gid.len() as u32).map(|l| local.position(l)).collect();
+        let owner: Vec<usize> = x.iter().map(|&p| self.grid.owner(p)).collect();
         self.owned = owner.iter().map(|&o| o == me).collect();
         self.links = (0..self.world.size() as usize)
             .filter(|&r| r != me)
             .map(|r| Link {
                 rank: r,
-                send: (0..x.len() as u32).filter(|&l| owner[l as usize] == me && self.slabs.near(x[l as usize], r)).collect(),
+                send: (0..x.len() as u32).filter(|&l| owner[l as usize] == me && self.grid.near(x[l as usize], r)).collect(),
                 recv: (0..x.len() as u32).filter(|&l| owner[l as usize] == r).collect(),
             })
             .filter(|l| !l.send.is_empty() || !l.recv.is_empty())

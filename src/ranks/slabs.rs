@@ -1,14 +1,14 @@
-//! How a distributed run cuts the domain: slabs along one axis, one per process, each
-//! holding about as many grains as the others: cut at the start, and again at a rebuild when
-//! the counts have drifted apart. Along a wrapping axis the slabs form a ring: the last one
-//! borders the first across the period.
+//! How a distributed run cuts one axis of the domain (see [`super::Grid`], which cuts each
+//! axis so): into slabs, each holding about as many grains as the others, cut at the start
+//! and again at a rebuild when the counts have drifted apart. Along a wrapping axis the slabs
+//! form a ring: the last one borders the first across the period.
 
 use crate::scene::Scene;
 
-/// Slabs along `axis`: process `r` owns the grains with `cuts[r - 1] <= x < cuts[r]` (the
-/// first and last slabs reach to infinity, or, along a wrapping axis, to the period's ends,
-/// positions taken within the period), and holds as ghosts the grains of its neighbours within
-/// `reach` of its slab.
+/// Slabs along `axis`: slab `r` holds the grains with `cuts[r - 1] <= x < cuts[r]` (the first
+/// and last slabs reach to infinity, or, along a wrapping axis, to the period's ends,
+/// positions taken within the period), and its neighbours' grains within `reach` of it as
+/// ghosts.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Slabs {
     /// The axis cut (0 = x).
@@ -27,40 +27,37 @@ pub struct Slabs {
     pub period: Option<[f64; 2]>,
 }
 
-/// A grain count at which the slabs are cut anew, as a multiple of the mean: a rebuild that
-/// finds a process owning more moves the cuts to the quantiles of the grains' positions.
-pub const REBALANCE_ABOVE: f64 = 1.2;
-
 impl Slabs {
-    /// The slabs of `scene` for `ranks` processes: along the axis over which the grains spread
-    /// widest (a wrapping axis spans its period), cut at the quantiles of the grains' starting
-    /// positions.
-    pub fn new(scene: &Scene, ranks: usize) -> anyhow::Result<Self> {
-        let file = scene.path.display();
-        let g = &scene.grains;
-        let extent = |a: usize| match scene.periodic[a] {
+    /// One slab along `axis` of `scene` (uncut), with the scene's reach, skin and period.
+    pub fn uncut(scene: &Scene, axis: usize) -> Self {
+        let r_max = scene.grains.radius.iter().copied().fold(0.0, f64::max);
+        Slabs { axis, cuts: Vec::new(), reach: 2.0 * r_max + scene.skin + scene.bridges.reach, skin: scene.skin, period: scene.periodic[axis] }
+    }
+
+    /// How far the grains of `scene` spread along the axis (m): a wrapping axis spans its
+    /// period.
+    pub fn extent(&self, scene: &Scene) -> f64 {
+        match self.period {
             Some([lo, hi]) => hi - lo,
             None => {
-                let (lo, hi) = g.position.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[a]), hi.max(p[a])));
+                let (lo, hi) = scene.grains.position.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p[self.axis]), hi.max(p[self.axis])));
                 hi - lo
             }
-        };
-        let axis = (0..3).max_by(|&a, &b| extent(a).total_cmp(&extent(b))).unwrap_or(0);
-        let r_max = g.radius.iter().copied().fold(0.0, f64::max);
-        let n = g.len();
-        if ranks > n {
-            anyhow::bail!("{file}: {ranks} processes for {n} grains; fix: run on at most {n} processes");
         }
-        let mut slabs = Slabs { axis, cuts: Vec::new(), reach: 2.0 * r_max + scene.skin + scene.bridges.reach, skin: scene.skin, period: scene.periodic[axis] };
-        let x: Vec<f64> = g.position.iter().map(|p| p[axis]).collect();
-        if let Err(w) = slabs.cut_at_quantiles(x, ranks) {
-            let (name, need) = (["x", "y", "z"][axis], slabs.reach + slabs.skin);
-            anyhow::bail!(
-                "{file}: {ranks} processes cut the grains into slabs along {name} as narrow as {w:.3e} m, below the {need:.3e} m a slab needs (the neighbour reach 2 r_max + skin = {:.3e} m plus the skin); fix: run on fewer processes",
-                slabs.reach
-            );
-        }
-        Ok(slabs)
+    }
+
+    /// Slabs along the axis (0 = x) cut into `slabs` at the quantiles of `scene`'s starting
+    /// positions; the narrowest slab (m) when one would be too narrow (see
+    /// [`Self::cut_at_quantiles`]).
+    pub fn cut(scene: &Scene, axis: usize, slabs: usize) -> Result<Self, f64> {
+        let mut s = Slabs::uncut(scene, axis);
+        s.cut_at_quantiles(scene.grains.position.iter().map(|p| p[axis]).collect(), slabs)?;
+        Ok(s)
+    }
+
+    /// Slabs along the axis.
+    pub fn count(&self) -> usize {
+        self.cuts.len() + 1
     }
 
     /// `x` (m) brought into the period along a wrapping axis; `x` itself otherwise.
@@ -79,6 +76,10 @@ impl Slabs {
     /// the narrowest slab (m) when one would be narrower than `reach + skin` (an inner one;
     /// along a wrapping axis, any one).
     pub fn cut_at_quantiles(&mut self, x: Vec<f64>, ranks: usize) -> Result<(), f64> {
+        if ranks <= 1 {
+            self.cuts.clear();
+            return Ok(());
+        }
         let mut x: Vec<f64> = x.into_iter().map(|x| self.wrap(x)).collect();
         x.sort_by(f64::total_cmp);
         let n = x.len();
