@@ -401,43 +401,15 @@ fn liquid_bridges_across_the_cuts_give_the_same_bits() {
     same_bits_on(&[2, 3], &path, "f64");
 }
 
-/// Two grains hit a wet third one from both sides in the same step (seed of
-/// `tests/reorder.rs`'s twin), the left one on process 0, the middle and right ones on process
-/// 1, the right one beyond process 0's reach: both bridges form in one step from the middle
+/// Two grains hit a wet third one from both sides in the same step
+/// ([`common::three_wet_grains`], as in `tests/reorder.rs`), the left one on process 0, the
+/// middle and right ones on process 1, the right one beyond process 0's reach: both bridges form in one step from the middle
 /// grain's liquid, the first (by ids: right and middle) found on process 1, the second on
 /// process 0, which must take what the first left. On two processes: the lone run's bytes,
 /// both bridges and the liquid left on the grains included.
 #[test]
 fn two_bridges_formed_in_one_step_on_two_processes_take_their_liquid_in_id_order() {
-    let grain = |x: f64, v: f64| format!("[[grain]]\nmaterial = \"glass\"\nradius = 5.0e-4\nposition = [{x:e}, 0.0, 0.0]\nvelocity = [{v:e}, 0.0, 0.0]\n");
-    let text = format!(
-        r#"
-[[material]]
-name = "glass"
-density = 2500.0
-youngs_modulus = 1.0e8
-poisson_ratio = 0.3
-restitution = 0.5
-{}{}{}
-[model]
-damping = "restitution"
-cohesion = "capillary"
-[simulation]
-gravity = [0.0, 0.0, 0.0]
-dt = 2.0e-7
-stats_interval = 50
-[[stage]]
-kind = "run"
-duration = 6.0e-4
-water_content = 0.01
-[output]
-frame_interval = 1.0e-5
-contact_forces = true
-"#,
-        grain(2.0e-3, -2.0),
-        grain(-2.0e-3, 2.0),
-        grain(0.0, 0.0)
-    );
+    let text = common::three_wet_grains(6.0e-4) + "[output]\nframe_interval = 1.0e-5\ncontact_forces = true\n";
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("three.toml");
     std::fs::write(&path, text).unwrap();

@@ -131,32 +131,7 @@ fn renumbering_changes_no_bit_of_a_periodic_gas() {
 /// grain first in memory; the bridges must still form in permanent-id order.
 #[test]
 fn two_bridges_formed_in_one_step_take_their_liquid_in_id_order() {
-    let grain = |x: f64, v: f64| format!("[[grain]]\nmaterial = \"glass\"\nradius = 5.0e-4\nposition = [{x:e}, 0.0, 0.0]\nvelocity = [{v:e}, 0.0, 0.0]\n");
-    let scene = common::parse(&format!(
-        r#"
-[[material]]
-name = "glass"
-density = 2500.0
-youngs_modulus = 1.0e8
-poisson_ratio = 0.3
-restitution = 0.5
-{}{}{}
-[model]
-damping = "restitution"
-cohesion = "capillary"
-[simulation]
-gravity = [0.0, 0.0, 0.0]
-dt = 2.0e-7
-stats_interval = 50
-[[stage]]
-kind = "run"
-duration = 1.0e-3
-water_content = 0.01
-"#,
-        grain(2.0e-3, -2.0),
-        grain(-2.0e-3, 2.0),
-        grain(0.0, 0.0)
-    ));
+    let scene = common::parse(&common::three_wet_grains(1.0e-3));
     let volume = scene.stages[0].wet_volume.unwrap();
     let wet = |e: &mut CpuEngine<f64>| e.wet(volume).unwrap();
     let plain = run::<f64>(&scene, 0, 2700, wet);

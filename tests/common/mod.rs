@@ -181,3 +181,36 @@ impl Recorder for StopAt {
         anyhow::bail!("interrupted at checkpoint {} (stage {}, inside it: {})", self.seen, progress.next_stage, progress.in_stage.is_some())
     }
 }
+
+/// Two glass grains (d = 1 mm) moving at 2 m/s from x = +-2 mm onto a third at rest at the
+/// origin, listed out of their order in space (ids: right, left, middle), wetted (w = 0.01) with
+/// capillary cohesion, no gravity, dt = 2e-7 s, one run stage of `duration` (s): both hit the
+/// middle grain in the same step, and both bridges form then from its liquid.
+pub fn three_wet_grains(duration: f64) -> String {
+    let grain = |x: f64, v: f64| format!("[[grain]]\nmaterial = \"glass\"\nradius = 5.0e-4\nposition = [{x:e}, 0.0, 0.0]\nvelocity = [{v:e}, 0.0, 0.0]\n");
+    format!(
+        r#"
+[[material]]
+name = "glass"
+density = 2500.0
+youngs_modulus = 1.0e8
+poisson_ratio = 0.3
+restitution = 0.5
+{}{}{}
+[model]
+damping = "restitution"
+cohesion = "capillary"
+[simulation]
+gravity = [0.0, 0.0, 0.0]
+dt = 2.0e-7
+stats_interval = 50
+[[stage]]
+kind = "run"
+duration = {duration:e}
+water_content = 0.01
+"#,
+        grain(2.0e-3, -2.0),
+        grain(-2.0e-3, 2.0),
+        grain(0.0, 0.0)
+    )
+}
