@@ -434,8 +434,8 @@ impl<T: Real> CpuEngine<T> {
         events
     }
 
-    /// Runs the force passes: `update_bridges` (capillary scenes), `pair_force`, `gather`,
-    /// `wall_contacts`; the springs advance by `elapsed` (s).
+    /// Runs the force passes: `pair_force`, `gather`, `wall_contacts`; the springs advance by
+    /// `elapsed` (s). In capillary scenes the step's hooks update the bridges just before.
     fn evaluate_forces(&mut self, elapsed: T) {
         let t = self.clock.start();
         let ctx = ForceContext {

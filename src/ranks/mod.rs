@@ -2,11 +2,11 @@
 //!
 //! The domain is cut into boxes ([`Grid`]: slabs along one axis, or a grid of them along two
 //! or three), one per process. Each process runs the CPU engine over the grains it owns and,
-//! as ghosts, the grains of the boxes around it within the neighbour reach of its box. A pair with a ghost is computed by both processes with the
-//! same operations on the same bits, and every sum a grain's load takes runs in permanent-id
-//! order whatever the numbering (see `cpu`), so each owned grain's load, and so its motion,
-//! is the one process's to the bit. Between the operations of a step
-//! ([`crate::cpu::CpuEngine::step_with`]):
+//! as ghosts, the grains of the boxes around it within the neighbour reach of its box. A pair
+//! with a ghost is computed by both processes with the same operations on the same bits, and
+//! every sum a grain's load takes runs in permanent-id order whatever the numbering (see
+//! `cpu`), so each owned grain's load, and so its motion, is the one process's to the bit.
+//! Between the operations of a step ([`crate::cpu::CpuEngine::step_with`]):
 //! - after each drift, each process sends its neighbours the motion of the grains they hold
 //!   as ghosts, and the largest displacement since the last rebuild is the maximum over all;
 //! - when that calls for a rebuild, every process rebuilds at once: the cuts move to the
