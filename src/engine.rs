@@ -45,6 +45,15 @@ pub enum SimError {
         /// A second fix, when the step may not be the cause ("" otherwise), starting with ", ".
         also: &'static str,
     },
+    /// The processes of a run over MPI disagree on the state or its messages: a bug of grains,
+    /// not of the scene or its step.
+    #[error("processes disagree at step {step}: {what}; fix: report this as a bug, with the scene and the process count (the run on one process does not meet it)")]
+    Internal {
+        /// Step at which it was seen.
+        step: u64,
+        /// What was seen, naming the process.
+        what: String,
+    },
 }
 
 /// Force on one wall and, for the piston, its state.

@@ -296,12 +296,13 @@ impl<T: Real> Net<T> {
     /// The same error on every process: of the errors the processes met (`mine` here), the one
     /// about the lowest permanent id.
     fn agree(&self, e: &CpuEngine<T>, mine: Option<SimError>) -> Result<(), SimError> {
-        // [kind (0: none, 1: capacity, 2: non-finite), grain, count]
+        // [kind (0: none, 1: capacity, 2: non-finite, 3: internal), grain, count]
         let code = match &mine {
             None => [0, u32::MAX as u64, 0],
             Some(SimError::Capacity { grain, count, .. }) => [1, self.gid[*grain as usize] as u64, *count as u64],
             Some(SimError::Unstable { grain, .. }) => [2, self.gid.get(*grain as usize).copied().unwrap_or(*grain) as u64, 0],
             Some(SimError::Device { .. }) => [2, 0, 0],
+            Some(SimError::Internal { .. }) => [3, 0, 0],
         };
         let mut all = vec![0u64; 3 * self.world.size() as usize];
         self.world.all_gather_into(&code[..], &mut all[..]);
@@ -310,14 +311,14 @@ impl<T: Real> Net<T> {
         let grain = c[1] as u32;
         Err(match c[0] {
             1 => SimError::Capacity { step, grain, count: c[2] as usize, capacity: self.template.max_neighbours },
+            3 => SimError::Internal { step, what: format!("process {} met an internal error", all.chunks_exact(3).position(|c| c[0] == 3).unwrap_or(0)) },
             _ => SimError::Unstable { step, time, what: "non-finite position or velocity".into(), grain, suggested_dt, also: "" },
         })
     }
 
     /// An error for a state the processes disagree on (a bug, not the scene's doing).
     fn internal(&self, e: &CpuEngine<T>, what: &str) -> SimError {
-        let (step, time, suggested_dt) = e.error_context();
-        SimError::Unstable { step, time, what: format!("process {}: {what}", self.rank), grain: 0, suggested_dt, also: ", and report this as a bug" }
+        SimError::Internal { step: e.steps(), what: format!("process {}: {what}", self.rank) }
     }
 
     /// Local numbers of the grains this process owns.
