@@ -262,8 +262,8 @@ fn cuts_move_to_the_quantiles_unless_a_slab_would_be_too_narrow() {
 }
 
 /// A jostling gas periodic along every axis (Hertz-Mindlin, 1,300 grains in a 14 mm cube,
-/// contacts with their forces and springs in the frames): the slabs of 2 or 3 processes form a ring along z, the first of its
-/// equally wide axes.
+/// contacts with their forces and springs in the frames): the slabs of 2 or 3 processes form a
+/// ring along z, the first of its equally wide axes.
 fn periodic_gas(dir: &Path) -> PathBuf {
     let path = dir.join("periodic_gas.toml");
     std::fs::write(&path, PERIODIC_GAS).unwrap();
