@@ -85,7 +85,7 @@ impl Slabs {
         let n = x.len();
         let cuts: Vec<f64> = (1..ranks).map(|k| 0.5 * (x[k * n / ranks - 1] + x[k * n / ranks])).collect();
         let bounds: Vec<f64> = match self.period {
-            Some([lo, hi]) if ranks > 1 => [lo].into_iter().chain(cuts.iter().copied()).chain([hi]).collect(),
+            Some([lo, hi]) => [lo].into_iter().chain(cuts.iter().copied()).chain([hi]).collect(),
             _ => cuts.clone(),
         };
         if let Some(w) = bounds.windows(2).map(|c| c[1] - c[0]).min_by(f64::total_cmp).filter(|&w| !(w >= self.reach + self.skin)) {
