@@ -3,15 +3,15 @@
 //! granular model), with or without capillary bridges, in lanes that the compiler turns into
 //! vector instructions.
 //!
-//! Each lane group is loaded one pair at a time (the scattered reads of the two grains),
-//! then every lane runs the very same `contact_force` as the one-pair pass, with the laws
-//! fixed at compile time and no branch on whether the pair touches (a third of a dense
-//! packing's listed pairs do not, in no order a branch predictor learns): the result of a
-//! pair that does not touch is dropped by a select. In capillary scenes, where most listed
-//! pairs are open, each window of pairs is first sorted without a branch: the open ones take
-//! `pair_force` itself (springs forgotten, a bridge's pull across the gap), the touching ones
-//! fill the lanes, and a bridge adds its contact force `f0` by a select. Same operations on
-//! the same inputs, so the same bits as `pair_force`; `tests` below check it.
+//! Each window of pairs is first tested for touch without a branch (the positions and radii
+//! read one pair at a time, the fold and the test in vector lanes) and split into its touching
+//! and open pairs. The open ones are done at once (a third of a dense packing's listed pairs,
+//! most of a capillary scene's): dry, a zero force and forgotten springs; wet, `pair_force`
+//! itself (springs forgotten, a bridge's pull across the gap). The touching ones, packed, load
+//! the rest of their grains one pair at a time and run the very same `contact_force` as the
+//! one-pair pass in every lane, with the laws fixed at compile time; a bridge adds its contact
+//! force `f0` by a select. Same operations on the same inputs, so the same bits as
+//! `pair_force`; `tests` below check it.
 
 use super::pair_force::ForceContext;
 use super::pairs::PairList;
@@ -66,10 +66,8 @@ impl<T: Real> V3s<T> {
 
 /// What one lane group reads.
 struct Inputs<T> {
-    /// `pos_i - pos_j`, before the periodic fold.
+    /// The separation `r_i - r_j` (m, minimum image, residuals included).
     d: V3s<T>,
-    /// `residual_i - residual_j` (zero unless compensated).
-    dr: V3s<T>,
     r_i: [T; LANES],
     r_j: [T; LANES],
     m_i: [T; LANES],
@@ -103,17 +101,80 @@ struct Outputs<T> {
 /// Pairs sorted into touching and open at a time.
 const WINDOW: usize = 256;
 
-/// Where the lane kernel hands each pair's force.
-pub trait PairSink<T> {
-    /// Takes the force of the block's pair `m` (counted from its first pair). Without cohesion
-    /// the pairs come in pair order; in capillary scenes each window's open pairs come first.
-    fn put(&mut self, m: usize, f: &ContactForce<T>);
+/// What the touch test of one window of pairs reads and finds.
+struct Window<T> {
+    /// `pos_i - pos_j`, then, once folded and completed, the separation (m).
+    d: [[T; WINDOW]; 3],
+    /// `residual_i - residual_j` (zero unless compensated).
+    dr: [[T; WINDOW]; 3],
+    r_i: [T; WINDOW],
+    r_j: [T; WINDOW],
+    touching: [bool; WINDOW],
 }
 
-impl<T: Copy> PairSink<T> for [ContactForce<T>] {
+/// The lane kernel's working arrays, kept from call to call (each call overwrites what it
+/// reads): a task of the pair pass would otherwise clear tens of kilobytes per few hundred
+/// pairs.
+pub struct Scratch<T> {
+    win: Window<T>,
+    /// The window's touching pairs, then its open ones, in pair order.
+    touching: [u16; WINDOW],
+    open: [u16; WINDOW],
+}
+
+impl<T: Real> Scratch<T> {
+    /// Arrays of zeros.
+    pub fn new() -> Box<Self> {
+        let win = Window { d: [[T::ZERO; WINDOW]; 3], dr: [[T::ZERO; WINDOW]; 3], r_i: [T::ZERO; WINDOW], r_j: [T::ZERO; WINDOW], touching: [false; WINDOW] };
+        Box::new(Scratch { win, touching: [0; WINDOW], open: [0; WINDOW] })
+    }
+}
+
+impl<T: Real> Inputs<T> {
+    /// Lanes of zeros, with unit masses so that the lanes of a first short group divide by
+    /// no zero mass.
+    fn new() -> Self {
+        Inputs {
+            d: V3s::ZERO,
+            r_i: [T::ZERO; LANES],
+            r_j: [T::ZERO; LANES],
+            m_i: [T::ONE; LANES],
+            m_j: [T::ONE; LANES],
+            v_i: V3s::ZERO,
+            v_j: V3s::ZERO,
+            w_i: V3s::ZERO,
+            w_j: V3s::ZERO,
+            v_eff: [T::ZERO; LANES],
+            g_eff: [T::ZERO; LANES],
+            mu_s: [T::ZERO; LANES],
+            beta: [T::ZERO; LANES],
+            xi: V3s::ZERO,
+            v_b: [T::ZERO; LANES],
+        }
+    }
+}
+
+/// Where the lane kernel hands each pair's force.
+pub trait PairSink<T> {
+    /// Takes the force of the block's pair `m` (counted from its first pair). The touching
+    /// pairs come in pair order; in capillary scenes each window's open pairs come before
+    /// them.
+    fn put(&mut self, m: usize, f: &ContactForce<T>);
+
+    /// Pair `m` does not touch and has no bridge: its force is zero. Called in any order
+    /// (in a dry scene, a window's open pairs before its touching ones).
+    fn skip(&mut self, m: usize);
+}
+
+impl<T: Copy + Default> PairSink<T> for [ContactForce<T>] {
     #[inline(always)]
     fn put(&mut self, m: usize, f: &ContactForce<T>) {
         self[m] = *f;
+    }
+
+    #[inline(always)]
+    fn skip(&mut self, m: usize) {
+        self[m] = ContactForce::default();
     }
 }
 
@@ -122,82 +183,72 @@ impl<T: Copy> PairSink<T> for [ContactForce<T>] {
 /// scenes, their bridge volumes (a fourth).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub fn hertz_mindlin_block<T: Real, S: PairSink<T> + ?Sized>(model: &ContactModel<T>, first: usize, n: usize, sink: &mut S, hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
+pub fn hertz_mindlin_block<T: Real, S: PairSink<T> + ?Sized>(model: &ContactModel<T>, scratch: &mut Scratch<T>, first: usize, n: usize, sink: &mut S, hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
     debug_assert!(ctx.slots.tangential == 0 && (!ctx.slots.layout.bridge || ctx.slots.bridge == 3), "the spring first, the bridge after it");
     match ctx.model.cohesion {
-        CohesionLaw::Capillary { kappa, .. } => lanes::<T, S, 4, true>(model, Some(kappa), first, n, sink, hist, pairs, body, prop, ctx),
-        CohesionLaw::None => lanes::<T, S, 3, false>(model, None, first, n, sink, hist, pairs, body, prop, ctx),
+        CohesionLaw::Capillary { kappa, .. } => lanes::<T, S, 4>(model, scratch, Some(kappa), first, n, sink, hist, pairs, body, prop, ctx),
+        CohesionLaw::None => lanes::<T, S, 3>(model, scratch, None, first, n, sink, hist, pairs, body, prop, ctx),
     }
 }
 
 /// [`hertz_mindlin_block`] with `STRIDE` reals of history per pair (the bridge volume last
-/// when 4) and `kappa` (N/m) when bridges pull. With `SORT`, each window of pairs is sorted
-/// first, with no branch, into touching and open ones: the open ones take `pair_force`'s short
-/// way (springs forgotten, a bridge's pull across the gap) and the touching ones fill the
-/// lanes, packed; most of a capillary scene's listed pairs are open (the list reaches the
-/// largest bridge's rupture distance), while in a dry packing a third are, and there the
-/// lanes cost less than the sorting (the 8000-grain triaxial stage on one thread: 50 s
-/// unsorted, 57 s sorted; the wet stage of wet_iso_0pa: 392 s sorted, 442 s unsorted).
+/// when 4) and `kappa` (N/m) when bridges pull. Each window of pairs is first tested for
+/// touch, with no branch: the positions' scattered reads and the radii, then the fold and the
+/// test in vector lanes over the window. The open pairs are done at once: dry, a zero force
+/// and forgotten springs; wet, `pair_force`'s short way (springs forgotten, a bridge's pull
+/// across the gap). Only the touching ones, packed, load the rest of their grains and fill the
+/// lanes (a third of a dense packing's listed pairs are open, most of a capillary scene's).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize, const SORT: bool>(model: &ContactModel<T>, kappa: Option<T>, first: usize, n: usize, sink: &mut S, hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
-    let mut inp = Inputs {
-        d: V3s::ZERO,
-        dr: V3s::ZERO,
-        r_i: [T::ZERO; LANES],
-        r_j: [T::ZERO; LANES],
-        m_i: [T::ONE; LANES],
-        m_j: [T::ONE; LANES],
-        v_i: V3s::ZERO,
-        v_j: V3s::ZERO,
-        w_i: V3s::ZERO,
-        w_j: V3s::ZERO,
-        v_eff: [T::ZERO; LANES],
-        g_eff: [T::ZERO; LANES],
-        mu_s: [T::ZERO; LANES],
-        beta: [T::ZERO; LANES],
-        xi: V3s::ZERO,
-        v_b: [T::ZERO; LANES],
-    };
+fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactModel<T>, scratch: &mut Scratch<T>, kappa: Option<T>, first: usize, n: usize, sink: &mut S, hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
+    let Scratch { win, touching, open } = scratch;
+    let mut inp = Inputs::new();
     let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], f_c: [T::ZERO; LANES], clamped: [false; LANES], sliding: [false; LANES], xi: V3s::ZERO };
-    let mut listed = [0u16; WINDOW];
-    let mut open = [true; WINDOW];
     for (w, hist) in hist[..STRIDE * n].chunks_mut(STRIDE * WINDOW).enumerate() {
         let (base, len) = (first + w * WINDOW, hist.len() / STRIDE);
-        let mut n_listed = 0;
-        for (m, is_open) in open[..len].iter_mut().enumerate() {
-            let keep = if SORT {
-                let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
-                let d = ctx.separation(body, i, j);
-                let reach = prop[i].radius + prop[j].radius;
-                d.norm2() < reach * reach
-            } else {
-                true
-            };
-            listed[n_listed] = m as u16;
-            n_listed += keep as usize;
-            *is_open = !keep;
+        // Touch test: the scattered reads one pair at a time, then the fold and the test in
+        // vector lanes.
+        for m in 0..len {
+            let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
+            let (d, dr) = (body[i].pos - body[j].pos, residual_at(ctx.residual, i) - residual_at(ctx.residual, j));
+            [win.d[0][m], win.d[1][m], win.d[2][m]] = [d.x, d.y, d.z];
+            [win.dr[0][m], win.dr[1][m], win.dr[2][m]] = [dr.x, dr.y, dr.z];
+            (win.r_i[m], win.r_j[m]) = (prop[i].radius, prop[j].radius);
         }
-        if SORT {
-            for m in (0..len).filter(|&m| open[m]) {
-                sink.put(w * WINDOW + m, &super::pair_force::pair_force(base + m, pairs, body, prop, ctx, &mut hist[STRIDE * m..STRIDE * (m + 1)]));
+        for m in 0..len {
+            let d = Vec3::new(win.d[0][m], win.d[1][m], win.d[2][m]);
+            let d = complete(ctx.periodic.min_image(d), Vec3::new(win.dr[0][m], win.dr[1][m], win.dr[2][m]));
+            [win.d[0][m], win.d[1][m], win.d[2][m]] = [d.x, d.y, d.z];
+            let reach = win.r_i[m] + win.r_j[m];
+            win.touching[m] = d.norm2() < reach * reach;
+        }
+        let (mut n_touching, mut n_open) = (0, 0);
+        for m in 0..len {
+            let t = win.touching[m];
+            touching[n_touching] = m as u16;
+            open[n_open] = m as u16;
+            n_touching += t as usize;
+            n_open += !t as usize;
+        }
+        for &m in &open[..n_open] {
+            let m = m as usize;
+            match kappa {
+                Some(_) => sink.put(w * WINDOW + m, &super::pair_force::pair_force(base + m, pairs, body, prop, ctx, &mut hist[STRIDE * m..STRIDE * (m + 1)])),
+                None => {
+                    sink.skip(w * WINDOW + m);
+                    hist[STRIDE * m..STRIDE * m + 3].fill(T::ZERO);
+                }
             }
         }
-        for group in listed[..n_listed].chunks(LANES) {
-            // Load: the scattered reads, one pair at a time; first the positions alone, in a
-            // short loop that keeps many of the partners' cache misses in flight.
-            for (l, &m) in group.iter().enumerate() {
-                let m = m as usize;
-                let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
-                inp.d.set(l, body[i].pos - body[j].pos);
-                inp.dr.set(l, residual_at(ctx.residual, i) - residual_at(ctx.residual, j));
-            }
+        for group in touching[..n_touching].chunks(LANES) {
+            // Load: the rest of the touching pairs' grains, one pair at a time.
             for (l, &m) in group.iter().enumerate() {
                 let m = m as usize;
                 let i = pairs.owner[base + m] as usize;
                 let j = pairs.partner[base + m] as usize;
                 let (bi, bj, pi, pj) = (&body[i], &body[j], &prop[i], &prop[j]);
-                (inp.r_i[l], inp.r_j[l], inp.m_i[l], inp.m_j[l]) = (pi.radius, pj.radius, pi.mass, pj.mass);
+                inp.d.set(l, Vec3::new(win.d[0][m], win.d[1][m], win.d[2][m]));
+                (inp.r_i[l], inp.r_j[l], inp.m_i[l], inp.m_j[l]) = (win.r_i[m], win.r_j[m], pi.mass, pj.mass);
                 inp.v_i.set(l, bi.vel);
                 inp.v_j.set(l, bj.vel);
                 inp.w_i.set(l, bi.omega);
@@ -208,22 +259,17 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize, const SORT: bool
                 inp.xi.set(l, Vec3::new(h[0], h[1], h[2]));
                 inp.v_b[l] = if STRIDE == 4 { h[STRIDE - 1] } else { T::ZERO };
             }
-            // Compute: every lane, touching or not, with no branch the compiler cannot turn
-            // into a select (unsorted, the result of a pair that does not touch is dropped;
-            // lanes past the end of a short group recompute stale inputs, unstored).
+            // Compute: every lane, with no branch the compiler cannot turn into a select
+            // (lanes past the end of a short group recompute stale inputs, unstored).
             for l in 0..LANES {
-                let d = complete(ctx.periodic.min_image(inp.d.get(l)), inp.dr.get(l));
-                let dist2 = d.norm2();
-                let reach = inp.r_i[l] + inp.r_j[l];
-                let touching = dist2 < reach * reach;
-                let geo = Geometry::grain_grain(d, dist2.sqrt(), inp.r_i[l], inp.r_j[l], inp.m_i[l], inp.m_j[l]);
+                let d = inp.d.get(l);
+                let geo = Geometry::grain_grain(d, d.norm2().sqrt(), inp.r_i[l], inp.r_j[l], inp.m_i[l], inp.m_j[l]);
                 let kin = Kinematics { v_i: inp.v_i.get(l), v_j: inp.v_j.get(l), w_i: inp.w_i.get(l), w_j: inp.w_j.get(l) };
                 let c = PairCoeffs { v_eff: inp.v_eff[l], g_eff: inp.g_eff[l], mu_s: inp.mu_s[l], beta: inp.beta[l], ..Default::default() };
                 let mut h = History { tangential: inp.xi.get(l), ..Default::default() };
-                let f = contact_force(model, &c, &geo, &kin, &Bodies::default(), &mut h, ctx.elapsed);
-                let mut f = if touching { f } else { ContactForce::default() };
+                let mut f = contact_force(model, &c, &geo, &kin, &Bodies::default(), &mut h, ctx.elapsed);
                 // A touching bridge pulls with f0 = -kappa sqrt(R_i R_j), added after the
-                // contact force as `contact_force` adds it (only sorted lanes hold bridges).
+                // contact force as `contact_force` adds it.
                 if let Some(kappa) = kappa {
                     let f_c = if inp.v_b[l] > T::ZERO { -kappa * (inp.r_i[l] * inp.r_j[l]).sqrt() } else { T::ZERO };
                     f.f_c = f_c;
@@ -238,7 +284,7 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize, const SORT: bool
                 res.f_c[l] = f.f_c;
                 res.clamped[l] = f.clamped;
                 res.sliding[l] = f.regime == Regime::Sliding;
-                res.xi.set(l, if touching { h.tangential } else { Vec3::ZERO });
+                res.xi.set(l, h.tangential);
             }
             // Store.
             for (l, &m) in group.iter().enumerate() {
@@ -314,7 +360,7 @@ duration = 1.0e-3
         let (mut hist_one, mut hist_lanes) = (e.hist.clone(), e.hist.clone());
         let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[stride * k..stride * (k + 1)])).collect();
         let mut lanes = vec![ContactForce::default(); n];
-        hertz_mindlin_block(&model, 0, n, lanes.as_mut_slice(), &mut hist_lanes, &e.pairs, &e.body, &e.prop, &ctx);
+        hertz_mindlin_block(&model, &mut Scratch::new(), 0, n, lanes.as_mut_slice(), &mut hist_lanes, &e.pairs, &e.body, &e.prop, &ctx);
         let touching = one.iter().filter(|f| f.f_n > T::ZERO).count();
         let springs = e.hist.chunks(stride).filter(|s| s[..3].iter().any(|x| *x != T::ZERO)).count();
         let open_bridges = one.iter().filter(|f| f.f_n == T::ZERO && f.f_c < T::ZERO).count();

@@ -50,7 +50,7 @@ use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
 use gather::gather_block;
 pub(crate) use grid::{hash_cells, CellGrid};
-use pair_force::{owner_block, OwnerBlock};
+use pair_force::{owner_block, OwnerBlock, TaskScratch};
 use profile::{Phase, PhaseClock};
 use reorder::Renumbering;
 use rayon::prelude::*;
@@ -450,7 +450,7 @@ impl<T: Real> CpuEngine<T> {
         let (pairs, body, prop, gravity) = (&self.pairs, &self.body, &self.prop, self.gravity);
         let blocks = owner_blocks(pairs, self.slots.stride, &mut self.load, &mut self.share, &mut self.report, &mut self.force_i, &mut self.hist);
         let min_blocks = (PAR_MIN_PAIRS * blocks.len()).div_ceil(pairs.len().max(1));
-        blocks.into_par_iter().with_min_len(min_blocks.max(1)).for_each_init(Vec::new, |scratch, b| owner_block(b, scratch, pairs, body, prop, &ctx, gravity));
+        blocks.into_par_iter().with_min_len(min_blocks.max(1)).for_each_init(TaskScratch::default, |scratch, b| owner_block(b, scratch, pairs, body, prop, &ctx, gravity));
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
         let (sums, touches) = complete_loads(&ctx, pairs, &self.share, &self.id, body, prop, &self.walls, &mut self.load, &mut self.wall_hist);

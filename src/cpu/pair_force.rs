@@ -81,6 +81,16 @@ pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &
 /// the report.
 pub const BLOCK: usize = 256;
 
+/// What a thread of the pair pass keeps from task to task (made when first needed; its
+/// contents are overwritten by each task).
+#[derive(Default)]
+pub struct TaskScratch<T> {
+    /// The lane kernel's output in capillary scenes, [`BLOCK`] records.
+    records: Vec<ContactForce<T>>,
+    /// The lane kernel's working arrays.
+    lanes: Option<Box<super::lanes::Scratch<T>>>,
+}
+
 /// Owner grains per task of the pair pass: a task takes every pair these grains own, so each
 /// owner's share is summed within one task, in pair order.
 pub const OWNERS: usize = 64;
@@ -119,14 +129,13 @@ super::simd::dispatch! {
     /// `pair_force` for every pair the grains of `block` own, with each owner's share summed
     /// into its load from `gravity * m` in pair order: the bits the gather got when it read
     /// whole per-pair records, with a third of the bytes.
-    /// `scratch` is the lane kernel's output, reused from task to task (grown to [`BLOCK`]
-    /// records when first needed; its contents are overwritten).
-    pub fn owner_block<T: Real>(block: OwnerBlock<'_, T>, scratch: &mut Vec<ContactForce<T>>, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, gravity: Vec3<T>) => owner_block_portable
+    /// `scratch` is the lane kernel's working arrays and output, reused from task to task.
+    pub fn owner_block<T: Real>(block: OwnerBlock<'_, T>, scratch: &mut TaskScratch<T>, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, gravity: Vec3<T>) => owner_block_portable
 }
 
 /// [`owner_block`] for whatever instruction set the caller is compiled for.
 #[inline(always)]
-fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut Vec<ContactForce<T>>, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, gravity: Vec3<T>) {
+fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut TaskScratch<T>, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, gravity: Vec3<T>) {
     let first = block.first;
     for (m, l) in block.load.iter_mut().enumerate() {
         *l = Load { force: gravity * prop[first + m].mass, torque: Vec3::ZERO };
@@ -136,15 +145,20 @@ fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut Vec
     let hist = std::mem::take(&mut block.hist);
     let mut sink = Deposit::new(&mut block, &pairs.owner[first_pair..first_pair + n_pairs]);
     match super::lanes::hertz_mindlin(ctx.model) {
-        // Without cohesion the lanes hand the pairs over in pair order.
-        Some(model) if matches!(ctx.model.cohesion, CohesionLaw::None) => super::lanes::hertz_mindlin_block(&model, first_pair, n_pairs, &mut sink, hist, pairs, body, prop, ctx),
+        // Without cohesion the lanes hand the touching pairs over in pair order.
+        Some(model) if matches!(ctx.model.cohesion, CohesionLaw::None) => {
+            let lanes = scratch.lanes.get_or_insert_with(super::lanes::Scratch::new);
+            super::lanes::hertz_mindlin_block(&model, lanes, first_pair, n_pairs, &mut sink, hist, pairs, body, prop, ctx)
+        }
         Some(model) => {
-            scratch.resize(BLOCK, ContactForce::default());
-            for start in (0..n_pairs).step_by(scratch.len()) {
-                let n = scratch.len().min(n_pairs - start);
+            let TaskScratch { records, lanes } = scratch;
+            let lanes = lanes.get_or_insert_with(super::lanes::Scratch::new);
+            records.resize(BLOCK, ContactForce::default());
+            for start in (0..n_pairs).step_by(BLOCK) {
+                let n = BLOCK.min(n_pairs - start);
                 let h = &mut hist[start * stride..(start + n) * stride];
-                super::lanes::hertz_mindlin_block(&model, first_pair + start, n, &mut scratch[..n], h, pairs, body, prop, ctx);
-                for (q, f) in scratch[..n].iter().enumerate() {
+                super::lanes::hertz_mindlin_block(&model, lanes, first_pair + start, n, &mut records[..n], h, pairs, body, prop, ctx);
+                for (q, f) in records[..n].iter().enumerate() {
                     sink.put(start + q, f);
                 }
             }
@@ -198,6 +212,13 @@ impl<T: Real> PairSink<T> for Deposit<'_, '_, T> {
         self.sum.force += f.f_i;
         self.sum.torque += f.t_i;
         self.block.deposit(k, f);
+    }
+
+    /// A zero force leaves the owner's sum as it is: adding `+0` changes the bits of no sum
+    /// but `-0`, which a sum starting from `gravity * m` only is where gravity is written `-0`.
+    #[inline(always)]
+    fn skip(&mut self, k: usize) {
+        self.block.deposit(k, &ContactForce::default());
     }
 }
 
