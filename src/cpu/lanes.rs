@@ -203,6 +203,12 @@ pub fn hertz_mindlin_block<T: Real, S: PairSink<T> + ?Sized>(model: &ContactMode
 fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactModel<T>, scratch: &mut Scratch<T>, kappa: Option<T>, first: usize, n: usize, sink: &mut S, hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
     let Scratch { win, touching, open } = scratch;
     let mut inp = Inputs::new();
+    // One material: every pair's coefficients are the same, set once in every lane.
+    let uniform = ctx.n_materials == 1;
+    if uniform {
+        let c = &ctx.coeffs[0];
+        (inp.v_eff, inp.g_eff, inp.mu_s, inp.beta) = ([c.v_eff; LANES], [c.g_eff; LANES], [c.mu_s; LANES], [c.beta; LANES]);
+    }
     let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], f_c: [T::ZERO; LANES], clamped: [false; LANES], sliding: [false; LANES], xi: V3s::ZERO };
     for (w, hist) in hist[..STRIDE * n].chunks_mut(STRIDE * WINDOW).enumerate() {
         let (base, len) = (first + w * WINDOW, hist.len() / STRIDE);
@@ -253,8 +259,10 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
                 inp.v_j.set(l, bj.vel);
                 inp.w_i.set(l, bi.omega);
                 inp.w_j.set(l, bj.omega);
-                let c = &ctx.coeffs[pi.material as usize * ctx.n_materials + pj.material as usize];
-                (inp.v_eff[l], inp.g_eff[l], inp.mu_s[l], inp.beta[l]) = (c.v_eff, c.g_eff, c.mu_s, c.beta);
+                if !uniform {
+                    let c = &ctx.coeffs[pi.material as usize * ctx.n_materials + pj.material as usize];
+                    (inp.v_eff[l], inp.g_eff[l], inp.mu_s[l], inp.beta[l]) = (c.v_eff, c.g_eff, c.mu_s, c.beta);
+                }
                 let h = &hist[STRIDE * m..STRIDE * (m + 1)];
                 inp.xi.set(l, Vec3::new(h[0], h[1], h[2]));
                 inp.v_b[l] = if STRIDE == 4 { h[STRIDE - 1] } else { T::ZERO };
@@ -342,10 +350,18 @@ kind = "run"
 duration = 1.0e-3
 "#;
 
-    /// The lane kernel against the one-pair pass on `SCENE` (wetted with its water content
+    /// `SCENE` with a third of its grains of a second, stiffer and rougher material.
+    fn two_materials() -> String {
+        SCENE.replace("count = 1300", "count = 870").replace(
+            "[periodic]",
+            "[[material]]\nname = \"glass\"\ndensity = 2500.0\nyoungs_modulus = 2.0e8\npoisson_ratio = 0.25\nmu_s = 0.3\nrestitution = 0.7\n\n[[generate]]\nmaterial = \"glass\"\ncount = 430\ndiameter = { min = 0.9e-3, max = 1.1e-3 }\nregion = { shape = \"box\", min = [0.0, 0.0, 0.0], max = [14.0e-3, 14.0e-3, 14.0e-3] }\nrandom_speed = 0.5\n\n[periodic]",
+        )
+    }
+
+    /// The lane kernel against the one-pair pass on `scene` (wetted with its water content
     /// first when `wet`), bit for bit.
-    fn check<T: Real>(wet: bool) {
-        let text = if wet { SCENE.replace("[[stage]]", "[[stage]]\nwater_content = 0.007").replace("[model]", "[model]\ncohesion = \"capillary\"") } else { SCENE.to_string() };
+    fn check<T: Real>(scene: &str, wet: bool) {
+        let text = if wet { scene.replace("[[stage]]", "[[stage]]\nwater_content = 0.007").replace("[model]", "[model]\ncohesion = \"capillary\"") } else { scene.to_string() };
         let mut scene = crate::scene::parse(std::path::Path::new("lanes_test.toml"), &text).unwrap();
         // Grown 10% after placement: a dense, jostling gas.
         scene.grains.radius.iter_mut().for_each(|r| *r *= 1.1);
@@ -440,17 +456,23 @@ duration = 1.0e-3
 
     #[test]
     fn lanes_give_the_one_pair_pass_bits_in_f64() {
-        check::<f64>(false);
+        check::<f64>(SCENE, false);
     }
 
     #[test]
     fn lanes_give_the_one_pair_pass_bits_in_f32() {
-        check::<f32>(false);
+        check::<f32>(SCENE, false);
+    }
+
+    #[test]
+    fn lanes_give_the_one_pair_pass_bits_with_two_materials() {
+        check::<f64>(&two_materials(), false);
+        check::<f32>(&two_materials(), true);
     }
 
     #[test]
     fn lanes_give_the_one_pair_pass_bits_with_liquid_bridges() {
-        check::<f64>(true);
-        check::<f32>(true);
+        check::<f64>(SCENE, true);
+        check::<f32>(SCENE, true);
     }
 }
