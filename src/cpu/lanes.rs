@@ -215,6 +215,14 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
         // Touch test: the scattered reads one pair at a time, then the fold and the test in
         // vector lanes.
         for m in 0..len {
+            // The partners a window ahead (in this task or the next), whose loads will then
+            // find them in cache.
+            if let Some(&j) = pairs.partner.get(base + m + WINDOW) {
+                let b = &body[j as usize];
+                super::simd::prefetch(&b.pos);
+                super::simd::prefetch(&b.omega);
+                super::simd::prefetch(&prop[j as usize]);
+            }
             let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
             let (d, dr) = (body[i].pos - body[j].pos, residual_at(ctx.residual, i) - residual_at(ctx.residual, j));
             [win.d[0][m], win.d[1][m], win.d[2][m]] = [d.x, d.y, d.z];
