@@ -23,6 +23,7 @@ mod reorder;
 mod snapshot;
 pub mod simd;
 mod state;
+mod sweeps;
 mod stats;
 mod traffic;
 mod wall_contacts;
@@ -53,6 +54,7 @@ pub(crate) use grid::{hash_cells, CellGrid};
 use pair_force::{owner_block, OwnerBlock, TaskScratch};
 use profile::{Phase, PhaseClock};
 use reorder::Renumbering;
+use sweeps::Sweep;
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS, PAR_MIN_PAIRS};
 use wall_contacts::{wall_block, WallTouch};
@@ -436,7 +438,9 @@ impl<T: Real> CpuEngine<T> {
 
     /// Runs the force passes: `pair_force`, `gather`, `wall_contacts`; the springs advance by
     /// `elapsed` (s). In capillary scenes the step's hooks update the bridges just before.
-    fn evaluate_forces(&mut self, elapsed: T) {
+    /// With `kick` (s), the grains are then kicked in the gather's sweep, each as soon as its
+    /// load is whole (the piston's kick is left to the caller).
+    fn evaluate_forces(&mut self, elapsed: T, kick: Option<T>) {
         let t = self.clock.start();
         let ctx = ForceContext {
             model: &self.model,
@@ -453,7 +457,7 @@ impl<T: Real> CpuEngine<T> {
         blocks.into_par_iter().with_min_len(min_blocks.max(1)).for_each_init(TaskScratch::default, |scratch, b| owner_block(b, scratch, pairs, body, prop, &ctx, gravity));
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
-        let (sums, touches) = complete_loads(&ctx, pairs, &self.share, &self.id, body, prop, &self.walls, &mut self.load, &mut self.wall_hist);
+        let (sums, touches) = complete_loads(&ctx, pairs, &self.share, &self.id, &mut self.body, prop, &self.walls, &mut self.load, &mut self.wall_hist, kick);
         self.wall_touches = touches;
         self.wall_reaction = sums.reaction;
         self.wall_count = sums.count;
@@ -468,31 +472,46 @@ impl<T: Real> CpuEngine<T> {
         let t = self.clock.start();
         let (load, prop) = (&self.load, &self.prop);
         self.body.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, b)| integrate::kick(b, &load[i], &prop[i], tau));
+        self.kick_piston(tau);
+        self.clock.stop(Phase::Integrate, t);
+    }
+
+    /// Kick of the piston by `tau` (s) under the grains' push and its pressure.
+    fn kick_piston(&mut self, tau: T) {
         if let Some(p) = self.piston {
             let push = self.wall_reaction[p.wall].z - p.pressure * p.area;
             self.walls[p.wall].velocity.z += push * tau / p.mass;
         }
-        self.clock.stop(Phase::Integrate, t);
     }
 
-    /// Drift of every grain (and orientation, piston and servo walls) by `tau` (s); notes
-    /// how far the grains have moved since the last build.
-    fn drift(&mut self, tau: T) {
+    /// Drift of every grain (and orientation, piston and servo walls) by `tau` (s), after a
+    /// [`Self::kick`] by `kick` (s) when given: in one sweep over the grains, each kicked and
+    /// then drifted (the same operations on each grain in the same order as a kick and a
+    /// drift, with one pass over the grains' arrays instead of two). Notes how far the grains
+    /// have moved since the last build.
+    fn drift(&mut self, kick: Option<T>, tau: T) {
         let t = self.clock.start();
+        if let Some(k) = kick {
+            self.kick_piston(k);
+        }
+        let (load, prop) = (&self.load, &self.prop);
+        let step = |b: &mut Body<T>, r: &mut Vec3<T>, at: Vec3<T>, l: &Load<T>, p: &Props<T>| {
+            if let Some(k) = kick {
+                integrate::kick(b, l, p, k);
+            }
+            integrate::drift(b, r, at, tau)
+        };
+        let grains = self.body.par_chunks_mut(CHUNK).zip(self.built_at.par_chunks(CHUNK)).zip(load.par_chunks(CHUNK).zip(prop.par_chunks(CHUNK)));
         let moved: Vec<T> = if T::COMPENSATED {
-            self.body
-                .par_chunks_mut(CHUNK)
+            grains
                 .zip(self.residual.par_chunks_mut(CHUNK))
-                .zip(self.built_at.par_chunks(CHUNK))
                 .with_min_len(PAR_MIN_CHUNKS)
-                .map(|((bodies, res), at)| bodies.iter_mut().zip(res).zip(at).map(|((b, r), at)| integrate::drift(b, r, *at, tau)).fold(T::ZERO, T::max))
+                .map(|(((bodies, at), (l, p)), res)| bodies.iter_mut().zip(res).zip(at).zip(l.iter().zip(p)).map(|(((b, r), at), (l, p))| step(b, r, *at, l, p)).fold(T::ZERO, T::max))
                 .collect()
         } else {
-            self.body
-                .par_chunks_mut(CHUNK)
-                .zip(self.built_at.par_chunks(CHUNK))
+            grains
                 .with_min_len(PAR_MIN_CHUNKS)
-                .map(|(bodies, at)| bodies.iter_mut().zip(at).map(|(b, at)| integrate::drift(b, &mut Vec3::default(), *at, tau)).fold(T::ZERO, T::max))
+                .map(|((bodies, at), (l, p))| bodies.iter_mut().zip(at).zip(l.iter().zip(p)).map(|((b, at), (l, p))| step(b, &mut Vec3::default(), *at, l, p)).fold(T::ZERO, T::max))
                 .collect()
         };
         if let Some(q) = &mut self.orientation {
@@ -528,21 +547,25 @@ impl<T: Real> CpuEngine<T> {
         match op {
             Op::Kick { tau } => self.kick(T::of(tau)),
             Op::Drift { tau } => {
-                self.drift(T::of(tau));
+                self.drift(None, T::of(tau));
                 hooks.drifted(self)?;
             }
             Op::RebuildIfNeeded => hooks.rebuild_if_needed(self)?,
-            Op::Forces { elapsed } => {
-                if self.slots.layout.bridge {
-                    let t = self.clock.start();
-                    hooks.bridges(self)?;
-                    self.clock.stop(Phase::Force, t);
-                }
-                self.evaluate_forces(T::of(elapsed));
-                hooks.forces_evaluated(self)?;
-            }
+            Op::Forces { elapsed } => self.forces(elapsed, None, hooks)?,
         }
         Ok(())
+    }
+
+    /// A force evaluation ([`Op::Forces`]) with `hooks` around it, and with the grains kicked by
+    /// `kick` (s) in its last sweep when given.
+    fn forces(&mut self, elapsed: f64, kick: Option<T>, hooks: &mut impl StepHooks<T>) -> Result<(), SimError> {
+        if self.slots.layout.bridge {
+            let t = self.clock.start();
+            hooks.bridges(self)?;
+            self.clock.stop(Phase::Force, t);
+        }
+        self.evaluate_forces(T::of(elapsed), kick);
+        hooks.forces_evaluated(self)
     }
 
     /// Makes the loads valid by the schedule's prologue, if nothing has evaluated them yet.
@@ -582,8 +605,26 @@ impl<T: Real> CpuEngine<T> {
             self.ensure_loads_with(hooks)?;
         }
         let ops = self.schedule.ops(self.step).len();
-        for k in 0..ops {
-            self.run(self.schedule.ops(self.step)[k], hooks)?;
+        let mut k = 0;
+        while k < ops {
+            let (sweep, covers) = sweeps::sweep_at(self.schedule.ops(self.step), k);
+            match sweep {
+                Sweep::Op(op) => self.run(op, hooks)?,
+                Sweep::ForcesKick { elapsed, tau } => {
+                    self.trace.record(Op::Forces { elapsed });
+                    self.trace.record(Op::Kick { tau });
+                    self.forces(elapsed, Some(T::of(tau)), hooks)?;
+                    // The piston's kick reads the walls' sums, which the hooks complete.
+                    self.kick_piston(T::of(tau));
+                }
+                Sweep::KickDrift { kick, tau } => {
+                    self.trace.record(Op::Kick { tau: kick });
+                    self.trace.record(Op::Drift { tau });
+                    self.drift(Some(T::of(kick)), T::of(tau));
+                    hooks.drifted(self)?;
+                }
+            }
+            k += covers;
         }
         self.step += 1;
         self.time += self.dt.f64();
@@ -787,31 +828,41 @@ fn absorb<T: Real>(total: &mut [WallRow<T>], part: &mut [WallRow<T>]) {
 /// `gather`, then `wall_contacts`, over every grain in one sweep (chunk by chunk): each
 /// grain's load gets its partners' shares, then its wall load. Returns the per-wall sums
 /// ([`WallSums::of`]) and the wall contacts, sorted by grain id, then wall.
+/// With `kick` (s), each grain is then kicked by its load in the same sweep (see
+/// [`CpuEngine::kick`]; the piston's kick is the caller's).
 #[allow(clippy::too_many_arguments)]
 fn complete_loads<T: Real>(
     ctx: &ForceContext<T>,
     pairs: &PairList,
     share: &[Load<T>],
     id: &[u32],
-    body: &[Body<T>],
+    body: &mut [Body<T>],
     prop: &[Props<T>],
     walls: &[WallState<T>],
     load: &mut [Load<T>],
     wall_hist: &mut [T],
+    kick: Option<T>,
 ) -> (WallSums<T>, Vec<WallTouch<T>>) {
     let per_grain = walls.len() * ctx.slots.stride;
-    let run = |c: usize, loads: &mut [Load<T>], hist: &mut [T]| {
+    let run = |c: usize, loads: &mut [Load<T>], bodies: &mut [Body<T>], hist: &mut [T]| {
+        let grains = c * CHUNK..c * CHUNK + loads.len();
         gather_block(c * CHUNK, loads, pairs, share);
         let mut touches = Vec::new();
         if !walls.is_empty() {
-            wall_block(c * CHUNK, loads, hist, id, body, prop, walls, ctx, &mut touches);
+            wall_block(c * CHUNK, loads, hist, &id[grains.clone()], bodies, &prop[grains.clone()], walls, ctx, &mut touches);
+        }
+        if let Some(tau) = kick {
+            for ((b, l), p) in bodies.iter_mut().zip(loads.iter()).zip(&prop[grains]) {
+                integrate::kick(b, l, p, tau);
+            }
         }
         touches
     };
+    let grains = load.par_chunks_mut(CHUNK).zip(body.par_chunks_mut(CHUNK));
     let parts: Vec<Vec<WallTouch<T>>> = if per_grain == 0 {
-        load.par_chunks_mut(CHUNK).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, loads)| run(c, loads, &mut [])).collect()
+        grains.with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, (loads, bodies))| run(c, loads, bodies, &mut [])).collect()
     } else {
-        load.par_chunks_mut(CHUNK).zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, (loads, hist))| run(c, loads, hist)).collect()
+        grains.zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, ((loads, bodies), hist))| run(c, loads, bodies, hist)).collect()
     };
     let mut touches = parts.concat();
     touches.sort_unstable_by_key(|t| (t.grain, t.wall));

@@ -13,7 +13,9 @@ fn bytes<X>(v: &[X]) -> u64 {
 
 impl<T: Real> CpuEngine<T> {
     /// Bytes each phase of a step that keeps its neighbour list moves (`kick`, `drift`,
-    /// `force`, `walls`, `gather`), in the order of the schedule's later steps.
+    /// `force`, `walls`, `gather`), in the order of the schedule's later steps, as the engine's
+    /// sweeps run them ([`super::sweeps`]: a kick merged into a sweep reads the grains' load
+    /// and properties there, while the sweep has the bodies in hand).
     pub(super) fn traffic(&self) -> Vec<(&'static str, u64)> {
         let l = &self.pairs;
         let (body, prop) = (bytes(&self.body), bytes(&self.prop));
@@ -34,17 +36,33 @@ impl<T: Real> CpuEngine<T> {
             Some(e) => e.1 += b,
             None => out.push((name, b)),
         };
-        for op in &self.schedule.step {
-            match op {
-                Op::Kick { .. } => add("kick", kick),
-                Op::Drift { .. } => add("drift", drift),
-                Op::RebuildIfNeeded => {}
-                Op::Forces { .. } => {
+        let merged_kick = bytes(&self.load) + prop;
+        let ops = &self.schedule.step;
+        let mut k = 0;
+        while k < ops.len() {
+            let (sweep, covers) = super::sweeps::sweep_at(ops, k);
+            match sweep {
+                Sweep::Op(Op::Kick { .. }) => add("kick", kick),
+                Sweep::Op(Op::Drift { .. }) => add("drift", drift),
+                Sweep::Op(Op::RebuildIfNeeded) => {}
+                Sweep::Op(Op::Forces { .. }) => {
                     add("force", force);
                     add("gather", gather);
                     add("walls", walls);
                 }
+                Sweep::KickDrift { .. } => {
+                    add("kick", merged_kick);
+                    add("drift", drift);
+                }
+                Sweep::ForcesKick { .. } => {
+                    add("force", force);
+                    // The gather's sweep reads and writes the bodies to kick them; the load it
+                    // has just written is in hand.
+                    add("gather", gather + 2 * body + prop);
+                    add("walls", walls);
+                }
             }
+            k += covers;
         }
         out.retain(|e| e.1 > 0);
         out

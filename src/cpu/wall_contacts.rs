@@ -82,9 +82,10 @@ pub fn wall_contacts<T: Real>(
 }
 
 super::simd::dispatch! {
-    /// `wall_contacts` for slots `first..first + loads.len()` (at most [`CHUNK`]), each grain's wall load (zero
-    /// without a contact) added to its load; `hist` holds their history blocks (empty when the
-    /// model keeps none); the contacts are appended to `touches`.
+    /// `wall_contacts` for slots `first..first + loads.len()` (at most [`CHUNK`]; `id`, `body`
+    /// and `prop` are theirs alone), each grain's wall load (zero without a contact) added to
+    /// its load; `hist` holds their history blocks (empty when the model keeps none); the
+    /// contacts are appended to `touches`.
     pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) => wall_block_portable
 }
 
@@ -99,19 +100,18 @@ fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut 
     let near = &mut near[..loads.len()];
     for wall in walls {
         for (m, near) in near.iter_mut().enumerate() {
-            let i = first + m;
-            *near |= !(wall.geom.frame(body[i].pos, crate::position::residual_at(ctx.residual, i)).1 >= prop[i].radius);
+            *near |= !(wall.geom.frame(body[m].pos, crate::position::residual_at(ctx.residual, first + m)).1 >= prop[m].radius);
         }
     }
     for (m, l) in loads.iter_mut().enumerate() {
-        let (i, hist) = (first + m, &mut hist[m * per_grain..(m + 1) * per_grain]);
+        let hist = &mut hist[m * per_grain..(m + 1) * per_grain];
         if !near[m] {
             for w in 0..walls.len() {
                 ctx.slots.clear_springs(&mut hist[w * stride..(w + 1) * stride]);
             }
             continue;
         }
-        let w = wall_contacts(id[i], &body[i], crate::position::residual_at(ctx.residual, i), &prop[i], walls, ctx, hist, touches);
+        let w = wall_contacts(id[m], &body[m], crate::position::residual_at(ctx.residual, first + m), &prop[m], walls, ctx, hist, touches);
         l.force += w.force;
         l.torque += w.torque;
     }
