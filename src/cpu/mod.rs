@@ -23,7 +23,6 @@ mod reorder;
 mod snapshot;
 pub mod simd;
 mod state;
-mod sweeps;
 mod stats;
 mod traffic;
 mod wall_contacts;
@@ -45,7 +44,7 @@ use crate::model::{capillary_potential, normal_potential, share_liquid, within_r
 use crate::periodic::Periodic;
 use crate::position;
 use crate::real::{Real, Vec3};
-use crate::schedule::{Op, Schedule, Trace};
+use crate::schedule::{sweep_at, Op, Schedule, Sweep, Trace};
 use crate::scene::{Scene, WallShape};
 use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
@@ -54,7 +53,6 @@ pub(crate) use grid::{hash_cells, CellGrid};
 use pair_force::{owner_block, OwnerBlock, TaskScratch};
 use profile::{Phase, PhaseClock};
 use reorder::Renumbering;
-use sweeps::Sweep;
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS, PAR_MIN_PAIRS};
 use wall_contacts::{wall_block, WallTouch};
@@ -607,7 +605,7 @@ impl<T: Real> CpuEngine<T> {
         let ops = self.schedule.ops(self.step).len();
         let mut k = 0;
         while k < ops {
-            let (sweep, covers) = sweeps::sweep_at(self.schedule.ops(self.step), k);
+            let (sweep, covers) = sweep_at(self.schedule.ops(self.step), k);
             match sweep {
                 Sweep::Op(op) => self.run(op, hooks)?,
                 Sweep::ForcesKick { elapsed, tau } => {

@@ -14,7 +14,7 @@ fn bytes<X>(v: &[X]) -> u64 {
 impl<T: Real> CpuEngine<T> {
     /// Bytes each phase of a step that keeps its neighbour list moves (`kick`, `drift`,
     /// `force`, `walls`, `gather`), in the order of the schedule's later steps, as the engine's
-    /// sweeps run them ([`super::sweeps`]: a kick merged into a sweep reads the grains' load
+    /// sweeps run them ([`Sweep`]: a kick merged into a sweep reads the grains' load
     /// and properties there, while the sweep has the bodies in hand).
     pub(super) fn traffic(&self) -> Vec<(&'static str, u64)> {
         let l = &self.pairs;
@@ -40,7 +40,7 @@ impl<T: Real> CpuEngine<T> {
         let ops = &self.schedule.step;
         let mut k = 0;
         while k < ops.len() {
-            let (sweep, covers) = super::sweeps::sweep_at(ops, k);
+            let (sweep, covers) = sweep_at(ops, k);
             match sweep {
                 Sweep::Op(Op::Kick { .. }) => add("kick", kick),
                 Sweep::Op(Op::Drift { .. }) => add("drift", drift),

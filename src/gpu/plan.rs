@@ -1,10 +1,10 @@
-//! How the GPU engine encodes the schedule: neighbouring operations that each grain runs on
-//! its own data are one dispatch (a kick and the drift after it in `integrate`; an
-//! evaluation's gather and the kick after it in `gather`), with the arithmetic of running
-//! them apart, so the step costs fewer dispatches and gives the same bits.
+//! How the GPU engine encodes the schedule: each of its sweeps ([`Sweep`]) is one entry (a
+//! kick and the drift after it in `integrate`; an evaluation's gather and the kick after it in
+//! `gather`), with the arithmetic of running them apart, so the step costs fewer dispatches and
+//! gives the same bits.
 
 use super::layout::Phase;
-use crate::schedule::{Op, Schedule};
+use crate::schedule::{sweep_at, Op, Schedule, Sweep};
 
 /// What one entry of a plan encodes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,14 +34,14 @@ pub fn plan(ops: &[Op]) -> Vec<Entry> {
     let mut out = Vec::new();
     let mut k = 0;
     while k < ops.len() {
-        let next = ops.get(k + 1).copied();
-        let (dispatch, phase, covered) = match (ops[k], next) {
-            (Op::Kick { tau }, Some(Op::Drift { tau: drift })) => (Dispatch::Integrate, Phase { kick: tau as f32, drift: drift as f32, ..Default::default() }, 2),
-            (Op::Kick { tau }, _) => (Dispatch::Integrate, Phase { kick: tau as f32, ..Default::default() }, 1),
-            (Op::Drift { tau }, _) => (Dispatch::Integrate, Phase { drift: tau as f32, ..Default::default() }, 1),
-            (Op::RebuildIfNeeded, _) => (Dispatch::RebuildIfNeeded, Phase::default(), 1),
-            (Op::Forces { elapsed }, Some(Op::Kick { tau })) => (Dispatch::Forces, Phase { elapsed: elapsed as f32, kick: tau as f32, ..Default::default() }, 2),
-            (Op::Forces { elapsed }, _) => (Dispatch::Forces, Phase { elapsed: elapsed as f32, ..Default::default() }, 1),
+        let (sweep, covered) = sweep_at(ops, k);
+        let (dispatch, phase) = match sweep {
+            Sweep::KickDrift { kick, tau } => (Dispatch::Integrate, Phase { kick: kick as f32, drift: tau as f32, ..Default::default() }),
+            Sweep::Op(Op::Kick { tau }) => (Dispatch::Integrate, Phase { kick: tau as f32, ..Default::default() }),
+            Sweep::Op(Op::Drift { tau }) => (Dispatch::Integrate, Phase { drift: tau as f32, ..Default::default() }),
+            Sweep::Op(Op::RebuildIfNeeded) => (Dispatch::RebuildIfNeeded, Phase::default()),
+            Sweep::ForcesKick { elapsed, tau } => (Dispatch::Forces, Phase { elapsed: elapsed as f32, kick: tau as f32, ..Default::default() }),
+            Sweep::Op(Op::Forces { elapsed }) => (Dispatch::Forces, Phase { elapsed: elapsed as f32, ..Default::default() }),
         };
         out.push(Entry { dispatch, phase, ops: ops[k..k + covered].to_vec() });
         k += covered;
