@@ -22,6 +22,28 @@ pub fn drift<T: Real>(b: &mut Body<T>, residual: &mut Vec3<T>, built_at: Vec3<T>
     (b.pos - built_at).norm2()
 }
 
+super::simd::dispatch! {
+    /// A chunk of grains each [`kick`]ed by `kick` (s) when given, then [`drift`]ed by `tau`
+    /// (s); `residual` is empty unless positions are compensated. Returns the largest squared
+    /// displacement since the last neighbour build.
+    pub fn kick_drift<T: Real>(body: &mut [Body<T>], residual: &mut [Vec3<T>], built_at: &[Vec3<T>], load: &[Load<T>], prop: &[Props<T>], kick_by: Option<T>, tau: T) -> T => kick_drift_portable
+}
+
+/// [`kick_drift`] for whatever instruction set the caller is compiled for.
+#[inline(always)]
+fn kick_drift_portable<T: Real>(body: &mut [Body<T>], residual: &mut [Vec3<T>], built_at: &[Vec3<T>], load: &[Load<T>], prop: &[Props<T>], kick_by: Option<T>, tau: T) -> T {
+    let mut moved = T::ZERO;
+    for (m, ((b, l), p)) in body.iter_mut().zip(load).zip(prop).enumerate() {
+        if let Some(k) = kick_by {
+            kick(b, l, p, k);
+        }
+        let mut none = Vec3::ZERO;
+        let r = if T::COMPENSATED { &mut residual[m] } else { &mut none };
+        moved = moved.max(drift(b, r, built_at[m], tau));
+    }
+    moved
+}
+
 /// Omelyan's norm-preserving rotation of a unit quaternion (scalar first) by the world-frame
 /// angular velocity `w` over `tau` (seed 000 eqs. 16-18):
 /// `q' = ((1 - a) q + tau/2 (0, w) * q) / (1 + a)`, `a = tau^2 |w|^2 / 16`, a rotation by

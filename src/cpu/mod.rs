@@ -492,25 +492,11 @@ impl<T: Real> CpuEngine<T> {
         if let Some(k) = kick {
             self.kick_piston(k);
         }
-        let (load, prop) = (&self.load, &self.prop);
-        let step = |b: &mut Body<T>, r: &mut Vec3<T>, at: Vec3<T>, l: &Load<T>, p: &Props<T>| {
-            if let Some(k) = kick {
-                integrate::kick(b, l, p, k);
-            }
-            integrate::drift(b, r, at, tau)
-        };
-        let grains = self.body.par_chunks_mut(CHUNK).zip(self.built_at.par_chunks(CHUNK)).zip(load.par_chunks(CHUNK).zip(prop.par_chunks(CHUNK)));
+        let grains = self.body.par_chunks_mut(CHUNK).zip(self.built_at.par_chunks(CHUNK)).zip(self.load.par_chunks(CHUNK).zip(self.prop.par_chunks(CHUNK)));
         let moved: Vec<T> = if T::COMPENSATED {
-            grains
-                .zip(self.residual.par_chunks_mut(CHUNK))
-                .with_min_len(PAR_MIN_CHUNKS)
-                .map(|(((bodies, at), (l, p)), res)| bodies.iter_mut().zip(res).zip(at).zip(l.iter().zip(p)).map(|(((b, r), at), (l, p))| step(b, r, *at, l, p)).fold(T::ZERO, T::max))
-                .collect()
+            grains.zip(self.residual.par_chunks_mut(CHUNK)).with_min_len(PAR_MIN_CHUNKS).map(|(((b, at), (l, p)), r)| integrate::kick_drift(b, r, at, l, p, kick, tau)).collect()
         } else {
-            grains
-                .with_min_len(PAR_MIN_CHUNKS)
-                .map(|((bodies, at), (l, p))| bodies.iter_mut().zip(at).zip(l.iter().zip(p)).map(|((b, at), (l, p))| step(b, &mut Vec3::default(), *at, l, p)).fold(T::ZERO, T::max))
-                .collect()
+            grains.with_min_len(PAR_MIN_CHUNKS).map(|((b, at), (l, p))| integrate::kick_drift(b, &mut [], at, l, p, kick, tau)).collect()
         };
         if let Some(q) = &mut self.orientation {
             let body = &self.body;
