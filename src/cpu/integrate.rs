@@ -44,19 +44,6 @@ fn kick_drift_portable<T: Real>(body: &mut [Body<T>], residual: &mut [Vec3<T>], 
     moved
 }
 
-super::simd::dispatch! {
-    /// A chunk of grains each [`kick`]ed by `tau` (s).
-    pub fn kick_block<T: Real>(body: &mut [Body<T>], load: &[Load<T>], prop: &[Props<T>], tau: T) => kick_block_portable
-}
-
-/// [`kick_block`] for whatever instruction set the caller is compiled for.
-#[inline(always)]
-fn kick_block_portable<T: Real>(body: &mut [Body<T>], load: &[Load<T>], prop: &[Props<T>], tau: T) {
-    for ((b, l), p) in body.iter_mut().zip(load).zip(prop) {
-        kick(b, l, p, tau);
-    }
-}
-
 /// Omelyan's norm-preserving rotation of a unit quaternion (scalar first) by the world-frame
 /// angular velocity `w` over `tau` (seed 000 eqs. 16-18):
 /// `q' = ((1 - a) q + tau/2 (0, w) * q) / (1 + a)`, `a = tau^2 |w|^2 / 16`, a rotation by

@@ -469,7 +469,7 @@ impl<T: Real> CpuEngine<T> {
     fn kick(&mut self, tau: T) {
         let t = self.clock.start();
         let (load, prop) = (&self.load, &self.prop);
-        self.body.par_chunks_mut(CHUNK).zip(load.par_chunks(CHUNK).zip(prop.par_chunks(CHUNK))).with_min_len(PAR_MIN_CHUNKS).for_each(|(b, (l, p))| integrate::kick_block(b, l, p, tau));
+        self.body.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, b)| integrate::kick(b, &load[i], &prop[i], tau));
         self.kick_piston(tau);
         self.clock.stop(Phase::Integrate, t);
     }
@@ -836,7 +836,9 @@ fn complete_loads<T: Real>(
             wall_block(c * CHUNK, loads, hist, &id[grains.clone()], bodies, &prop[grains.clone()], walls, ctx, &mut touches);
         }
         if let Some(tau) = kick {
-            integrate::kick_block(bodies, loads, &prop[grains], tau);
+            for ((b, l), p) in bodies.iter_mut().zip(loads.iter()).zip(&prop[grains]) {
+                integrate::kick(b, l, p, tau);
+            }
         }
         touches
     };
