@@ -228,7 +228,10 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
             let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
             let (d, dr) = (body[i].pos - body[j].pos, residual_at(ctx.residual, i) - residual_at(ctx.residual, j));
             [win.d[0][m], win.d[1][m], win.d[2][m]] = [d.x, d.y, d.z];
-            [win.dr[0][m], win.dr[1][m], win.dr[2][m]] = [dr.x, dr.y, dr.z];
+            if T::COMPENSATED {
+                // (f64's residuals are zero: nothing to store, nothing read.)
+                [win.dr[0][m], win.dr[1][m], win.dr[2][m]] = [dr.x, dr.y, dr.z];
+            }
             (win.r_i[m], win.r_j[m]) = (prop[i].radius, prop[j].radius);
         }
         for m in 0..len {
