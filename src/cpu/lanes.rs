@@ -164,8 +164,10 @@ pub trait PairSink<T> {
     fn put(&mut self, m: usize, f: &ContactForce<T>);
 
     /// Pair `m` does not touch and has no bridge: its force is zero. Called in any order
-    /// (in a dry scene, a window's open pairs before its touching ones).
-    fn skip(&mut self, m: usize);
+    /// (in a dry scene, a window's open pairs before its touching ones). Returns false when
+    /// the pair's records are known to be those of an open pair already, springs included,
+    /// which the caller then need not clear.
+    fn skip(&mut self, m: usize) -> bool;
 }
 
 impl<T: Copy + Default> PairSink<T> for [ContactForce<T>] {
@@ -175,8 +177,9 @@ impl<T: Copy + Default> PairSink<T> for [ContactForce<T>] {
     }
 
     #[inline(always)]
-    fn skip(&mut self, m: usize) {
+    fn skip(&mut self, m: usize) -> bool {
         self[m] = ContactForce::default();
+        true
     }
 }
 
@@ -254,8 +257,9 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
             match kappa {
                 Some(_) => sink.put(w * WINDOW + m, &super::pair_force::pair_force(base + m, pairs, body, prop, ctx, &mut hist[STRIDE * m..STRIDE * (m + 1)])),
                 None => {
-                    sink.skip(w * WINDOW + m);
-                    hist[STRIDE * m..STRIDE * m + 3].fill(T::ZERO);
+                    if sink.skip(w * WINDOW + m) {
+                        hist[STRIDE * m..STRIDE * m + 3].fill(T::ZERO);
+                    }
                 }
             }
         }

@@ -216,9 +216,15 @@ impl<T: Real> PairSink<T> for Deposit<'_, '_, T> {
 
     /// A zero force leaves the owner's sum as it is: adding `+0` changes the bits of no sum
     /// but `-0`, which a sum starting from `gravity * m` only is where gravity is written `-0`.
+    /// A pair still open since the last evaluation ([`PairFlags::OPEN`]) keeps its zeros.
     #[inline(always)]
-    fn skip(&mut self, k: usize) {
+    fn skip(&mut self, k: usize) -> bool {
+        if self.block.flags[k] == PairFlags::OPEN.0 {
+            return false;
+        }
         self.block.deposit(k, &ContactForce::default());
+        self.block.flags[k] = PairFlags::OPEN.0;
+        true
     }
 }
 

@@ -77,12 +77,19 @@ impl<T: Real> PairReports<T> {
     }
 }
 
-/// A pair's tangential regime (bits 0-1, [`Regime`]'s code) and whether the no-pull clamp
-/// removed an attractive damping force (bit 2), in one byte.
+/// A pair's tangential regime (bits 0-1, [`Regime`]'s code), whether the no-pull clamp
+/// removed an attractive damping force (bit 2) and whether the pair was open with every
+/// record zero (bit 3, [`Self::OPEN`]), in one byte.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PairFlags(pub u8);
 
 impl PairFlags {
+    /// A dry pair found open: its force, reports and springs were all set to zero, so that
+    /// while it stays open the pair pass need not write them again (a third of a dense
+    /// packing's listed pairs, whose zeros were most of the pass's stores). Regime static,
+    /// no clamp.
+    pub const OPEN: PairFlags = PairFlags(8);
+
     /// The flags of a regime and a clamp.
     #[inline(always)]
     pub fn new(regime: Regime, clamped: bool) -> Self {
