@@ -43,6 +43,10 @@ pub struct Schedule {
     pub first: Vec<Op>,
     /// Every later step.
     pub step: Vec<Op>,
+    /// `first`'s sweeps ([`sweeps`]).
+    first_sweeps: Vec<Sweep>,
+    /// `step`'s sweeps.
+    step_sweeps: Vec<Sweep>,
 }
 
 impl Schedule {
@@ -71,12 +75,14 @@ impl Schedule {
         let drifts_after_last = step.iter().rev().take_while(|op| !matches!(op, Op::Forces { .. })).map(Op::drift).sum();
         let first = with_elapsed(&step, 0.0);
         let step = with_elapsed(&step, drifts_after_last);
-        Schedule { prologue: vec![Op::RebuildIfNeeded, Op::Forces { elapsed: 0.0 }], needs_loads: matches!(step[0], Kick { .. }), first, step }
+        let (first_sweeps, step_sweeps) = (sweeps(&first), sweeps(&step));
+        Schedule { prologue: vec![Op::RebuildIfNeeded, Op::Forces { elapsed: 0.0 }], needs_loads: matches!(step[0], Kick { .. }), first, step, first_sweeps, step_sweeps }
     }
 
-    /// The operations of step number `step` (0 = the first).
-    pub fn ops(&self, step: u64) -> &[Op] {
-        if step == 0 { &self.first } else { &self.step }
+    /// The sweeps of step number `step` (0 = the first): its operations, each kick merged
+    /// into the sweep next to it ([`sweeps`]).
+    pub fn sweeps(&self, step: u64) -> &[Sweep] {
+        if step == 0 { &self.first_sweeps } else { &self.step_sweeps }
     }
 }
 
@@ -154,12 +160,31 @@ pub enum Sweep {
     },
 }
 
-/// The sweep that starts at operation `k` of `ops`, and how many operations it covers.
-pub fn sweep_at(ops: &[Op], k: usize) -> (Sweep, usize) {
-    match (ops[k], ops.get(k + 1)) {
-        (Op::Forces { elapsed }, Some(&Op::Kick { tau })) => (Sweep::ForcesKick { elapsed, tau }, 2),
-        (Op::Kick { tau: kick }, Some(&Op::Drift { tau })) => (Sweep::KickDrift { kick, tau }, 2),
-        (op, _) => (Sweep::Op(op), 1),
+/// The sweeps that run `ops`, in order: a kick right after a force evaluation merged into it,
+/// a kick right before a drift merged into the drift, every other operation alone.
+pub fn sweeps(ops: &[Op]) -> Vec<Sweep> {
+    let (mut out, mut k) = (Vec::new(), 0);
+    while k < ops.len() {
+        let (sweep, covers) = match (ops[k], ops.get(k + 1)) {
+            (Op::Forces { elapsed }, Some(&Op::Kick { tau })) => (Sweep::ForcesKick { elapsed, tau }, 2),
+            (Op::Kick { tau: kick }, Some(&Op::Drift { tau })) => (Sweep::KickDrift { kick, tau }, 2),
+            (op, _) => (Sweep::Op(op), 1),
+        };
+        out.push(sweep);
+        k += covers;
+    }
+    out
+}
+
+impl Sweep {
+    /// The operations the sweep runs, in order.
+    pub fn ops(self) -> impl Iterator<Item = Op> {
+        let (a, b) = match self {
+            Sweep::Op(op) => (op, None),
+            Sweep::KickDrift { kick, tau } => (Op::Kick { tau: kick }, Some(Op::Drift { tau })),
+            Sweep::ForcesKick { elapsed, tau } => (Op::Forces { elapsed }, Some(Op::Kick { tau })),
+        };
+        std::iter::once(a).chain(b)
     }
 }
 
@@ -192,19 +217,10 @@ mod tests {
     /// velocity Verlet's kicks merge into the evaluations before them.
     #[test]
     fn kicks_merge_into_the_sweeps_next_to_them() {
-        let all = |ops: &[Op]| {
-            let (mut k, mut out) = (0, Vec::new());
-            while k < ops.len() {
-                let (s, n) = sweep_at(ops, k);
-                out.push(s);
-                k += n;
-            }
-            out
-        };
         let dt = 1.0e-6;
-        let vv = all(&Schedule::new(Integrator::VelocityVerlet, dt).step);
+        let vv = Schedule::new(Integrator::VelocityVerlet, dt).sweeps(1).to_vec();
         assert_eq!(vv, vec![Sweep::KickDrift { kick: 0.5 * dt, tau: dt }, Sweep::Op(Op::RebuildIfNeeded), Sweep::ForcesKick { elapsed: dt, tau: 0.5 * dt }]);
-        let ovv = all(&Schedule::new(Integrator::OptimizedVerlet, dt).step);
+        let ovv = Schedule::new(Integrator::OptimizedVerlet, dt).sweeps(1).to_vec();
         let merged = ovv.iter().filter(|s| matches!(s, Sweep::ForcesKick { .. })).count();
         assert_eq!((ovv.len(), merged), (7, 2), "{ovv:?}");
     }

@@ -44,7 +44,7 @@ use crate::model::{capillary_potential, normal_potential, share_liquid, within_r
 use crate::periodic::Periodic;
 use crate::position;
 use crate::real::{Real, Vec3};
-use crate::schedule::{sweep_at, Op, Schedule, Sweep, Trace};
+use crate::schedule::{Op, Schedule, Sweep, Trace};
 use crate::scene::{Scene, WallShape};
 use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
@@ -588,27 +588,23 @@ impl<T: Real> CpuEngine<T> {
         if self.schedule.needs_loads {
             self.ensure_loads_with(hooks)?;
         }
-        let ops = self.schedule.ops(self.step).len();
-        let mut k = 0;
-        while k < ops {
-            let (sweep, covers) = sweep_at(self.schedule.ops(self.step), k);
+        for s in 0..self.schedule.sweeps(self.step).len() {
+            let sweep = self.schedule.sweeps(self.step)[s];
+            if !matches!(sweep, Sweep::Op(_)) {
+                sweep.ops().for_each(|op| self.trace.record(op));
+            }
             match sweep {
                 Sweep::Op(op) => self.run(op, hooks)?,
                 Sweep::ForcesKick { elapsed, tau } => {
-                    self.trace.record(Op::Forces { elapsed });
-                    self.trace.record(Op::Kick { tau });
                     self.forces(elapsed, Some(T::of(tau)), hooks)?;
                     // The piston's kick reads the walls' sums, which the hooks complete.
                     self.kick_piston(T::of(tau));
                 }
                 Sweep::KickDrift { kick, tau } => {
-                    self.trace.record(Op::Kick { tau: kick });
-                    self.trace.record(Op::Drift { tau });
                     self.drift(Some(T::of(kick)), T::of(tau));
                     hooks.drifted(self)?;
                 }
             }
-            k += covers;
         }
         self.step += 1;
         self.time += self.dt.f64();

@@ -42,10 +42,7 @@ impl<T: Real> CpuEngine<T> {
             None => out.push((name, b)),
         };
         let merged_kick = bytes(&self.load) + prop;
-        let ops = &self.schedule.step;
-        let mut k = 0;
-        while k < ops.len() {
-            let (sweep, covers) = sweep_at(ops, k);
+        for &sweep in self.schedule.sweeps(1) {
             match sweep {
                 Sweep::Op(Op::Kick { .. }) => add("kick", kick),
                 Sweep::Op(Op::Drift { .. }) => add("drift", drift),
@@ -67,7 +64,6 @@ impl<T: Real> CpuEngine<T> {
                     add("walls", walls);
                 }
             }
-            k += covers;
         }
         out.retain(|e| e.1 > 0);
         out

@@ -4,7 +4,7 @@
 //! gives the same bits.
 
 use super::layout::Phase;
-use crate::schedule::{sweep_at, Op, Schedule, Sweep};
+use crate::schedule::{sweeps, Op, Schedule, Sweep};
 
 /// What one entry of a plan encodes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -32,9 +32,7 @@ pub struct Entry {
 /// The plan of `ops`.
 pub fn plan(ops: &[Op]) -> Vec<Entry> {
     let mut out = Vec::new();
-    let mut k = 0;
-    while k < ops.len() {
-        let (sweep, covered) = sweep_at(ops, k);
+    for sweep in sweeps(ops) {
         let (dispatch, phase) = match sweep {
             Sweep::KickDrift { kick, tau } => (Dispatch::Integrate, Phase { kick: kick as f32, drift: tau as f32, ..Default::default() }),
             Sweep::Op(Op::Kick { tau }) => (Dispatch::Integrate, Phase { kick: tau as f32, ..Default::default() }),
@@ -43,8 +41,7 @@ pub fn plan(ops: &[Op]) -> Vec<Entry> {
             Sweep::ForcesKick { elapsed, tau } => (Dispatch::Forces, Phase { elapsed: elapsed as f32, kick: tau as f32, ..Default::default() }),
             Sweep::Op(Op::Forces { elapsed }) => (Dispatch::Forces, Phase { elapsed: elapsed as f32, ..Default::default() }),
         };
-        out.push(Entry { dispatch, phase, ops: ops[k..k + covered].to_vec() });
-        k += covered;
+        out.push(Entry { dispatch, phase, ops: sweep.ops().collect() });
     }
     out
 }
@@ -65,7 +62,7 @@ impl Plans {
     pub fn of(schedule: &Schedule) -> Self {
         Plans { prologue: plan(&schedule.prologue), needs_loads: schedule.needs_loads, first: plan(&schedule.first), later: plan(&schedule.step) }
     }
-    /// The plan of step number `step` (0 = the first), as [`Schedule::ops`].
+    /// The plan of step number `step` (0 = the first), as [`Schedule::sweeps`].
     pub fn step(&self, step: u64) -> &[Entry] {
         if step == 0 { &self.first } else { &self.later }
     }
