@@ -350,8 +350,8 @@ impl<T: Real> ContactDynamics<T> {
         crate::cpu::hash_cells(&self.body, cutoff, &periodic, &mut grid);
         let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grid, &periodic, allowance, usize::MAX).unwrap_or_default();
         let mut contacts = Vec::with_capacity(pairs.len() + self.walls.len());
-        for (k, &b) in pairs.partner.iter().enumerate() {
-            let (a, b) = (pairs.owner[k] as usize, b as usize);
+        for (a, &b) in pairs.owners_of(0..pairs.len()).zip(&pairs.partner) {
+            let b = b as usize;
             let d = position::separation_of(&periodic, |s| self.body[s].pos, &self.residual, b, a);
             let dist = d.norm();
             let (pa, pb) = (&self.prop[a], &self.prop[b]);

@@ -112,6 +112,8 @@ struct Window<T> {
     r_i: [T; WINDOW],
     r_j: [T; WINDOW],
     touching: [bool; WINDOW],
+    /// Each pair's owner grain.
+    owner: [u32; WINDOW],
 }
 
 /// The lane kernel's working arrays, kept from call to call (each call overwrites what it
@@ -127,7 +129,7 @@ pub struct Scratch<T> {
 impl<T: Real> Scratch<T> {
     /// Arrays of zeros.
     pub fn new() -> Box<Self> {
-        let win = Window { d: [[T::ZERO; WINDOW]; 3], dr: [[T::ZERO; WINDOW]; 3], r_i: [T::ZERO; WINDOW], r_j: [T::ZERO; WINDOW], touching: [false; WINDOW] };
+        let win = Window { d: [[T::ZERO; WINDOW]; 3], dr: [[T::ZERO; WINDOW]; 3], r_i: [T::ZERO; WINDOW], r_j: [T::ZERO; WINDOW], touching: [false; WINDOW], owner: [0; WINDOW] };
         Box::new(Scratch { win, touching: [0; WINDOW], open: [0; WINDOW] })
     }
 }
@@ -158,10 +160,10 @@ impl<T: Real> Inputs<T> {
 
 /// Where the lane kernel hands each pair's force.
 pub trait PairSink<T> {
-    /// Takes the force of the block's pair `m` (counted from its first pair). The touching
-    /// pairs come in pair order; in capillary scenes each window's open pairs come before
-    /// them.
-    fn put(&mut self, m: usize, f: &ContactForce<T>);
+    /// Takes the force of the block's pair `m` (counted from its first pair), owned by grain
+    /// `owner`. The touching pairs come in pair order; in capillary scenes each window's open
+    /// pairs come before them.
+    fn put(&mut self, m: usize, owner: usize, f: &ContactForce<T>);
 
     /// Pair `m` does not touch and has no bridge: its force is zero. Called in any order
     /// (in a dry scene, a window's open pairs before its touching ones). Returns false when
@@ -172,7 +174,7 @@ pub trait PairSink<T> {
 
 impl<T: Copy + Default> PairSink<T> for [ContactForce<T>] {
     #[inline(always)]
-    fn put(&mut self, m: usize, f: &ContactForce<T>) {
+    fn put(&mut self, m: usize, _owner: usize, f: &ContactForce<T>) {
         self[m] = *f;
     }
 
@@ -217,6 +219,7 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
     let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], f_c: [T::ZERO; LANES], clamped: [false; LANES], sliding: [false; LANES], xi: V3s::ZERO };
     for (w, hist) in hist[..STRIDE * n].chunks_mut(STRIDE * WINDOW).enumerate() {
         let (base, len) = (first + w * WINDOW, hist.len() / STRIDE);
+        window_owners(pairs, base, &mut win.owner[..len]);
         // Touch test: the scattered reads one pair at a time, then the fold and the test in
         // vector lanes.
         for m in 0..len {
@@ -228,7 +231,7 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
                 super::simd::prefetch(&b.omega);
                 super::simd::prefetch(&prop[j as usize]);
             }
-            let (i, j) = (pairs.owner[base + m] as usize, pairs.partner[base + m] as usize);
+            let (i, j) = (win.owner[m] as usize, pairs.partner[base + m] as usize);
             let (d, dr) = (body[i].pos - body[j].pos, residual_at(ctx.residual, i) - residual_at(ctx.residual, j));
             [win.d[0][m], win.d[1][m], win.d[2][m]] = [d.x, d.y, d.z];
             if T::COMPENSATED {
@@ -255,7 +258,10 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
         for &m in &open[..n_open] {
             let m = m as usize;
             match kappa {
-                Some(_) => sink.put(w * WINDOW + m, &super::pair_force::pair_force(base + m, pairs, body, prop, ctx, &mut hist[STRIDE * m..STRIDE * (m + 1)])),
+                Some(_) => {
+                    let i = win.owner[m] as usize;
+                    sink.put(w * WINDOW + m, i, &super::pair_force::pair_force(i, base + m, pairs, body, prop, ctx, &mut hist[STRIDE * m..STRIDE * (m + 1)]));
+                }
                 None => {
                     if sink.skip(w * WINDOW + m) {
                         hist[STRIDE * m..STRIDE * m + 3].fill(T::ZERO);
@@ -267,7 +273,7 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
             // Load: the rest of the touching pairs' grains, one pair at a time.
             for (l, &m) in group.iter().enumerate() {
                 let m = m as usize;
-                let i = pairs.owner[base + m] as usize;
+                let i = win.owner[m] as usize;
                 let j = pairs.partner[base + m] as usize;
                 let (bi, bj, pi, pj) = (&body[i], &body[j], &prop[i], &prop[j]);
                 inp.d.set(l, Vec3::new(win.d[0][m], win.d[1][m], win.d[2][m]));
@@ -314,11 +320,30 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
             // Store.
             for (l, &m) in group.iter().enumerate() {
                 let m = m as usize;
-                sink.put(w * WINDOW + m, &ContactForce { f_i: res.f_i.get(l), f_j: res.f_j.get(l), t_i: res.t_i.get(l), t_j: res.t_j.get(l), f_n: res.f_n[l], f_c: res.f_c[l], clamped: res.clamped[l], regime: if res.sliding[l] { Regime::Sliding } else { Regime::Static } });
+                sink.put(w * WINDOW + m, win.owner[m] as usize, &ContactForce { f_i: res.f_i.get(l), f_j: res.f_j.get(l), t_i: res.t_i.get(l), t_j: res.t_j.get(l), f_n: res.f_n[l], f_c: res.f_c[l], clamped: res.clamped[l], regime: if res.sliding[l] { Regime::Sliding } else { Regime::Static } });
                 let xi = res.xi.get(l);
                 hist[STRIDE * m..STRIDE * m + 3].copy_from_slice(&[xi.x, xi.y, xi.z]);
             }
         }
+    }
+}
+
+/// The owner of each pair `base..base + owner.len()`, without a branch per pair: a mark where
+/// each owner's pairs begin (several where owners own none), summed along the window.
+#[inline(always)]
+fn window_owners(pairs: &PairList, base: usize, owner: &mut [u32]) {
+    let first = pairs.owner_of(base);
+    owner.fill(0);
+    // `owner_start`'s last entry, the number of pairs, ends the walk.
+    let mut q = first + 1;
+    while (pairs.owner_start[q] as usize) < base + owner.len() {
+        owner[pairs.owner_start[q] as usize - base] += 1;
+        q += 1;
+    }
+    let mut sum = first as u32;
+    for o in owner.iter_mut() {
+        sum += *o;
+        *o = sum;
     }
 }
 
@@ -391,7 +416,7 @@ duration = 1.0e-3
         let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), periodic: e.periodic, residual: &e.residual };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let (mut hist_one, mut hist_lanes) = (e.hist.clone(), e.hist.clone());
-        let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[stride * k..stride * (k + 1)])).collect();
+        let one: Vec<ContactForce<T>> = e.pairs.owners_of(0..n).enumerate().map(|(k, i)| pair_force(i, k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[stride * k..stride * (k + 1)])).collect();
         let mut lanes = vec![ContactForce::default(); n];
         hertz_mindlin_block(&model, &mut Scratch::new(), 0, n, lanes.as_mut_slice(), &mut hist_lanes, &e.pairs, &e.body, &e.prop, &ctx);
         let touching = one.iter().filter(|f| f.f_n > T::ZERO).count();
@@ -434,7 +459,7 @@ duration = 1.0e-3
         let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed, periodic: e.periodic, residual: &e.residual };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let mut hist = e.hist.clone();
-        let one: Vec<ContactForce<T>> = (0..n).map(|k| pair_force(k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist[stride * k..stride * (k + 1)])).collect();
+        let one: Vec<ContactForce<T>> = e.pairs.owners_of(0..n).enumerate().map(|(k, i)| pair_force(i, k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist[stride * k..stride * (k + 1)])).collect();
         let asymmetric = one.iter().filter(|f| f.f_i != -f.f_j).count();
         // The floor's loads, from the same history.
         let per_grain = e.walls.len() * stride;

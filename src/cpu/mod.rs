@@ -383,9 +383,8 @@ impl<T: Real> CpuEngine<T> {
         (starts, partners)
     }
 
-    /// Gap (m) between the surfaces of pair `k`'s grains (negative when they overlap).
-    fn gap(&self, k: usize) -> T {
-        let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+    /// Gap (m) between the surfaces of grains `i` and `j` (negative when they overlap).
+    fn gap(&self, i: usize, j: usize) -> T {
         self.separation(i, j).norm() - self.prop[i].radius - self.prop[j].radius
     }
 
@@ -403,7 +402,7 @@ impl<T: Real> CpuEngine<T> {
         let (stride, b) = (self.slots.stride, self.slots.bridge);
         for (k, event) in self.bridge_events() {
             let k = k as usize;
-            let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+            let (i, j) = self.pairs.grains_of(k);
             let (mut l_i, mut l_j) = (self.liquid[i], self.liquid[j]);
             self.hist[k * stride + b] = move_liquid(event, self.hist[k * stride + b], self.bridge_cap, &mut l_i, &mut l_j);
             (self.liquid[i], self.liquid[j]) = (l_i, l_j);
@@ -417,8 +416,10 @@ impl<T: Real> CpuEngine<T> {
         let (stride, b) = (self.slots.stride, self.slots.bridge);
         let events: Vec<Vec<(u32, BridgeEvent)>> = chunked(self.pairs.len(), |range| {
             range
-                .filter_map(|k| {
-                    let (v, gap) = (self.hist[k * stride + b], self.gap(k));
+                .clone()
+                .zip(self.pairs.owners_of(range))
+                .filter_map(|(k, i)| {
+                    let (v, gap) = (self.hist[k * stride + b], self.gap(i, self.pairs.partner[k] as usize));
                     let event = if v > T::ZERO {
                         (!within_rupture(theta, v, gap)).then_some(BridgeEvent::Rupture)
                     } else {
@@ -430,7 +431,7 @@ impl<T: Real> CpuEngine<T> {
         });
         // Pair order by slot follows the numbering; the liquid moves in canonical order.
         let mut events: Vec<(u32, BridgeEvent)> = events.into_iter().flatten().collect();
-        events.sort_by_key(|&(k, _)| (self.id[self.pairs.owner[k as usize] as usize], k));
+        events.sort_by_key(|&(k, _)| (self.id[self.pairs.owner_of(k as usize)], k));
         events
     }
 
@@ -620,9 +621,8 @@ impl<T: Real> CpuEngine<T> {
         }
     }
 
-    /// Overlap (m) and smaller radius (m) of pair `k`.
-    fn pair_overlap(&self, k: usize) -> (T, T) {
-        let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+    /// Overlap (m) and smaller radius (m) of grains `i` and `j`.
+    fn pair_overlap(&self, i: usize, j: usize) -> (T, T) {
         let d = self.separation(i, j).norm();
         (self.prop[i].radius + self.prop[j].radius - d, self.prop[i].radius.min(self.prop[j].radius))
     }
@@ -951,8 +951,8 @@ impl<T: Real> Engine for CpuEngine<T> {
             .iter()
             .map(|&k| {
                 let k = k as usize;
-                let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
-                (self.prop[i].radius.f64(), self.prop[j].radius.f64(), self.gap(k).f64())
+                let (i, j) = self.pairs.grains_of(k);
+                (self.prop[i].radius.f64(), self.prop[j].radius.f64(), self.gap(i, j).f64())
             })
             .collect();
         let (shares, rest) = share_liquid(volume, &pairs, self.bridge_cap.f64(), theta.f64());
@@ -989,7 +989,7 @@ impl<T: Real> Engine for CpuEngine<T> {
         let l = &self.pairs;
         let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
         let walls = allocated(&self.wall_hist) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
-        let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.owner) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
+        let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
         grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)
     }
 

@@ -44,11 +44,11 @@ impl<T: Real> ForceContext<'_, T> {
     }
 }
 
-/// `pair_force` for pair `k`. A listed pair that does not touch forgets its springs and
-/// exerts only the capillary force of its liquid bridge, if it has one within reach.
+/// `pair_force` for pair `k`, owned by grain `i`. A listed pair that does not touch forgets
+/// its springs and exerts only the capillary force of its liquid bridge, if it has one within
+/// reach.
 #[inline(always)]
-pub fn pair_force<T: Real>(k: usize, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, hist: &mut [T]) -> ContactForce<T> {
-    let i = pairs.owner[k] as usize;
+pub fn pair_force<T: Real>(i: usize, k: usize, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, hist: &mut [T]) -> ContactForce<T> {
     let j = pairs.partner[k] as usize;
     let (bi, bj, pi, pj) = (&body[i], &body[j], &prop[i], &prop[j]);
     let d = ctx.separation(body, i, j);
@@ -143,7 +143,7 @@ fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut Tas
     let first_pair = pairs.owner_start[first] as usize;
     let (stride, n_pairs) = (ctx.slots.stride, block.f_n.len());
     let hist = std::mem::take(&mut block.hist);
-    let mut sink = Deposit::new(&mut block, &pairs.owner[first_pair..first_pair + n_pairs]);
+    let mut sink = Deposit::new(&mut block);
     match super::lanes::hertz_mindlin(ctx.model) {
         // Without cohesion the lanes hand the touching pairs over in pair order.
         Some(model) if matches!(ctx.model.cohesion, CohesionLaw::None) => {
@@ -158,14 +158,15 @@ fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut Tas
                 let n = BLOCK.min(n_pairs - start);
                 let h = &mut hist[start * stride..(start + n) * stride];
                 super::lanes::hertz_mindlin_block(&model, lanes, first_pair + start, n, &mut records[..n], h, pairs, body, prop, ctx);
-                for (q, f) in records[..n].iter().enumerate() {
-                    sink.put(start + q, f);
+                let owners = pairs.owners_of(first_pair + start..first_pair + start + n);
+                for ((q, f), i) in records[..n].iter().enumerate().zip(owners) {
+                    sink.put(start + q, i, f);
                 }
             }
         }
         None => {
-            for k in 0..n_pairs {
-                sink.put(k, &pair_force(first_pair + k, pairs, body, prop, ctx, &mut hist[k * stride..(k + 1) * stride]));
+            for (k, i) in pairs.owners_of(first_pair..first_pair + n_pairs).enumerate() {
+                sink.put(k, i, &pair_force(i, first_pair + k, pairs, body, prop, ctx, &mut hist[k * stride..(k + 1) * stride]));
             }
         }
     }
@@ -177,8 +178,6 @@ fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut Tas
 /// wait on the previous one's store), the rest stored per pair.
 struct Deposit<'b, 'a, T> {
     block: &'b mut OwnerBlock<'a, T>,
-    /// The owner of each of the block's pairs.
-    owner: &'b [u32],
     /// The owner being summed, as an index into the block's loads.
     current: usize,
     /// Its load so far.
@@ -186,9 +185,9 @@ struct Deposit<'b, 'a, T> {
 }
 
 impl<'b, 'a, T: Real> Deposit<'b, 'a, T> {
-    fn new(block: &'b mut OwnerBlock<'a, T>, owner: &'b [u32]) -> Self {
+    fn new(block: &'b mut OwnerBlock<'a, T>) -> Self {
         let sum = block.load.first().copied().unwrap_or_default();
-        Deposit { block, owner, current: 0, sum }
+        Deposit { block, current: 0, sum }
     }
 
     /// Stores the load being summed.
@@ -202,8 +201,8 @@ impl<'b, 'a, T: Real> Deposit<'b, 'a, T> {
 
 impl<T: Real> PairSink<T> for Deposit<'_, '_, T> {
     #[inline(always)]
-    fn put(&mut self, k: usize, f: &ContactForce<T>) {
-        let owner = self.owner[k] as usize - self.block.first;
+    fn put(&mut self, k: usize, owner: usize, f: &ContactForce<T>) {
+        let owner = owner - self.block.first;
         if owner != self.current {
             self.finish();
             self.current = owner;

@@ -6,15 +6,13 @@ use super::reduce::chunked;
 use super::state::{Body, Props};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
-use rayon::prelude::*;
 
 /// Candidate pairs, each listed once under its owner (the lower permanent id).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PairList {
-    /// `owner_start[i]..owner_start[i + 1]` are the pairs grain `i` owns.
+    /// `owner_start[i]..owner_start[i + 1]` are the pairs grain `i` owns (no per-pair owner
+    /// array: 4 bytes a pair; the passes walk the owners, [`Self::owner_of`] finds one).
     pub owner_start: Vec<u32>,
-    /// Owner grain of each pair.
-    pub owner: Vec<u32>,
     /// Partner grain of each pair (higher permanent id), ascending id within an owner.
     pub partner: Vec<u32>,
     /// `rev_start[j]..rev_start[j + 1]` index `rev_pair` for the pairs where `j` is partner.
@@ -26,11 +24,32 @@ pub struct PairList {
 impl PairList {
     /// Number of pairs.
     pub fn len(&self) -> usize {
-        self.owner.len()
+        self.partner.len()
     }
     /// True when there are no pairs.
     pub fn is_empty(&self) -> bool {
-        self.owner.is_empty()
+        self.partner.is_empty()
+    }
+    /// The owner of pair `k`, by bisection of `owner_start` (for the passes that visit a few
+    /// pairs or run between steps; the per-step passes walk the owners).
+    #[inline]
+    pub fn owner_of(&self, k: usize) -> usize {
+        self.owner_start.partition_point(|&s| s as usize <= k) - 1
+    }
+    /// Pair `k`'s two grains (owner, partner), the owner by [`Self::owner_of`].
+    #[inline]
+    pub fn grains_of(&self, k: usize) -> (usize, usize) {
+        (self.owner_of(k), self.partner[k] as usize)
+    }
+    /// The owner of every pair in `range`, in order, walking `owner_start` once.
+    pub fn owners_of(&self, range: std::ops::Range<usize>) -> impl Iterator<Item = usize> + '_ {
+        let mut i = if range.is_empty() { 0 } else { self.owner_of(range.start) };
+        range.map(move |k| {
+            while self.owner_start[i + 1] as usize <= k {
+                i += 1;
+            }
+            i
+        })
     }
 
     /// Runs `detect_pairs` for every grain and assembles the list, without the reverse lists
@@ -59,7 +78,7 @@ impl PairList {
         });
         // Exact sizes: a pair list of 10^6 grains is tens of megabytes, so no growth slack.
         let total = parts.iter().map(|(_, partners)| partners.len()).sum();
-        let mut list = PairList { owner_start: Vec::with_capacity(n + 1), owner: Vec::with_capacity(total), partner: Vec::with_capacity(total), ..Default::default() };
+        let mut list = PairList { owner_start: Vec::with_capacity(n + 1), partner: Vec::with_capacity(total), ..Default::default() };
         list.owner_start.push(0);
         let mut over: Option<(usize, usize)> = None;
         for (counts, partners) in parts {
@@ -68,7 +87,6 @@ impl PairList {
                 if c as usize > capacity && over.is_none_or(|(o, _)| id[i] < id[o]) {
                     over = Some((i, c as usize));
                 }
-                list.owner.extend(std::iter::repeat_n(i as u32, c as usize));
                 list.owner_start.push(list.owner_start[i] + c);
             }
             list.partner.extend(partners);
@@ -121,12 +139,11 @@ impl PairList {
     }
 }
 
-/// `remap_history` for new pair `k`: copies the history block of the same pair (owner and
-/// partner's permanent id, as DEM-Engine's persistent map matches them) from the old list,
-/// or zeroes it for a pair that is new.
+/// `remap_history` for new pair `k`, owned by `i`: copies the history block of the same pair
+/// (owner and partner's permanent id, as DEM-Engine's persistent map matches them) from the
+/// old list, or zeroes it for a pair that is new.
 #[inline]
-pub fn remap_history<T: Real>(k: usize, new: &PairList, old: &PairList, old_hist: &[T], id: &[u32], stride: usize, out: &mut [T]) {
-    let i = new.owner[k] as usize;
+pub fn remap_history<T: Real>(i: usize, k: usize, new: &PairList, old: &PairList, old_hist: &[T], id: &[u32], stride: usize, out: &mut [T]) {
     let j = new.partner[k] as usize;
     match old.find(i, id[j], id) {
         Some(o) => out.copy_from_slice(&old_hist[o * stride..(o + 1) * stride]),
@@ -136,9 +153,18 @@ pub fn remap_history<T: Real>(k: usize, new: &PairList, old: &PairList, old_hist
 
 /// Runs `remap_history` over every new pair.
 pub fn remap_all<T: Real>(new: &PairList, old: &PairList, old_hist: &[T], id: &[u32], stride: usize) -> Vec<T> {
-    let mut hist = vec![T::ZERO; new.len() * stride];
-    if stride > 0 {
-        hist.par_chunks_mut(stride).with_min_len(super::reduce::PAR_MIN_ITEMS).enumerate().for_each(|(k, out)| remap_history(k, new, old, old_hist, id, stride, out));
+    if stride == 0 {
+        return Vec::new();
     }
-    hist
+    // Owner by owner, in chunks of owners whose blocks are joined in order.
+    let n = new.owner_start.len().saturating_sub(1);
+    chunked(n, |owners| {
+        let pairs = new.owner_start[owners.start] as usize..new.owner_start[owners.end] as usize;
+        let mut hist = vec![T::ZERO; pairs.len() * stride];
+        for (m, (k, i)) in pairs.clone().zip(new.owners_of(pairs)).enumerate() {
+            remap_history(i, k, new, old, old_hist, id, stride, &mut hist[m * stride..(m + 1) * stride]);
+        }
+        hist
+    })
+    .concat()
 }

@@ -98,9 +98,9 @@ impl Rows {
                 push_row(&mut rows.grains, s, &GRAIN_ARRAYS, &widths.grain, slot);
             }
         }
-        let (owner, partner) = (&s.ints["owner"], &s.ints["partner"]);
-        for k in 0..owner.len() {
-            let (a, b) = (id[owner[k] as usize] as u32, id[partner[k] as usize] as u32);
+        let (starts, partner) = (&s.ints["owner_start"], &s.ints["partner"]);
+        for (slot, k) in starts.windows(2).enumerate().flat_map(|(s, w)| (w[0]..w[1]).map(move |k| (s, k as usize))) {
+            let (a, b) = (id[slot] as u32, id[partner[k] as usize] as u32);
             if keep_pair(a, b) {
                 rows.pairs.extend([a as f64, b as f64]);
                 push_row(&mut rows.pairs, s, &PAIR_ARRAYS, &widths.pair, k);
@@ -171,7 +171,6 @@ pub(crate) fn state_of_rows(rows: &Rows, widths: &RowWidths, template: &EngineSt
     let mut list = PairList { owner_start: vec![0; ids.len() + 1], ..Default::default() };
     for &(a, b, values) in &pairs {
         list.owner_start[a as usize + 1] += 1;
-        list.owner.push(a);
         list.partner.push(b);
         pop_row(&mut s, &PAIR_ARRAYS, &widths.pair, values);
     }
@@ -179,7 +178,7 @@ pub(crate) fn state_of_rows(rows: &Rows, widths: &RowWidths, template: &EngineSt
         list.owner_start[i + 1] += list.owner_start[i];
     }
     list.build_reverse(&(0..ids.len() as u32).collect::<Vec<_>>());
-    for (name, v) in [("owner_start", &list.owner_start), ("owner", &list.owner), ("partner", &list.partner), ("rev_start", &list.rev_start), ("rev_pair", &list.rev_pair)] {
+    for (name, v) in [("owner_start", &list.owner_start), ("partner", &list.partner), ("rev_start", &list.rev_start), ("rev_pair", &list.rev_pair)] {
         s.put_ints(name, v.iter().map(|&x| x as u64));
     }
     for name in GLOBAL_ARRAYS {
@@ -299,7 +298,7 @@ impl<T: Real> CpuEngine<T> {
         let mut rows = Vec::new();
         for (k, event) in self.bridge_events() {
             let k = k as usize;
-            let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
+            let (i, j) = self.pairs.grains_of(k);
             if keep(self.id[i]) {
                 let kind = if event == BridgeEvent::Rupture { 0.0 } else { 1.0 };
                 rows.extend([to_id(self.id[i]) as f64, to_id(self.id[j]) as f64, kind, self.hist[k * stride + b].f64(), self.liquid[i].f64(), self.liquid[j].f64()]);

@@ -96,15 +96,11 @@ impl Renumbering {
             }
             (partner, h)
         });
-        let n_pairs = list.len();
-        let mut moved = PairList { owner: Vec::with_capacity(n_pairs), partner: Vec::with_capacity(n_pairs), ..Default::default() };
+        let mut moved = PairList { partner: Vec::with_capacity(list.len()), ..Default::default() };
         let mut moved_hist = Vec::with_capacity(hist.len());
         for (partner, h) in parts {
             moved.partner.extend(partner);
             moved_hist.extend(h);
-        }
-        for s in 0..n {
-            moved.owner.extend(std::iter::repeat_n(s as u32, (owner_start[s + 1] - owner_start[s]) as usize));
         }
         moved.owner_start = owner_start;
         (moved, moved_hist)
@@ -127,7 +123,7 @@ mod tests {
     #[test]
     fn pairs_follow_their_owners_and_partners_are_renamed() {
         // Three grains with permanent ids = old slots; pairs 0-1, 0-2, 1-2.
-        let mut list = PairList { owner_start: vec![0, 2, 3, 3], owner: vec![0, 0, 1], partner: vec![1, 2, 2], ..Default::default() };
+        let mut list = PairList { owner_start: vec![0, 2, 3, 3], partner: vec![1, 2, 2], ..Default::default() };
         list.build_reverse(&[0, 1, 2]);
         let hist: Vec<f64> = vec![1.0, 1.5, 2.0, 2.5, 3.0, 3.5];
         // New slots: old 2, old 0, old 1.
@@ -135,7 +131,7 @@ mod tests {
         assert_eq!(r.to, vec![1, 2, 0]);
         let (moved, h) = r.apply_pairs(&list, &hist, 2);
         assert_eq!(moved.owner_start, vec![0, 0, 2, 3]);
-        assert_eq!(moved.owner, vec![1, 1, 2]);
+        assert_eq!(moved.owners_of(0..3).collect::<Vec<_>>(), vec![1, 1, 2]);
         assert_eq!(moved.partner, vec![2, 0, 0]);
         assert_eq!(h, hist);
         let mut v = vec![10, 11, 12];

@@ -21,12 +21,13 @@ impl<T: Real> CpuEngine<T> {
                     .into_iter()
                     .filter_map(|k| {
                         let k = k as usize;
-                        let (h, _) = self.pair_overlap(k);
+                        let (i, j) = self.pairs.grains_of(k);
+                        let (h, _) = self.pair_overlap(i, j);
                         (h > T::ZERO || self.report.f_c(k) != T::ZERO).then(|| {
                             let springs = self.slots.load(&self.hist[k * self.slots.stride..]);
                             ContactRecord {
-                                i: self.id[self.pairs.owner[k] as usize],
-                                j: self.id[self.pairs.partner[k] as usize],
+                                i: self.id[i],
+                                j: self.id[j],
                                 overlap: h.f64(),
                                 normal_force: (self.report.f_n[k] + self.report.f_c(k)).f64(),
                                 force: self.owner_force(k).f64(),
@@ -83,7 +84,7 @@ impl<T: Real> CpuEngine<T> {
         });
         s.put_reals("servo", servo);
         let l = &self.pairs;
-        for (name, v) in [("owner_start", &l.owner_start), ("owner", &l.owner), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
+        for (name, v) in [("owner_start", &l.owner_start), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
             s.put_ints(name, v.iter().map(|&x| x as u64));
         }
         s.put_reals("hist", self.hist.iter().map(|x| x.f64()));
@@ -165,12 +166,11 @@ impl<T: Real> CpuEngine<T> {
             self.servo = Some(sv);
         }
         let u32s = |name: &str, len: Option<usize>| -> anyhow::Result<Vec<u32>> { Ok(s.ints(name, len)?.iter().map(|&x| x as u32).collect()) };
-        let owner = u32s("owner", None)?;
-        let n_pairs = owner.len();
+        let partner = u32s("partner", None)?;
+        let n_pairs = partner.len();
         self.pairs = PairList {
             owner_start: u32s("owner_start", Some(n + 1))?,
-            owner,
-            partner: u32s("partner", Some(n_pairs))?,
+            partner,
             rev_start: u32s("rev_start", Some(n + 1))?,
             rev_pair: u32s("rev_pair", Some(n_pairs))?,
         };

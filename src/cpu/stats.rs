@@ -106,11 +106,11 @@ impl<T: Real> CpuEngine<T> {
         let pair_sums = chunked(canonical.len(), |r| {
             let mut s = PairSums::default();
             for k in r.map(|c| canonical[c] as usize) {
-                let (h, r_min) = self.pair_overlap(k);
+                let (i, j) = self.pairs.grains_of(k);
+                let (h, r_min) = self.pair_overlap(i, j);
                 if h <= T::ZERO {
                     continue;
                 }
-                let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
                 let (pi, pj) = (&self.prop[i], &self.prop[j]);
                 let c = &self.coeffs[pi.material as usize * self.n_materials + pj.material as usize];
                 let r_eff = pi.radius * pj.radius / (pi.radius + pj.radius);
@@ -190,8 +190,8 @@ impl<T: Real> CpuEngine<T> {
                 let (stride, b) = (self.slots.stride, self.slots.bridge);
                 let bridge = |k: usize| {
                     let v = self.hist[k * stride + b];
-                    let (i, j) = (self.pairs.owner[k] as usize, self.pairs.partner[k] as usize);
-                    (v, capillary_potential(kappa, theta, c, self.prop[i].radius, self.prop[j].radius, v, self.gap(k)))
+                    let (i, j) = self.pairs.grains_of(k);
+                    (v, capillary_potential(kappa, theta, c, self.prop[i].radius, self.prop[j].radius, v, self.gap(i, j)))
                 };
                 chunked(canonical.len(), |r| r.map(|c| bridge(canonical[c] as usize)).filter(|(v, _)| *v > T::ZERO).fold((0u64, 0.0, 0.0), |(n, s, u), (v, e)| (n + 1, s + v.f64(), u + e.f64())))
                     .into_iter()

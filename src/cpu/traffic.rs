@@ -32,7 +32,7 @@ impl<T: Real> CpuEngine<T> {
         let open = r.flags.iter().filter(|&&f| f == PairFlags::OPEN.0).count() as u64;
         let live = |b: u64| b / n_pairs * (n_pairs - open);
         let pair_out = bytes(&self.share) + bytes(&r.f_n) + bytes(&r.f_c) + bytes(&self.force_i);
-        let force = bytes(&l.owner) + bytes(&l.partner) + body + residual + prop + bytes(&r.flags) + live(2 * bytes(&self.hist) + pair_out) + bytes(&self.load);
+        let force = bytes(&l.partner) + body + residual + prop + bytes(&r.flags) + live(2 * bytes(&self.hist) + pair_out) + bytes(&self.load);
         // The wall contacts run in the gather's sweep, on the loads it has in hand.
         let walls = if self.walls.is_empty() { 0 } else { body + residual + prop + 2 * bytes(&self.wall_hist) };
         let gather = bytes(&self.share) + bytes(&l.rev_start) + bytes(&l.rev_pair) + 2 * bytes(&self.load);

@@ -181,9 +181,9 @@ impl<T: Real> Net<T> {
         // Each grain's holders: its owner and the owners of its partners.
         let mut held: Vec<Vec<usize>> = owner.iter().map(|&o| vec![o]).collect();
         let ids = &state.ints["id"];
-        let (o, p) = (&state.ints["owner"], &state.ints["partner"]);
-        for k in 0..o.len() {
-            let (a, b) = (ids[o[k] as usize] as usize, ids[p[k] as usize] as usize);
+        let (starts, p) = (&state.ints["owner_start"], &state.ints["partner"]);
+        for (slot, k) in starts.windows(2).enumerate().flat_map(|(s, w)| (w[0]..w[1]).map(move |k| (s, k as usize))) {
+            let (a, b) = (ids[slot] as usize, ids[p[k] as usize] as usize);
             if owner[a] != owner[b] {
                 held[a].push(owner[b]);
                 held[b].push(owner[a]);
