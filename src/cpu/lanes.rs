@@ -489,6 +489,25 @@ duration = 1.0e-3
         assert_eq!(reports, None, "the pair's report differs at pair {reports:?}");
     }
 
+    /// Each pair's owner, found from `owner_start` alone, against the owners written out pair
+    /// by pair, on a list whose first, middle and last grains own no pair, for every window
+    /// start and length.
+    #[test]
+    fn owners_come_from_owner_start_alone() {
+        // Grains 0, 2, 3 and 5 own nothing; 1 owns pairs 0-1, 4 owns 2-4, 6 owns 5.
+        let pairs = PairList { owner_start: vec![0, 0, 2, 2, 2, 5, 5, 6], partner: vec![7; 6], ..Default::default() };
+        let written: Vec<usize> = vec![1, 1, 4, 4, 4, 6];
+        assert_eq!((0..6).map(|k| pairs.owner_of(k)).collect::<Vec<_>>(), written);
+        for base in 0..6 {
+            for len in 1..=6 - base {
+                assert_eq!(pairs.owners_of(base..base + len).collect::<Vec<_>>(), written[base..base + len], "owners_of({base}..{})", base + len);
+                let mut owner = vec![0u32; len];
+                window_owners(&pairs, base, &mut owner);
+                assert_eq!(owner.iter().map(|&o| o as usize).collect::<Vec<_>>(), written[base..base + len], "window at {base}, {len} pairs");
+            }
+        }
+    }
+
     #[test]
     fn owner_sums_give_the_gathers_bits() {
         check_loads::<f64>(false);
