@@ -172,6 +172,8 @@ pub struct ContactDynamics<T: Real> {
     /// Compensated positions' residuals ([`crate::position`]; empty in f64).
     residual: Vec<Vec3<T>>,
     prop: Vec<Props<T>>,
+    /// Material index of each grain.
+    material: Vec<u32>,
     walls: Vec<(WallGeom<T>, u32)>,
     wall_motion: Vec<WallMotion<T>>,
     servo: Option<servo::ServoWalls<T>>,
@@ -261,7 +263,7 @@ impl<T: Real> ContactDynamics<T> {
         let (pos, residual): (Vec<Vec3<T>>, Vec<Vec3<T>>) = g.position.iter().map(|&x| position::split(x)).unzip();
         let body = (0..n).map(|i| Body { pos: pos[i], vel: Vec3::of(g.velocity[i]), omega: Vec3::of(g.angular_velocity[i]) }).collect();
         let prop = (0..n)
-            .map(|i| Props { radius: T::of(g.radius[i]), mass: T::of(g.mass[i]), inertia: T::of(0.4 * g.mass[i] * g.radius[i] * g.radius[i]), material: g.material[i] as u32 })
+            .map(|i| Props { radius: T::of(g.radius[i]), mass: T::of(g.mass[i]), inertia: T::of(0.4 * g.mass[i] * g.radius[i] * g.radius[i]) })
             .collect();
         let servo = scene.servo.as_ref().map(|b| servo::ServoWalls {
             walls: b.walls,
@@ -278,6 +280,7 @@ impl<T: Real> ContactDynamics<T> {
             body,
             residual: if T::COMPENSATED { residual } else { Vec::new() },
             prop,
+            material: g.material.iter().map(|&m| m as u32).collect(),
             walls: scene.walls.iter().map(|w| (WallGeom::of(&w.shape), w.material as u32)).collect(),
             wall_motion: vec![WallMotion::default(); scene.walls.len()],
             servo,
@@ -356,7 +359,7 @@ impl<T: Real> ContactDynamics<T> {
             let dist = d.norm();
             let (pa, pb) = (&self.prop[a], &self.prop[b]);
             let (inv_mass_b, inv_inertia_b) = (T::ONE / pb.mass, T::ONE / pb.inertia);
-            contacts.push(self.contact(a, Partner::Grain(b as u32), d * (T::ONE / dist), dist - pa.radius - pb.radius, pb.material, (pb.radius, inv_mass_b, inv_inertia_b)));
+            contacts.push(self.contact(a, Partner::Grain(b as u32), d * (T::ONE / dist), dist - pa.radius - pb.radius, self.material[b], (pb.radius, inv_mass_b, inv_inertia_b)));
         }
         for i in 0..self.body.len() {
             for (w, (geom, material)) in self.walls.iter().enumerate() {
@@ -378,7 +381,7 @@ impl<T: Real> ContactDynamics<T> {
     /// normal `n` at `gap`, with its Delassus diagonals.
     fn contact(&self, a: usize, b: Partner, n: Vec3<T>, gap: T, material: u32, (radius_b, inv_mass_b, inv_inertia_b): (T, T, T)) -> Contact<T> {
         let pa = &self.prop[a];
-        let (mu, e) = self.pair(pa.material, material);
+        let (mu, e) = self.pair(self.material[a], material);
         let (inv_mass_a, inv_inertia_a) = (T::ONE / pa.mass, T::ONE / pa.inertia);
         let w_n = inv_mass_a + inv_mass_b;
         // A wall turns no more than it slides: only its normal motion yields.

@@ -283,7 +283,7 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
                 inp.w_i.set(l, bi.omega);
                 inp.w_j.set(l, bj.omega);
                 if !uniform {
-                    let c = &ctx.coeffs[pi.material as usize * ctx.n_materials + pj.material as usize];
+                    let c = ctx.pair_coeffs(i, j);
                     (inp.v_eff[l], inp.g_eff[l], inp.mu_s[l], inp.beta[l]) = (c.v_eff, c.g_eff, c.mu_s, c.beta);
                 }
                 let h = &hist[STRIDE * m..STRIDE * (m + 1)];
@@ -413,7 +413,7 @@ duration = 1.0e-3
         }
         e.advance(400).unwrap();
         let model = hertz_mindlin(&e.model).expect("the scene's model is Hertz-Mindlin");
-        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), periodic: e.periodic, residual: &e.residual };
+        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), periodic: e.periodic, residual: &e.residual, material: &e.material };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let (mut hist_one, mut hist_lanes) = (e.hist.clone(), e.hist.clone());
         let one: Vec<ContactForce<T>> = e.pairs.owners_of(0..n).enumerate().map(|(k, i)| pair_force(i, k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[stride * k..stride * (k + 1)])).collect();
@@ -456,7 +456,7 @@ duration = 1.0e-3
         let mut e = CpuEngine::<T>::new(&scene).unwrap();
         e.advance(400).unwrap();
         let elapsed = T::of(1.0e-7);
-        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed, periodic: e.periodic, residual: &e.residual };
+        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed, periodic: e.periodic, residual: &e.residual, material: &e.material };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let mut hist = e.hist.clone();
         let one: Vec<ContactForce<T>> = e.pairs.owners_of(0..n).enumerate().map(|(k, i)| pair_force(i, k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist[stride * k..stride * (k + 1)])).collect();
@@ -465,7 +465,7 @@ duration = 1.0e-3
         let per_grain = e.walls.len() * stride;
         let mut wall_hist = e.wall_hist.clone();
         let mut touches = Vec::new();
-        let wall: Vec<Load<T>> = (0..e.body.len()).map(|i| wall_contacts(e.id[i], &e.body[i], crate::position::residual_at(&e.residual, i), &e.prop[i], &e.walls, &ctx, &mut wall_hist[i * per_grain..(i + 1) * per_grain], &mut touches)).collect();
+        let wall: Vec<Load<T>> = (0..e.body.len()).map(|i| wall_contacts(e.id[i], &e.body[i], crate::position::residual_at(&e.residual, i), &e.prop[i], ctx.material(i), &e.walls, &ctx, &mut wall_hist[i * per_grain..(i + 1) * per_grain], &mut touches)).collect();
         assert!(!touches.is_empty(), "grains must touch the floor");
         e.evaluate_forces(elapsed, None);
         let p = &e.pairs;

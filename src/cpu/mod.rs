@@ -93,6 +93,8 @@ pub struct CpuEngine<T: Real> {
     /// `pos + residual`. Empty in f64, whose positions are plain.
     residual: Vec<Vec3<T>>,
     prop: Vec<Props<T>>,
+    /// Material index by slot; empty in a scene of one material (all 0).
+    material: Vec<u32>,
     load: Vec<Load<T>>,
     built_at: Vec<Vec3<T>>,
     /// Periods each grain has been wrapped by (empty without periodic axes).
@@ -160,7 +162,6 @@ impl<T: Real> CpuEngine<T> {
                 radius: T::of(g.radius[i]),
                 mass: T::of(g.mass[i]),
                 inertia: T::of(0.4 * g.mass[i] * g.radius[i] * g.radius[i]),
-                material: g.material[i] as u32,
             })
             .collect();
         let r_max = g.radius.iter().copied().fold(0.0, f64::max);
@@ -204,6 +205,7 @@ impl<T: Real> CpuEngine<T> {
             body,
             residual,
             prop,
+            material: if n_materials > 1 { g.material.iter().map(|&m| m as u32).collect() } else { Vec::new() },
             load: vec![Load::default(); n],
             orientation: scene.track_orientation.then(|| vec![[T::ONE, T::ZERO, T::ZERO, T::ZERO]; n]),
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
@@ -294,6 +296,7 @@ impl<T: Real> CpuEngine<T> {
         r.apply(&mut self.body);
         r.apply(&mut self.residual);
         r.apply(&mut self.prop);
+        r.apply(&mut self.material);
         r.apply(&mut self.load);
         r.apply(&mut self.built_at);
         r.apply(&mut self.image);
@@ -449,6 +452,7 @@ impl<T: Real> CpuEngine<T> {
             elapsed,
             periodic: self.periodic,
             residual: &self.residual,
+            material: &self.material,
         };
         let (pairs, body, prop, gravity) = (&self.pairs, &self.body, &self.prop, self.gravity);
         let blocks = owner_blocks(pairs, self.slots.stride, &mut self.load, &mut self.share, &mut self.report, &mut self.force_i, &mut self.hist);
@@ -610,6 +614,11 @@ impl<T: Real> CpuEngine<T> {
         self.step += 1;
         self.time += self.dt.f64();
         Ok(())
+    }
+
+    /// Material index of slot `i`.
+    fn material_of(&self, i: usize) -> usize {
+        self.material.get(i).map_or(0, |&m| m as usize)
     }
 
     /// The force pair `k` exerted on its owner at the last evaluation (N).
@@ -987,7 +996,7 @@ impl<T: Real> Engine for CpuEngine<T> {
 
     fn memory_bytes(&self) -> u64 {
         let l = &self.pairs;
-        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
+        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.material) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
         let walls = allocated(&self.wall_hist) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
         let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
         grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)

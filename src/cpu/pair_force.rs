@@ -34,9 +34,23 @@ pub struct ForceContext<'a, T> {
     pub periodic: Periodic<T>,
     /// The positions' residuals by slot ([`crate::position`]; empty in f64).
     pub residual: &'a [Vec3<T>],
+    /// Material index by slot; empty in a scene of one material, whose grains are all 0.
+    pub material: &'a [u32],
 }
 
 impl<T: Real> ForceContext<'_, T> {
+    /// Material index of slot `i`.
+    #[inline(always)]
+    pub fn material(&self, i: usize) -> usize {
+        self.material.get(i).map_or(0, |&m| m as usize)
+    }
+
+    /// The coefficients of slots `i` and `j`'s materials.
+    #[inline(always)]
+    pub fn pair_coeffs(&self, i: usize, j: usize) -> &PairCoeffs<T> {
+        &self.coeffs[self.material(i) * self.n_materials + self.material(j)]
+    }
+
     /// The separation `r_i - r_j` of slots `i` and `j` (m, minimum image, residuals included).
     #[inline(always)]
     pub fn separation(&self, body: &[Body<T>], i: usize, j: usize) -> Vec3<T> {
@@ -69,7 +83,7 @@ pub fn pair_force<T: Real>(i: usize, k: usize, pairs: &PairList, body: &[Body<T>
     let geo = Geometry::grain_grain(d, dist2.sqrt(), pi.radius, pj.radius, pi.mass, pj.mass);
     let kin = Kinematics { v_i: bi.vel, v_j: bj.vel, w_i: bi.omega, w_j: bj.omega };
     let bodies = Bodies { m_i: pi.mass, inertia_i: pi.inertia, m_j: pj.mass, inertia_j: pj.inertia, j_is_wall: false };
-    let c = &ctx.coeffs[pi.material as usize * ctx.n_materials + pj.material as usize];
+    let c = ctx.pair_coeffs(i, j);
     let mut h = ctx.slots.load(hist);
     let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
     ctx.slots.store(&h, hist);

@@ -41,7 +41,7 @@ impl<T: Real> CpuEngine<T> {
                     .collect()
             }),
             wall_contacts: contacts.then(|| {
-                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic, residual: &self.residual };
+                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic, residual: &self.residual, material: &self.material };
                 wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_hist)
             }),
             walls: self.walls.iter().map(|w| w.geom.f64()).collect(),
@@ -110,7 +110,9 @@ impl<T: Real> CpuEngine<T> {
             }
         }
         // The grains' constant properties follow the checkpoint's numbering.
-        Renumbering::new(id.iter().map(|&i| self.slot[i as usize]).collect()).apply(&mut self.prop);
+        let r = Renumbering::new(id.iter().map(|&i| self.slot[i as usize]).collect());
+        r.apply(&mut self.prop);
+        r.apply(&mut self.material);
         self.id = id;
         for (slot, &i) in self.id.iter().enumerate() {
             self.slot[i as usize] = slot as u32;

@@ -25,8 +25,6 @@ pub struct Props<T> {
     pub mass: T,
     /// Moment of inertia `2/5 m R^2` (kg m^2).
     pub inertia: T,
-    /// Material index.
-    pub material: u32,
 }
 
 /// Force and torque on a grain (N, N m).

@@ -37,15 +37,16 @@ pub struct WallTouch<T> {
     pub regime: Regime,
 }
 
-/// `wall_contacts` for the grain of permanent id `id`. `hist` holds the grain's history
-/// blocks, one per wall; each touching wall's contact is appended to `touches`. Returns the
-/// load on the grain.
+/// `wall_contacts` for the grain of permanent id `id` and material `material`. `hist` holds
+/// the grain's history blocks, one per wall; each touching wall's contact is appended to
+/// `touches`. Returns the load on the grain.
 #[inline(always)]
 pub fn wall_contacts<T: Real>(
     id: u32,
     b: &Body<T>,
     residual: Vec3<T>,
     p: &Props<T>,
+    material: usize,
     walls: &[WallState<T>],
     ctx: &ForceContext<T>,
     hist: &mut [T],
@@ -63,7 +64,7 @@ pub fn wall_contacts<T: Real>(
         let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
         let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
         let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
-        let c = &ctx.coeffs[wall.material as usize * ctx.n_materials + p.material as usize];
+        let c = &ctx.coeffs[wall.material as usize * ctx.n_materials + material];
         let mut h = ctx.slots.load(h_slot);
         let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
         ctx.slots.store(&h, h_slot);
@@ -111,7 +112,7 @@ fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut 
             }
             continue;
         }
-        let w = wall_contacts(id[m], &body[m], crate::position::residual_at(ctx.residual, first + m), &prop[m], walls, ctx, hist, touches);
+        let w = wall_contacts(id[m], &body[m], crate::position::residual_at(ctx.residual, first + m), &prop[m], ctx.material(first + m), walls, ctx, hist, touches);
         l.force += w.force;
         l.torque += w.torque;
     }
@@ -134,7 +135,7 @@ pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[
             let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
             let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
             let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
-            let c = &ctx.coeffs[wall.material as usize * ctx.n_materials + p.material as usize];
+            let c = &ctx.coeffs[wall.material as usize * ctx.n_materials + ctx.material(i)];
             let mut h = ctx.slots.load(&slot);
             let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
             ctx.slots.store(&h, &mut slot);
