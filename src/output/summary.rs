@@ -3,6 +3,7 @@
 use crate::analysis::fit::{e0_profile, fit_bauer, profile_e0s, BauerFit, E0Profile};
 use crate::analysis::packing_fraction;
 use crate::engine::Engine;
+use crate::model::{CohesionLaw, TangentialLaw};
 use crate::protocol::{CompressionPoint, StageResult};
 use crate::scene::Scene;
 use serde::Serialize;
@@ -208,18 +209,29 @@ fn fit_compression(points: &[CompressionPoint], e0: Option<f64>) -> Result<Optio
     fit_bauer(&compression_data(points), e0, 1.0).map(Some).map_err(|e| e.to_string())
 }
 
-/// Pairs per grain assumed by the memory estimate (a dense packing with a 10% skin).
+/// Pairs per grain assumed by the memory estimate: on the safe side of a dense packing with a
+/// 10% skin (the peers' bed lists 3.74 at 4.65 contacts per grain).
 pub const ESTIMATE_PAIRS_PER_GRAIN: f64 = 6.0;
 
-/// Bytes the CPU engine holds per grain and per pair, for reals of `real` bytes.
-fn engine_bytes(scene: &Scene, real: usize) -> f64 {
-    let stride = scene.model.cast::<f64>().history_layout().reals();
-    let walls = scene.walls.len();
-    // body 9, props 3 + u32, load 6, wall load 6, built_at 3 reals; id, cell, sorted index.
-    let per_grain = (27 * real + 4 + 12 + walls * stride * real + if scene.track_orientation { 4 * real } else { 0 }) as f64;
-    // owner, partner, reverse index; force record (4 vectors + normal force + flag); history.
-    let per_pair = (12 + 13 * real + 8 + stride * real) as f64;
-    scene.grains.len() as f64 * (per_grain + ESTIMATE_PAIRS_PER_GRAIN * per_pair)
+/// Bytes the CPU engine holds for `scene` in reals of `real` bytes (4: f32, whose positions
+/// carry a residual; 8: f64) with `pairs_per_grain` listed pairs per grain: the arrays
+/// `CpuEngine::memory_bytes` counts, but the cell starts and the wall contacts of a step (a
+/// few bytes a grain).
+pub(crate) fn engine_bytes(scene: &Scene, real: usize, pairs_per_grain: f64) -> f64 {
+    let model = scene.model.cast::<f64>();
+    let stride = model.history_layout().reals();
+    let capillary = matches!(model.cohesion, CohesionLaw::Capillary { .. });
+    let owner_force = matches!(model.tangential, TangentialLaw::Oquendo(_));
+    let some = |yes: bool, bytes: usize| if yes { bytes } else { 0 };
+    // Reals: body 9, properties 3, load 6, position at the last build 3, the position's
+    // residual 3 (f32), the walls' springs, the orientation 4, the liquid 1. Then the id, the
+    // slot, the pair and reverse list starts, the cell list (u32 each), the material index
+    // where there are several, the periodic image counts.
+    let per_grain = (21 + some(real == 4, 3) + scene.walls.len() * stride + some(scene.track_orientation, 4) + some(capillary, 1)) * real + 5 * 4 + some(scene.materials.len() > 1, 4) + some(scene.periodic.iter().any(Option::is_some), 12);
+    // The partner and the reverse index (u32), the history, the partner's share 6 and the
+    // normal force 1 reals, the capillary force, the owner's force (seed 000's law), the flags.
+    let per_pair = 8 + (stride + 7 + some(capillary, 1) + some(owner_force, 3)) * real + 1;
+    scene.grains.len() as f64 * (per_grain as f64 + pairs_per_grain * per_pair as f64)
 }
 
 /// The `grains check` report.
@@ -274,9 +286,43 @@ pub fn check_report(scene: &Scene) -> String {
         let _ = writeln!(s, "stage {}: {:?} for at most {:e} s ({} steps)", st.name, st.kind, st.duration, st.max_steps(ts.dt));
     }
     let mib = |b: f64| b / (1024.0 * 1024.0);
-    let _ = writeln!(s, "memory estimate (cpu, {ESTIMATE_PAIRS_PER_GRAIN} pairs/grain): {:.1} MiB in f64, {:.1} MiB in f32", mib(engine_bytes(scene, 8)), mib(engine_bytes(scene, 4)));
+    let _ = writeln!(s, "memory estimate (cpu, {ESTIMATE_PAIRS_PER_GRAIN} pairs/grain): {:.1} MiB in f64, {:.1} MiB in f32", mib(engine_bytes(scene, 8, ESTIMATE_PAIRS_PER_GRAIN)), mib(engine_bytes(scene, 4, ESTIMATE_PAIRS_PER_GRAIN)));
     for w in &scene.warnings {
         let _ = writeln!(s, "warning: {w}");
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cpu::CpuEngine;
+    use crate::real::Real;
+
+    /// The estimate within this of the bytes the engine holds (what it leaves out: the cell
+    /// starts and the step's wall contacts, a few bytes of several hundred a grain).
+    const ESTIMATE_TOLERANCE: f64 = 0.02;
+
+    /// `grains check`'s memory estimate, given the pairs per grain the engine listed, against
+    /// the bytes the engine holds, in f64 and f32, for the peers' bed (periodic, a floor, one
+    /// material) and a wet box (six servo walls, two materials, bridges).
+    #[test]
+    fn the_memory_estimate_follows_the_engine() {
+        fn check<T: Real>(name: &str, real: usize) {
+            let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name);
+            let mut scene = crate::scene::load(&path).unwrap();
+            // Grown 10% where they were placed: a dense gas, pairs listed near packing's count.
+            scene.grains.radius.iter_mut().for_each(|r| *r *= 1.1);
+            let mut e = CpuEngine::<T>::new(&scene).unwrap();
+            e.advance(1).unwrap();
+            let pairs = e.stats().unwrap().pairs as f64 / scene.grains.len() as f64;
+            let (held, estimate) = (e.memory_bytes() as f64, engine_bytes(&scene, real, pairs));
+            println!("{name} {}: {pairs:.2} pairs/grain, {:.0} B/grain held, {:.0} estimated", T::NAME, held / scene.grains.len() as f64, estimate / scene.grains.len() as f64);
+            assert!((estimate / held - 1.0).abs() < ESTIMATE_TOLERANCE, "{name} {}: estimate {estimate} B against {held} B held", T::NAME);
+        }
+        for name in ["bench_bed.toml", "wet_iso_100pa.toml"] {
+            check::<f64>(name, 8);
+            check::<f32>(name, 4);
+        }
+    }
 }
