@@ -28,7 +28,7 @@ mod traffic;
 mod wall_contacts;
 
 pub use integrate::rotate;
-pub use pairs::PairList;
+pub use pairs::{owned_pairs, PairList};
 #[cfg(feature = "mpi")]
 pub(crate) use parts::{state_of_rows, touch_of_row, touches_state, RowWidths, Rows, BRIDGE_ROW, TOUCH_ROW};
 #[cfg(feature = "mpi")]
@@ -614,11 +614,6 @@ impl<T: Real> CpuEngine<T> {
         self.step += 1;
         self.time += self.dt.f64();
         Ok(())
-    }
-
-    /// Material index of slot `i`.
-    fn material_of(&self, i: usize) -> usize {
-        self.material.get(i).map_or(0, |&m| m as usize)
     }
 
     /// The force pair `k` exerted on its owner at the last evaluation (N).

@@ -42,7 +42,7 @@ impl<T: Real> ForceContext<'_, T> {
     /// Material index of slot `i`.
     #[inline(always)]
     pub fn material(&self, i: usize) -> usize {
-        self.material.get(i).map_or(0, |&m| m as usize)
+        super::state::material_at(self.material, i)
     }
 
     /// The coefficients of slots `i` and `j`'s materials.

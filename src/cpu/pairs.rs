@@ -139,6 +139,12 @@ impl PairList {
     }
 }
 
+/// `(owner, pair)` for every pair of a list whose owners' pairs start at `starts` (the
+/// `owner_start` a saved state holds), in pair order.
+pub fn owned_pairs(starts: &[u64]) -> impl Iterator<Item = (usize, usize)> + '_ {
+    starts.windows(2).enumerate().flat_map(|(i, w)| (w[0] as usize..w[1] as usize).map(move |k| (i, k)))
+}
+
 /// `remap_history` for new pair `k`, owned by `i`: copies the history block of the same pair
 /// (owner and partner's permanent id, as DEM-Engine's persistent map matches them) from the
 /// old list, or zeroes it for a pair that is new.

@@ -99,7 +99,7 @@ impl Rows {
             }
         }
         let (starts, partner) = (&s.ints["owner_start"], &s.ints["partner"]);
-        for (slot, k) in starts.windows(2).enumerate().flat_map(|(s, w)| (w[0]..w[1]).map(move |k| (s, k as usize))) {
+        for (slot, k) in super::pairs::owned_pairs(starts) {
             let (a, b) = (id[slot] as u32, id[partner[k] as usize] as u32);
             if keep_pair(a, b) {
                 rows.pairs.extend([a as f64, b as f64]);

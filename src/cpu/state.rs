@@ -27,6 +27,13 @@ pub struct Props<T> {
     pub inertia: T,
 }
 
+/// Material index of slot `i` in `material`, the engine's indices by slot (empty in a scene
+/// of one material, whose grains are all 0).
+#[inline(always)]
+pub fn material_at(material: &[u32], i: usize) -> usize {
+    material.get(i).map_or(0, |&m| m as usize)
+}
+
 /// Force and torque on a grain (N, N m).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Load<T> {

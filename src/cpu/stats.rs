@@ -85,7 +85,7 @@ impl<T: Real> CpuEngine<T> {
                     let h = p.radius - dist;
                     if h > T::ZERO {
                         contacts += 1;
-                        let c = &self.coeffs[wall.material as usize * self.n_materials + self.material_of(i)];
+                        let c = &self.coeffs[wall.material as usize * self.n_materials + state::material_at(&self.material, i)];
                         s.wall_contacts += 1;
                         s.wall_elastic += normal_potential(&self.model.normal, c, p.radius, h).f64();
                         s.max_wall_overlap = max_by_first(s.max_wall_overlap, ((h / p.radius).f64(), self.id[i]));
@@ -112,7 +112,7 @@ impl<T: Real> CpuEngine<T> {
                     continue;
                 }
                 let (pi, pj) = (&self.prop[i], &self.prop[j]);
-                let c = &self.coeffs[self.material_of(i) * self.n_materials + self.material_of(j)];
+                let c = &self.coeffs[state::material_at(&self.material, i) * self.n_materials + state::material_at(&self.material, j)];
                 let r_eff = pi.radius * pj.radius / (pi.radius + pj.radius);
                 s.contacts += 1;
                 s.clamped += self.report.clamped(k) as u64;

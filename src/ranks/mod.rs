@@ -182,7 +182,7 @@ impl<T: Real> Net<T> {
         let mut held: Vec<Vec<usize>> = owner.iter().map(|&o| vec![o]).collect();
         let ids = &state.ints["id"];
         let (starts, p) = (&state.ints["owner_start"], &state.ints["partner"]);
-        for (slot, k) in starts.windows(2).enumerate().flat_map(|(s, w)| (w[0]..w[1]).map(move |k| (s, k as usize))) {
+        for (slot, k) in crate::cpu::owned_pairs(starts) {
             let (a, b) = (ids[slot] as usize, ids[p[k] as usize] as usize);
             if owner[a] != owner[b] {
                 held[a].push(owner[b]);
