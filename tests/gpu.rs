@@ -310,15 +310,32 @@ fn servo_walls_on_the_gpu_follow_the_cpu_twin() {
 /// positions are compared with the f32 tolerance.)
 #[test]
 fn liquid_bridges_on_the_gpu_form_and_break_as_on_the_cpu() {
+    bridges_follow_the_cpu(&common::wet_gas());
+}
+
+/// The same with rolling springs too, so that each pair holds three history blocks (tangential,
+/// rolling, bridge) and every one of them, the bridge's last, must survive the rebuilds (the
+/// replaced list's blocks sit in three different record buffers meanwhile).
+#[test]
+fn three_history_blocks_survive_rebuilds_on_the_gpu() {
+    let mut scene = common::wet_gas();
+    scene.model.rolling = grains::model::RollingLaw::Sds { k_r: 50.0, gamma_r: 0.0, mu_r: 0.05 };
+    assert_eq!(scene.model.history_layout(), grains::model::HistoryLayout { tangential: true, sliding: false, rolling: true, bridge: true });
+    bridges_follow_the_cpu(&scene);
+}
+
+/// Runs a wet gas on the GPU and the CPU f32 twin for 2000 steps and checks the bridges, the
+/// liquid and the positions at every statistics read (see
+/// `liquid_bridges_on_the_gpu_form_and_break_as_on_the_cpu`).
+fn bridges_follow_the_cpu(scene: &grains::scene::Scene) {
     /// Liquid conserved in f32: a bridge's volume and a grain's halves round (6e-8) at each
     /// transfer, and transfers are few.
     const LIQUID_F32_ROUNDOFF: f64 = 1e-7;
     /// Positions after 2000 steps of a colliding gas whose capillary forces differ by ulps
     /// (each backend's own pow and exp): collisions amplify the difference.
     const CAPILLARY_POSITION_TOLERANCE: f64 = 1e-4;
-    let scene = common::wet_gas();
-    let Some(mut g) = common::gpu_engine(&scene) else { return };
-    let mut c: CpuEngine<f32> = common::engine(&scene);
+    let Some(mut g) = common::gpu_engine(scene) else { return };
+    let mut c: CpuEngine<f32> = common::engine(scene);
     let total = scene.stages[0].wet_volume.unwrap();
     g.wet(total).unwrap();
     c.wet(total).unwrap();

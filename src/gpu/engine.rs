@@ -34,12 +34,19 @@ pub const STEPS_PER_SUBMIT: u64 = 16;
 
 /// Buffers a checkpoint leaves out: the scene's constants (set up again from the scene) and
 /// scratch space every step or statistics read rewrites before reading it.
-const NOT_STATE: [&str; 20] = [
+const NOT_STATE: [&str; 18] = [
     "params", "phase", "material", "coeffs", // constants
     "cell_of", "cell_grains", "cell_count", "cell_fill", "hash_sums", "grain_sums", "spare_sum", // the hash grid
-    "old_start", "old_j", "old_hist", "rev_fill", "bridge_event", // rebuild and bridge scratch
+    "old_start", "rev_fill", "bridge_event", // rebuild and bridge scratch
     "wall_partials", "grain_rows", "pair_rows", "stats", // reductions
 ];
+
+/// Rebuild scratch kept in the pair force records, as (binding, buffer): the replaced list's
+/// partners and history blocks (`save_pairs`, `remap_history`). The records are dead from a
+/// rebuild until the force evaluation that follows it rewrites them (every plan evaluates
+/// forces after a rebuild, and reads records only after that), so the replaced list needs no
+/// buffers of its own: 20 bytes per pair of capacity on a dry bed, 36 with rolling springs.
+const SCRATCH_IN_RECORDS: [(&str, &str); 4] = [("old_j", "out_tj"), ("old_hist0", "out_fi"), ("old_hist1", "out_fj"), ("old_hist2", "out_ti")];
 
 /// Why the GPU engine refused a scene.
 #[derive(Debug, thiserror::Error)]
@@ -353,16 +360,14 @@ impl GpuEngine {
     }
 
     /// The per-pair buffers and their bytes per pair.
-    fn pair_buffers(&self) -> [(&'static str, u64); 11] {
+    fn pair_buffers(&self) -> [(&'static str, u64); 9] {
         let blocks = self.params.hist_blocks as u64;
         [
             ("bridge_event", if self.history.bridge { 4 } else { 0 }),
             ("pair_i", 4),
             ("pair_j", 4),
-            ("old_j", 4),
             ("rev_pair", 4),
             ("hist", 16 * blocks),
-            ("old_hist", 16 * blocks),
             ("out_fi", 16),
             ("out_fj", 16),
             ("out_ti", 16),
@@ -436,7 +441,7 @@ impl GpuEngine {
             };
             for (key, aliases) in instances {
                 let buffer = |name: &str| {
-                    let buffer_name = aliases.iter().find(|(a, _)| *a == name).map_or(name, |(_, b)| *b);
+                    let buffer_name = aliases.iter().chain(&SCRATCH_IN_RECORDS).find(|(a, _)| *a == name).map_or(name, |(_, b)| *b);
                     self.buffers.get(buffer_name).unwrap_or_else(|| panic!("kernel {} binds {buffer_name}, which the engine lacks", k.name))
                 };
                 let bg = super::pipeline::bind_group(&self.gpu.device, &key, k, &self.layouts[k.name], buffer, std::mem::size_of::<Phase>() as u64);
