@@ -38,7 +38,7 @@ pub struct ForceContext<'a, T> {
     pub material: &'a [u32],
 }
 
-impl<T: Real> ForceContext<'_, T> {
+impl<'a, T: Real> ForceContext<'a, T> {
     /// Material index of slot `i`.
     #[inline(always)]
     pub fn material(&self, i: usize) -> usize {
@@ -47,8 +47,14 @@ impl<T: Real> ForceContext<'_, T> {
 
     /// The coefficients of slots `i` and `j`'s materials.
     #[inline(always)]
-    pub fn pair_coeffs(&self, i: usize, j: usize) -> &PairCoeffs<T> {
-        &self.coeffs[self.material(i) * self.n_materials + self.material(j)]
+    pub fn pair_coeffs(&self, i: usize, j: usize) -> &'a PairCoeffs<T> {
+        coeffs_of(self.coeffs, self.n_materials, self.material(i), self.material(j))
+    }
+
+    /// The coefficients of a wall of material `wall` against a grain of material `grain`.
+    #[inline(always)]
+    pub fn wall_coeffs(&self, wall: u32, grain: usize) -> &'a PairCoeffs<T> {
+        coeffs_of(self.coeffs, self.n_materials, wall as usize, grain)
     }
 
     /// The separation `r_i - r_j` of slots `i` and `j` (m, minimum image, residuals included).
@@ -56,6 +62,13 @@ impl<T: Real> ForceContext<'_, T> {
     pub fn separation(&self, body: &[Body<T>], i: usize, j: usize) -> Vec3<T> {
         crate::position::separation_of(&self.periodic, |k| body[k].pos, self.residual, i, j)
     }
+}
+
+/// The coefficients of materials `a` and `b` in a table of `n_materials` squared
+/// (`[a * n_materials + b]`).
+#[inline(always)]
+pub fn coeffs_of<T>(coeffs: &[PairCoeffs<T>], n_materials: usize, a: usize, b: usize) -> &PairCoeffs<T> {
+    &coeffs[a * n_materials + b]
 }
 
 /// `pair_force` for pair `k`, owned by grain `i`. A listed pair that does not touch forgets

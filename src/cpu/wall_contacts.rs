@@ -4,7 +4,7 @@
 use super::pair_force::ForceContext;
 use super::reduce::CHUNK;
 use super::state::{Body, Load, Props};
-use crate::model::{contact_force, normal_damping, normal_stiffness, Bodies, Geometry, Kinematics, Regime};
+use crate::model::{contact_force, normal_damping, normal_stiffness, Bodies, ContactForce, Geometry, Kinematics, PairCoeffs, Regime};
 use crate::engine::WallContactRecord;
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
@@ -61,13 +61,7 @@ pub fn wall_contacts<T: Real>(
             ctx.slots.clear_springs(h_slot);
             continue;
         }
-        let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
-        let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
-        let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
-        let c = &ctx.coeffs[wall.material as usize * ctx.n_materials + material];
-        let mut h = ctx.slots.load(h_slot);
-        let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
-        ctx.slots.store(&h, h_slot);
+        let (geo, c, f) = wall_contact(n, dist, b, p, material, wall, ctx, h_slot);
         load.force += f.f_i;
         load.torque += f.t_i;
         touches.push(WallTouch {
@@ -80,6 +74,22 @@ pub fn wall_contacts<T: Real>(
         });
     }
     load
+}
+
+/// The contact of a grain of material `material` with a wall it touches, seen from the wall's
+/// frame (`n`, `dist`: [`WallGeom::frame`]): its geometry, coefficients and force; the history
+/// in `h_slot` advances by `ctx.elapsed`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, material: usize, wall: &WallState<T>, ctx: &ForceContext<'c, T>, h_slot: &mut [T]) -> (Geometry<T>, &'c PairCoeffs<T>, ContactForce<T>) {
+    let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
+    let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
+    let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
+    let c = ctx.wall_coeffs(wall.material, material);
+    let mut h = ctx.slots.load(h_slot);
+    let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
+    ctx.slots.store(&h, h_slot);
+    (geo, c, f)
 }
 
 super::simd::dispatch! {
@@ -131,14 +141,7 @@ pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[
                 continue;
             }
             let at = (i * walls.len() + w) * stride;
-            let mut slot = hist[at..at + stride].to_vec();
-            let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
-            let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
-            let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
-            let c = &ctx.coeffs[wall.material as usize * ctx.n_materials + ctx.material(i)];
-            let mut h = ctx.slots.load(&slot);
-            let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
-            ctx.slots.store(&h, &mut slot);
+            let (geo, _, f) = wall_contact(n, dist, b, p, ctx.material(i), wall, ctx, &mut hist[at..at + stride].to_vec());
             out.push(WallContactRecord { grain: id[i], wall: w as u32, overlap: geo.h.f64(), normal: n.f64(), lever: geo.rp_i.f64(), force: f.f_i.f64() });
         }
     }
