@@ -53,6 +53,18 @@ impl<T: Real> WallGeom<T> {
         }
     }
 
+    /// How far the surface has moved since it was `before` (m): no point's distance to it has
+    /// changed by more. Infinite where the two cannot be compared (another kind, a turned
+    /// plane).
+    pub fn moved_since(&self, before: &WallGeom<T>) -> T {
+        match (*self, *before) {
+            (WallGeom::Plane { point, normal }, WallGeom::Plane { point: p0, normal: n0 }) if normal == n0 => (point - p0).dot(normal).abs(),
+            (WallGeom::Cylinder { cx, cy, radius }, WallGeom::Cylinder { cx: x0, cy: y0, radius: r0 }) => ((cx - x0) * (cx - x0) + (cy - y0) * (cy - y0)).sqrt() + (radius - r0).abs(),
+            (WallGeom::Piston { z }, WallGeom::Piston { z: z0 }) => (z - z0).abs(),
+            _ => T::of(f64::INFINITY),
+        }
+    }
+
     /// Unit normal from the wall to a point `p + r` (m; `r` the residual of a compensated
     /// position, [`crate::position`]), and the signed distance (m) from the surface to it,
     /// positive on the grains' side.

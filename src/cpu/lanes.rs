@@ -463,7 +463,7 @@ duration = 1.0e-3
         let asymmetric = one.iter().filter(|f| f.f_i != -f.f_j).count();
         // The floor's loads, from the same history.
         let per_grain = e.walls.len() * stride;
-        let mut wall_hist = e.wall_hist.clone();
+        let mut wall_hist = e.wall_springs.dense(e.body.len(), per_grain);
         let mut touches = Vec::new();
         let wall: Vec<Load<T>> = (0..e.body.len()).map(|i| wall_contacts(e.id[i], &e.body[i], crate::position::residual_at(&e.residual, i), &e.prop[i], ctx.material(i), &e.walls, &ctx, &mut wall_hist[i * per_grain..(i + 1) * per_grain], &mut touches)).collect();
         assert!(!touches.is_empty(), "grains must touch the floor");

@@ -26,6 +26,7 @@ mod state;
 mod stats;
 mod traffic;
 mod wall_contacts;
+mod wall_springs;
 
 pub use integrate::rotate;
 pub use pairs::{owned_pairs, PairList};
@@ -56,6 +57,7 @@ use reorder::Renumbering;
 use rayon::prelude::*;
 use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS, PAR_MIN_PAIRS};
 use wall_contacts::{wall_block, WallTouch};
+use wall_springs::WallSprings;
 
 /// The CPU engine in precision `T`.
 pub struct CpuEngine<T: Real> {
@@ -105,7 +107,8 @@ pub struct CpuEngine<T: Real> {
     wall_names: Vec<String>,
     piston: Option<Piston<T>>,
     servo: Option<Servo<T>>,
-    wall_hist: Vec<T>,
+    /// The grain-wall contacts' history, for the grains a wall can reach.
+    wall_springs: WallSprings<T>,
     /// The grain-wall contacts of the last force evaluation, by grain id, then wall (their
     /// loads went straight into the grains' loads).
     wall_touches: Vec<WallTouch<T>>,
@@ -212,7 +215,7 @@ impl<T: Real> CpuEngine<T> {
             walls,
             piston,
             servo: scene.servo.map(|s| Servo { walls: s.walls, pressure: T::of(s.pressure), gain: T::of(s.gain), max_speed: T::of(s.max_speed), strain_rate: None }),
-            wall_hist: vec![T::ZERO; n * n_walls * slots.stride],
+            wall_springs: WallSprings::default(),
             wall_touches: Vec::new(),
             wall_reaction: vec![Vec3::ZERO; n_walls],
             wall_count: vec![0; n_walls],
@@ -278,6 +281,7 @@ impl<T: Real> CpuEngine<T> {
         for (b, at) in self.body.iter().zip(self.built_at.iter_mut()) {
             *at = b.pos;
         }
+        self.choose_wall_springs();
         self.rebuilds += 1;
         self.max_moved2 = T::ZERO;
         self.forces_valid = false;
@@ -301,7 +305,7 @@ impl<T: Real> CpuEngine<T> {
         r.apply(&mut self.built_at);
         r.apply(&mut self.image);
         r.apply(&mut self.liquid);
-        r.apply_blocks(&mut self.wall_hist, self.walls.len() * self.slots.stride);
+        r.apply(&mut self.wall_springs.entry);
         if let Some(q) = &mut self.orientation {
             r.apply(q);
         }
@@ -313,6 +317,13 @@ impl<T: Real> CpuEngine<T> {
             *s = r.to[*s as usize];
         }
         self.renumberings += 1;
+    }
+
+    /// Chooses the grains whose wall springs are kept ([`WallSprings::choose`]), from the
+    /// positions of the last rebuild and the walls now.
+    fn choose_wall_springs(&mut self) {
+        let per_grain = self.walls.len() * self.slots.stride;
+        self.wall_springs = WallSprings::choose(&self.built_at, &self.prop, &self.walls, self.skin, per_grain, &self.wall_springs);
     }
 
     /// Renumberings so far that moved a grain.
@@ -443,6 +454,9 @@ impl<T: Real> CpuEngine<T> {
     /// With `kick` (s), the grains are then kicked in the gather's sweep, each as soon as its
     /// load is whole (the piston's kick is left to the caller).
     fn evaluate_forces(&mut self, elapsed: T, kick: Option<T>) {
+        if self.wall_springs.stale(&self.walls, self.skin) {
+            self.choose_wall_springs();
+        }
         let t = self.clock.start();
         let ctx = ForceContext {
             model: &self.model,
@@ -460,7 +474,7 @@ impl<T: Real> CpuEngine<T> {
         blocks.into_par_iter().with_min_len(min_blocks.max(1)).for_each_init(TaskScratch::default, |scratch, b| owner_block(b, scratch, pairs, body, prop, &ctx, gravity));
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
-        let (sums, touches) = complete_loads(&ctx, pairs, &self.share, &self.id, &mut self.body, prop, &self.walls, &mut self.load, &mut self.wall_hist, kick);
+        let (sums, touches) = complete_loads(&ctx, pairs, &self.share, &self.id, &mut self.body, prop, &self.walls, &mut self.load, &mut self.wall_springs, kick);
         self.wall_touches = touches;
         self.wall_reaction = sums.reaction;
         self.wall_count = sums.count;
@@ -824,16 +838,17 @@ fn complete_loads<T: Real>(
     prop: &[Props<T>],
     walls: &[WallState<T>],
     load: &mut [Load<T>],
-    wall_hist: &mut [T],
+    wall_springs: &mut WallSprings<T>,
     kick: Option<T>,
 ) -> (WallSums<T>, Vec<WallTouch<T>>) {
     let per_grain = walls.len() * ctx.slots.stride;
-    let run = |c: usize, loads: &mut [Load<T>], bodies: &mut [Body<T>], hist: &mut [T]| {
+    let (entry, chunk_start) = (&wall_springs.entry, &wall_springs.chunk_start);
+    let run = |c: usize, loads: &mut [Load<T>], bodies: &mut [Body<T>], springs: &mut [T]| {
         let grains = c * CHUNK..c * CHUNK + loads.len();
         gather_block(c * CHUNK, loads, pairs, share);
         let mut touches = Vec::new();
         if !walls.is_empty() {
-            wall_block(c * CHUNK, loads, hist, &id[grains.clone()], bodies, &prop[grains.clone()], walls, ctx, &mut touches);
+            wall_block(c * CHUNK, loads, &entry[grains.clone()], chunk_start[c], springs, &id[grains.clone()], bodies, &prop[grains.clone()], walls, ctx, &mut touches);
         }
         if let Some(tau) = kick {
             for ((b, l), p) in bodies.iter_mut().zip(loads.iter()).zip(&prop[grains]) {
@@ -846,7 +861,10 @@ fn complete_loads<T: Real>(
     let parts: Vec<Vec<WallTouch<T>>> = if per_grain == 0 {
         grains.with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, (loads, bodies))| run(c, loads, bodies, &mut [])).collect()
     } else {
-        grains.zip(wall_hist.par_chunks_mut(CHUNK * per_grain)).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, ((loads, bodies), hist))| run(c, loads, bodies, hist)).collect()
+        // Each chunk's run of entries.
+        let mut rest = &mut wall_springs.springs[..];
+        let springs: Vec<&mut [T]> = chunk_start.windows(2).map(|w| take_front(&mut rest, (w[1] - w[0]) as usize * per_grain)).collect();
+        grains.zip(springs).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, ((loads, bodies), springs))| run(c, loads, bodies, springs)).collect()
     };
     let mut touches = parts.concat();
     touches.sort_unstable_by_key(|t| (t.grain, t.wall));
@@ -992,7 +1010,8 @@ impl<T: Real> Engine for CpuEngine<T> {
     fn memory_bytes(&self) -> u64 {
         let l = &self.pairs;
         let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.material) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
-        let walls = allocated(&self.wall_hist) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
+        let ws = &self.wall_springs;
+        let walls = allocated(&ws.entry) + allocated(&ws.chunk_start) + allocated(&ws.springs) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
         let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
         grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)
     }

@@ -42,7 +42,7 @@ impl<T: Real> CpuEngine<T> {
             }),
             wall_contacts: contacts.then(|| {
                 let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic, residual: &self.residual, material: &self.material };
-                wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_hist)
+                wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_springs.dense(self.body.len(), self.walls.len() * self.slots.stride))
             }),
             walls: self.walls.iter().map(|w| w.geom.f64()).collect(),
         }
@@ -66,7 +66,8 @@ impl<T: Real> CpuEngine<T> {
         if let Some(q) = &self.orientation {
             s.put_reals("orientation", q.iter().flat_map(|q| q.map(T::f64)));
         }
-        s.put_reals("wall_hist", self.wall_hist.iter().map(|x| x.f64()));
+        // Dense, one block per grain and wall, as before the springs were kept for candidates only.
+        s.put_reals("wall_hist", self.wall_springs.dense(self.body.len(), self.walls.len() * self.slots.stride).iter().map(|x| x.f64()));
         s.put_reals("wall_reaction", self.wall_reaction.iter().flat_map(v3));
         s.put_ints("wall_count", self.wall_count.iter().copied());
         let piston = self.piston.map_or(Vec::new(), |p| {
@@ -147,7 +148,8 @@ impl<T: Real> CpuEngine<T> {
                 *q = [T::of(c[0]), T::of(c[1]), T::of(c[2]), T::of(c[3])];
             }
         }
-        self.wall_hist = s.reals("wall_hist", self.wall_hist.len())?.iter().map(|&x| T::of(x)).collect();
+        let per_grain = self.walls.len() * self.slots.stride;
+        let wall_hist: Vec<T> = s.reals("wall_hist", if self.walls.is_empty() { 0 } else { n * per_grain })?.iter().map(|&x| T::of(x)).collect();
         self.wall_reaction = s.reals("wall_reaction", 3 * self.walls.len())?.chunks_exact(3).map(v3).collect();
         self.wall_count = s.ints("wall_count", Some(self.walls.len()))?.to_vec();
         if let Some(p) = &mut self.piston {
@@ -167,6 +169,7 @@ impl<T: Real> CpuEngine<T> {
             sv.strain_rate = (!v[37].is_nan()).then(|| T::of(v[37]));
             self.servo = Some(sv);
         }
+        self.wall_springs = WallSprings::from_dense(&wall_hist, &self.built_at, &self.prop, &self.walls, self.skin, per_grain);
         let u32s = |name: &str, len: Option<usize>| -> anyhow::Result<Vec<u32>> { Ok(s.ints(name, len)?.iter().map(|&x| x as u32).collect()) };
         let partner = u32s("partner", None)?;
         let n_pairs = partner.len();

@@ -2,7 +2,7 @@
 //! the same laws as grain-grain contacts (the wall is a partner of infinite radius and mass).
 
 use super::pair_force::ForceContext;
-use super::reduce::CHUNK;
+use super::wall_springs::NO_ENTRY;
 use super::state::{Body, Load, Props};
 use crate::model::{contact_force, normal_damping, normal_stiffness, Bodies, ContactForce, Geometry, Kinematics, PairCoeffs, Regime};
 use crate::engine::WallContactRecord;
@@ -93,36 +93,25 @@ fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, mat
 }
 
 super::simd::dispatch! {
-    /// `wall_contacts` for slots `first..first + loads.len()` (at most [`CHUNK`]; `id`, `body`
-    /// and `prop` are theirs alone), each grain's wall load (zero without a contact) added to
-    /// its load; `hist` holds their history blocks (empty when the model keeps none); the
-    /// contacts are appended to `touches`.
-    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) => wall_block_portable
+    /// `wall_contacts` for the candidates among slots `first..first + loads.len()` (at most
+    /// [`CHUNK`](super::reduce::CHUNK); `entry`, `id`, `body` and `prop` are theirs alone): each one's wall load (zero
+    /// without a contact) is added to its load; `springs` holds their entries' history blocks,
+    /// from entry `base` on (empty when the model keeps none); the contacts are appended to
+    /// `touches`. A grain without an entry can touch no wall ([`super::wall_springs`]).
+    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], entry: &[u32], base: u32, springs: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) => wall_block_portable
 }
 
 /// [`wall_block`] for whatever instruction set the caller is compiled for.
 #[inline(always)]
-fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], hist: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) {
-    let (stride, per_grain) = (ctx.slots.stride, walls.len() * ctx.slots.stride);
-    // Which grains touch a wall, in a short loop of its own (most grains touch none; tested
-    // within the full contact, the test cost a bed 7% of its step, now 4%; a vectorised loop
-    // that gathered the positions was slower).
-    let mut near = [false; CHUNK];
-    let near = &mut near[..loads.len()];
-    for wall in walls {
-        for (m, near) in near.iter_mut().enumerate() {
-            *near |= !(wall.geom.frame(body[m].pos, crate::position::residual_at(ctx.residual, first + m)).1 >= prop[m].radius);
-        }
-    }
+#[allow(clippy::too_many_arguments)]
+fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], entry: &[u32], base: u32, springs: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) {
+    let per_grain = walls.len() * ctx.slots.stride;
     for (m, l) in loads.iter_mut().enumerate() {
-        let hist = &mut hist[m * per_grain..(m + 1) * per_grain];
-        if !near[m] {
-            for w in 0..walls.len() {
-                ctx.slots.clear_springs(&mut hist[w * stride..(w + 1) * stride]);
-            }
+        if entry[m] == NO_ENTRY {
             continue;
         }
-        let w = wall_contacts(id[m], &body[m], crate::position::residual_at(ctx.residual, first + m), &prop[m], ctx.material(first + m), walls, ctx, hist, touches);
+        let e = (entry[m] - base) as usize;
+        let w = wall_contacts(id[m], &body[m], crate::position::residual_at(ctx.residual, first + m), &prop[m], ctx.material(first + m), walls, ctx, &mut springs[e * per_grain..(e + 1) * per_grain], touches);
         l.force += w.force;
         l.torque += w.torque;
     }

@@ -5,7 +5,9 @@ use crate::analysis::packing_fraction;
 use crate::engine::Engine;
 use crate::model::{CohesionLaw, TangentialLaw};
 use crate::protocol::{CompressionPoint, StageResult};
+use crate::real::Vec3;
 use crate::scene::Scene;
+use crate::walls::WallGeom;
 use serde::Serialize;
 use std::fmt::Write;
 
@@ -224,14 +226,25 @@ pub(crate) fn engine_bytes(scene: &Scene, real: usize, pairs_per_grain: f64) -> 
     let owner_force = matches!(model.tangential, TangentialLaw::Oquendo(_));
     let some = |yes: bool, bytes: usize| if yes { bytes } else { 0 };
     // Reals: body 9, properties 3, load 6, position at the last build 3, the position's
-    // residual 3 (f32), the walls' springs, the orientation 4, the liquid 1. Then the id, the
-    // slot, the pair and reverse list starts, the cell list (u32 each), the material index
-    // where there are several, the periodic image counts.
-    let per_grain = (21 + some(real == 4, 3) + scene.walls.len() * stride + some(scene.track_orientation, 4) + some(capillary, 1)) * real + 5 * 4 + some(scene.materials.len() > 1, 4) + some(scene.periodic.iter().any(Option::is_some), 12);
+    // residual 3 (f32), the orientation 4, the liquid 1. Then the id, the slot, the pair and
+    // reverse list starts, the cell list (u32 each), the material index where there are
+    // several, the periodic image counts, the wall springs' entry where there are walls.
+    let walls = !scene.walls.is_empty();
+    let per_grain = (21 + some(real == 4, 3) + some(scene.track_orientation, 4) + some(capillary, 1)) * real + 5 * 4 + some(scene.materials.len() > 1, 4) + some(scene.periodic.iter().any(Option::is_some), 12) + some(walls, 4);
     // The partner and the reverse index (u32), the history, the partner's share 6 and the
     // normal force 1 reals, the capillary force, the owner's force (seed 000's law), the flags.
     let per_pair = 8 + (stride + 7 + some(capillary, 1) + some(owner_force, 3)) * real + 1;
-    scene.grains.len() as f64 * (per_grain as f64 + pairs_per_grain * per_pair as f64)
+    // One history block per wall for each grain a wall can reach (`cpu::wall_springs`), as placed.
+    let wall_springs = wall_candidates(scene) * scene.walls.len() * stride * real;
+    scene.grains.len() as f64 * (per_grain as f64 + pairs_per_grain * per_pair as f64) + wall_springs as f64
+}
+
+/// The grains nearer than their radius plus the skin to a wall, as placed: those whose wall
+/// springs the CPU engine keeps.
+fn wall_candidates(scene: &Scene) -> usize {
+    let walls: Vec<WallGeom<f64>> = scene.walls.iter().map(|w| WallGeom::of(&w.shape)).collect();
+    let g = &scene.grains;
+    g.position.iter().zip(&g.radius).filter(|&(x, &r)| walls.iter().any(|w| w.frame(Vec3::of(*x), Vec3::ZERO).1 < r + scene.skin)).count()
 }
 
 /// The `grains check` report.
