@@ -53,6 +53,15 @@ impl<T: Real> WallGeom<T> {
         }
     }
 
+    /// True when the point `x` lies nearer than `reach` (m) to one of `walls` (signed distance,
+    /// [`Self::frame`]): a grain of radius `r` there can touch one of them within `reach - r`.
+    pub fn any_within<'a>(walls: impl IntoIterator<Item = &'a WallGeom<T>>, x: Vec3<T>, reach: T) -> bool
+    where
+        T: 'a,
+    {
+        walls.into_iter().any(|w| w.frame(x, Vec3::ZERO).1 < reach)
+    }
+
     /// How far the surface has moved since it was `before` (m): no point's distance to it has
     /// changed by more. Infinite where the two cannot be compared (another kind, a turned
     /// plane).

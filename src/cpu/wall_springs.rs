@@ -45,8 +45,7 @@ impl<T: Real> WallSprings<T> {
             if s % CHUNK == 0 {
                 chunk_start.push(count);
             }
-            let reach = p.radius + skin;
-            if walls.iter().all(|w| !(w.geom.frame(*x, Vec3::ZERO).1 < reach)) {
+            if !WallGeom::any_within(walls.iter().map(|w| &w.geom), *x, p.radius + skin) {
                 entry.push(NO_ENTRY);
                 continue;
             }

@@ -244,7 +244,7 @@ pub(crate) fn engine_bytes(scene: &Scene, real: usize, pairs_per_grain: f64) -> 
 fn wall_candidates(scene: &Scene) -> usize {
     let walls: Vec<WallGeom<f64>> = scene.walls.iter().map(|w| WallGeom::of(&w.shape)).collect();
     let g = &scene.grains;
-    g.position.iter().zip(&g.radius).filter(|&(x, &r)| walls.iter().any(|w| w.frame(Vec3::of(*x), Vec3::ZERO).1 < r + scene.skin)).count()
+    g.position.iter().zip(&g.radius).filter(|&(x, &r)| WallGeom::any_within(&walls, Vec3::of(*x), r + scene.skin)).count()
 }
 
 /// The `grains check` report.
