@@ -2,7 +2,9 @@
 // the pairs where it is partner, its wall contacts. No float atomics. force.w counts the
 // grain's pairs that push (f_n > 0), for the statistics' rattlers. With phase.kick > 0 it
 // then kicks the grain (and invocation 0 the piston) under that load: the kick after an
-// evaluation, in the same dispatch.
+// evaluation, in the same dispatch. A partner's force is out_fj where the pair pass stores it
+// (PARTNER_FORCE_STORED), else the owner's reversed: subtracting out_fi adds the same bits.
+override PARTNER_FORCE_STORED: bool;
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read_write> vel: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> pair_start: array<u32>;
@@ -41,7 +43,11 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index
     }
     for (var s = rev_start[i]; s < rev_start[i + 1u]; s++) {
         let k = rev_pair[s];
-        f += out_fj[k].xyz;
+        if (PARTNER_FORCE_STORED) {
+            f += out_fj[k].xyz;
+        } else {
+            f -= out_fi[k].xyz;
+        }
         t += out_tj[k].xyz;
         pushing += select(0.0, 1.0, out_fi[k].w > 0.0);
     }

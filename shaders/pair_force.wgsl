@@ -1,8 +1,13 @@
 // One invocation computes the force of one listed pair, once, in canonical order (owner =
 // lower id = i), reading and writing its history (the tangential block's w is the sliding
-// flag, the bridge block's x the liquid volume); out_ti.w is its tangential regime, out_tj.w
-// its capillary force. A pair that does not touch forgets its springs and exerts only the
-// capillary force of its bridge, if it has one within reach.
+// flag, the bridge block's x the liquid volume). Its record: out_fi the force on i and the
+// normal force, out_ti the torque on i and its tangential regime (plus CLAMPED_FLAG when the
+// normal force was clamped), out_tj the torque on j and its capillary force, and out_fj the
+// force on j only where the law's force on j is not the force on i reversed
+// (PARTNER_FORCE_STORED; the gather subtracts out_fi otherwise). A pair that does not touch
+// forgets its springs and exerts only the capillary force of its bridge, if it has one within
+// reach.
+override PARTNER_FORCE_STORED: bool;
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
 @group(0) @binding(2) var<storage, read> pos: array<vec4<f32>>;
@@ -62,7 +67,9 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
         }
         store_history(k, open);
         out_fi[k] = vec4<f32>(n * f_c, 0.0);
-        out_fj[k] = vec4<f32>(n * (-f_c), 0.0);
+        if (PARTNER_FORCE_STORED) {
+            out_fj[k] = vec4<f32>(n * (-f_c), 0.0);
+        }
         out_ti[k] = vec4<f32>(0.0);
         out_tj[k] = vec4<f32>(0.0, 0.0, 0.0, f_c);
         return;
@@ -85,7 +92,9 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
         f.f_j -= g.n * f_c;
     }
     out_fi[k] = vec4<f32>(f.f_i, f.f_n);
-    out_fj[k] = vec4<f32>(f.f_j, select(0.0, 1.0, f.clamped));
-    out_ti[k] = vec4<f32>(f.t_i, f32(f.regime));
+    if (PARTNER_FORCE_STORED) {
+        out_fj[k] = vec4<f32>(f.f_j, 0.0);
+    }
+    out_ti[k] = vec4<f32>(f.t_i, f32(f.regime + select(0u, CLAMPED_FLAG, f.clamped)));
     out_tj[k] = vec4<f32>(f.t_j, f_c);
 }

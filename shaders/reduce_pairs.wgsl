@@ -9,10 +9,9 @@
 @group(0) @binding(5) var<storage, read> pair_i: array<u32>;
 @group(0) @binding(6) var<storage, read> pair_j: array<u32>;
 @group(0) @binding(7) var<storage, read> out_fi: array<vec4<f32>>;
-@group(0) @binding(8) var<storage, read> out_fj: array<vec4<f32>>;
-@group(0) @binding(9) var<storage, read> out_ti: array<vec4<f32>>;
-@group(0) @binding(10) var<storage, read> control: Control;
-@group(0) @binding(11) var<storage, read_write> pair_rows: array<f32>;
+@group(0) @binding(8) var<storage, read> out_ti: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read> control: Control;
+@group(0) @binding(10) var<storage, read_write> pair_rows: array<f32>;
 
 var<workgroup> row: array<f32, WG * STAT_ROW>;
 
@@ -30,10 +29,12 @@ fn reduce_pairs(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
         if (h > 0.0) {
             let c = coeffs[material[i] * params.n_materials + material[j]];
             row[r + P_CONTACTS] = count_field(1u);
-            row[r + P_CLAMPED] = count_field(u32(out_fj[k].w));
+            // The regime, plus CLAMPED_FLAG for a normal force clamped at zero (pair_force).
+            let code = u32(out_ti[k].w);
+            let regime = code % CLAMPED_FLAG;
+            row[r + P_CLAMPED] = count_field(code / CLAMPED_FLAG);
             row[r + P_ELASTIC] = normal_potential(c, pi.w * pj.w / (pi.w + pj.w), h);
             row[r + P_FORCE] = 2.0 * length(out_fi[k].xyz);
-            let regime = u32(out_ti[k].w);
             row[r + P_SLIDING] = count_field(select(0u, 1u, regime == REGIME_SLIDING));
             row[r + P_ROLLING] = count_field(select(0u, 1u, regime == REGIME_ROLLING));
             row[r + STAT_MAX] = h / min(pi.w, pj.w);

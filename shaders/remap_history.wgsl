@@ -1,6 +1,6 @@
 // One invocation finds one new pair in the replaced list (same owner, same partner id, as
 // DEM-Engine's persistent map matches them) and carries its history over, or zeroes it. The
-// replaced list sits in the pair force records, as `save_pairs` left it.
+// replaced list sits where `save_pairs` left it.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> pair_i: array<u32>;
 @group(0) @binding(2) var<storage, read> pair_j: array<u32>;
@@ -26,7 +26,7 @@ fn remap_history(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
     var found = NONE;
     while (lo < hi) {
         let mid = (lo + hi) / 2u;
-        let v = old_j[4u * mid];
+        let v = old_j[mid];
         if (v == j) {
             found = mid;
             break;

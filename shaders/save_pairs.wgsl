@@ -1,11 +1,11 @@
 // One invocation keeps one pair of the list being replaced: its partner and its history. They
-// are kept in the pair force records (`old_j` is `out_tj`, `old_hist0..2` are `out_fi`,
-// `out_fj`, `out_ti`: see `SCRATCH_IN_RECORDS`), which nothing reads between a rebuild and the
-// force evaluation that rewrites them, so the list being replaced costs no memory of its own.
+// are kept where nothing reads between here and what rewrites them (`old_j` is `rev_pair`,
+// which the rebuild's reverse lists rewrite; `old_hist0..2` are the pair force records
+// `out_fi`, `out_tj`, `out_ti`, which the force evaluation after a rebuild rewrites: see
+// `REBUILD_SCRATCH` in src/gpu/engine.rs), so the list being replaced costs no memory of its own.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> pair_j: array<u32>;
 @group(0) @binding(2) var<storage, read> hist: array<vec4<f32>>;
-// The partner of old pair k at word 4 k (a record is four words).
 @group(0) @binding(3) var<storage, read_write> old_j: array<u32>;
 // History block b of old pair k at old_hist<b>[k].
 @group(0) @binding(4) var<storage, read_write> old_hist0: array<vec4<f32>>;
@@ -19,7 +19,7 @@ fn save_pairs(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
     if (k >= control.n_pairs) {
         return;
     }
-    old_j[4u * k] = pair_j[k];
+    old_j[k] = pair_j[k];
     let blocks = params.hist_blocks;
     if (blocks > 0u) {
         old_hist0[k] = hist[k * blocks];

@@ -69,6 +69,8 @@ struct ContactForce {
 const REGIME_STATIC: u32 = 0u;
 const REGIME_SLIDING: u32 = 1u;
 const REGIME_ROLLING: u32 = 2u;
+// Added to the regime in a pair's record (out_ti.w) when its normal force was clamped at zero.
+const CLAMPED_FLAG: u32 = 4u;
 
 struct History {
     tangential: vec3<f32>,

@@ -129,7 +129,7 @@ pub struct CpuEngine<T: Real> {
     /// What the statistics and frames read of each pair's last evaluation.
     report: PairReports<T>,
     /// Each pair's force on its owner (N), for the laws whose force on the owner is not the
-    /// partner's reversed ([`pair_force::keeps_owner_force`]); empty otherwise.
+    /// partner's reversed ([`crate::model::ContactModel::keeps_both_forces`]); empty otherwise.
     force_i: Vec<Vec3<T>>,
     // Clocks.
     /// Largest squared displacement of a grain since the last build (m^2), as of the last drift.
@@ -277,7 +277,7 @@ impl<T: Real> CpuEngine<T> {
         let n_pairs = self.pairs.len();
         renew(&mut self.share, n_pairs);
         self.report.renew(n_pairs, self.slots.layout.bridge);
-        renew(&mut self.force_i, if pair_force::keeps_owner_force(&self.model) { n_pairs } else { 0 });
+        renew(&mut self.force_i, if self.model.keeps_both_forces() { n_pairs } else { 0 });
         for (b, at) in self.body.iter().zip(self.built_at.iter_mut()) {
             *at = b.pos;
         }

@@ -13,7 +13,7 @@
 use super::pairs::PairList;
 use super::state::{Body, HistorySlots, Load, PairFlags, Props};
 use super::lanes::PairSink;
-use crate::model::{capillary_force, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs, TangentialLaw};
+use crate::model::{capillary_force, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 
@@ -139,17 +139,10 @@ pub struct OwnerBlock<'a, T> {
     /// Each pair's [`PairFlags`].
     pub flags: &'a mut [u8],
     /// The force on the owner of each pair (N), kept only where it is not the partner's
-    /// force reversed (see [`keeps_owner_force`]); empty otherwise.
+    /// force reversed (see [`ContactModel::keeps_both_forces`]); empty otherwise.
     pub force_i: &'a mut [Vec3<T>],
     /// The pairs' history slots (empty when the model keeps none).
     pub hist: &'a mut [T],
-}
-
-/// True when a pair's force on its owner is not always its force on the partner reversed,
-/// bit for bit, so that it must be kept per pair: seed 000's rolling regime moves both grains
-/// along their own rolling directions. Every other law applies `f` to i and `-f` to j.
-pub fn keeps_owner_force<T>(model: &ContactModel<T>) -> bool {
-    matches!(model.tangential, TangentialLaw::Oquendo(_))
 }
 
 super::simd::dispatch! {

@@ -223,7 +223,7 @@ impl<T: Real> CpuEngine<T> {
         let stride = self.slots.stride;
         RowWidths {
             grain: [9, 6, 3 * T::COMPENSATED as usize, 3, 3 * !self.image.is_empty() as usize, 4 * self.orientation.is_some() as usize, self.walls.len() * stride, self.slots.layout.bridge as usize],
-            pair: [stride, 6, 1, self.slots.layout.bridge as usize, 1, 3 * pair_force::keeps_owner_force(&self.model) as usize],
+            pair: [stride, 6, 1, self.slots.layout.bridge as usize, 1, 3 * self.model.keeps_both_forces() as usize],
         }
     }
 

@@ -188,7 +188,7 @@ impl<T: Real> CpuEngine<T> {
             f_c: s.reals("f_c", capillary)?.iter().map(|&x| T::of(x)).collect(),
             flags: s.ints("pair_flags", Some(n_pairs))?.iter().map(|&x| x as u8).collect(),
         };
-        let kept = if pair_force::keeps_owner_force(&self.model) { n_pairs } else { 0 };
+        let kept = if self.model.keeps_both_forces() { n_pairs } else { 0 };
         self.force_i = s.reals("force_i", 3 * kept)?.chunks_exact(3).map(v3).collect();
         let clock = s.reals("clock", 3)?;
         (self.max_moved2, self.time, self.external_work) = (T::of(clock[0]), clock[1], clock[2]);

@@ -41,12 +41,13 @@ const NOT_STATE: [&str; 18] = [
     "wall_partials", "grain_rows", "pair_rows", "stats", // reductions
 ];
 
-/// Rebuild scratch kept in the pair force records, as (binding, buffer): the replaced list's
-/// partners and history blocks (`save_pairs`, `remap_history`). The records are dead from a
-/// rebuild until the force evaluation that follows it rewrites them (every plan evaluates
-/// forces after a rebuild, and reads records only after that), so the replaced list needs no
-/// buffers of its own: 20 bytes per pair of capacity on a dry bed, 36 with rolling springs.
-const SCRATCH_IN_RECORDS: [(&str, &str); 4] = [("old_j", "out_tj"), ("old_hist0", "out_fi"), ("old_hist1", "out_fj"), ("old_hist2", "out_ti")];
+/// The rebuild's scratch, as (binding, buffer): the replaced list's partners and history
+/// blocks (`save_pairs`, `remap_history`) are kept in buffers that nothing reads before they
+/// are rewritten: `rev_pair` (rewritten by the rebuild's `reverse_fill`) and the pair force
+/// records (rewritten by the force evaluation every plan runs after a rebuild, and read only
+/// after it). The replaced list needs no buffers of its own: 20 bytes per pair of capacity on
+/// a dry bed, 36 with rolling springs.
+const REBUILD_SCRATCH: [(&str, &str); 4] = [("old_j", "rev_pair"), ("old_hist0", "out_fi"), ("old_hist1", "out_tj"), ("old_hist2", "out_ti")];
 
 /// Why the GPU engine refused a scene.
 #[derive(Debug, thiserror::Error)]
@@ -369,7 +370,8 @@ impl GpuEngine {
             ("rev_pair", 4),
             ("hist", 16 * blocks),
             ("out_fi", 16),
-            ("out_fj", 16),
+            // The force on the partner, where it is not the owner's reversed.
+            ("out_fj", if self.model.keeps_both_forces() { 16 } else { 0 }),
             ("out_ti", 16),
             ("out_tj", 16),
         ]
@@ -408,11 +410,13 @@ impl GpuEngine {
         ];
         let orientation = ("TRACK_ORIENTATION", self.track_orientation as u8 as f64);
         let wall_response = ("WALL_RESPONSE", self.servo.is_some() as u8 as f64);
+        let partner_force = ("PARTNER_FORCE_STORED", m.keeps_both_forces() as u8 as f64);
         for k in KERNELS {
             let mut constants: Vec<(&str, f64)> = if k.includes.contains(&"model") { model_constants.to_vec() } else { Vec::new() };
             match k.name {
                 "integrate" => constants.push(orientation),
                 "wall_contacts" => constants.push(wall_response),
+                "pair_force" | "gather" => constants.push(partner_force),
                 _ => {}
             }
             let (layout, pipeline) = super::pipeline::compute_pipeline(&self.gpu.device, k, &constants);
@@ -441,7 +445,7 @@ impl GpuEngine {
             };
             for (key, aliases) in instances {
                 let buffer = |name: &str| {
-                    let buffer_name = aliases.iter().chain(&SCRATCH_IN_RECORDS).find(|(a, _)| *a == name).map_or(name, |(_, b)| *b);
+                    let buffer_name = aliases.iter().chain(&REBUILD_SCRATCH).find(|(a, _)| *a == name).map_or(name, |(_, b)| *b);
                     self.buffers.get(buffer_name).unwrap_or_else(|| panic!("kernel {} binds {buffer_name}, which the engine lacks", k.name))
                 };
                 let bg = super::pipeline::bind_group(&self.gpu.device, &key, k, &self.layouts[k.name], buffer, std::mem::size_of::<Phase>() as u64);

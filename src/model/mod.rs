@@ -322,6 +322,14 @@ impl<T: Real> ContactModel<T> {
             bridge: !matches!(self.cohesion, CohesionLaw::None),
         }
     }
+
+    /// True when a pair's force on its owner is not always its force on the partner reversed,
+    /// bit for bit, so that an engine must keep both: seed 000's rolling regime moves both
+    /// grains along their own rolling directions. Every other law applies `f` to i and `-f`
+    /// to j (a negation commutes with rounding, so `-f` is exact).
+    pub fn keeps_both_forces(&self) -> bool {
+        matches!(self.tangential, TangentialLaw::Oquendo(_))
+    }
 }
 
 /// Which per-contact history blocks exist: world-frame 3-vectors (m) and single reals; a

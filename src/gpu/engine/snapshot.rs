@@ -97,7 +97,8 @@ impl GpuEngine {
         let contact_records = contacts.then(|| -> Result<Vec<ContactRecord>, SimError> {
             let np = self.control.n_pairs as u64;
             let blocks = self.params.hist_blocks as u64;
-            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, 16 * np), ("hist", 0, 16 * np * blocks), ("out_tj", 0, 16 * np)])?;
+            let both = self.model.keeps_both_forces();
+            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, if both { 16 * np } else { 0 }), ("hist", 0, 16 * np * blocks), ("out_tj", 0, 16 * np)])?;
             let (pi, pj): (&[u32], &[u32]) = (&parts[0], &parts[1]);
             let fi: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
             let fj: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
@@ -117,7 +118,7 @@ impl GpuEngine {
                         overlap: h,
                         normal_force: (fi[k][3] + f_c[k]) as f64,
                         force: xyz(&fi[k]),
-                        force_j: xyz(&fj[k]),
+                        force_j: if both { xyz(&fj[k]) } else { xyz(&fi[k]).map(|f| -f) },
                         tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
                         rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + self.history.tangential as usize]) } else { [0.0; 3] },
                         bridge_volume: if self.history.bridge { hist[k * blocks as usize + self.history.tangential as usize + self.history.rolling as usize][0] as f64 } else { 0.0 },
