@@ -18,6 +18,9 @@ pub enum Access {
     Read,
     /// `var<storage, read_write>`.
     ReadWrite,
+    /// `var<storage, read_write>` that the kernel only stores to, never loads (WGSL has no
+    /// write-only storage): the traffic count takes its bytes once.
+    Write,
 }
 
 /// A kernel: one WGSL file, one entry point of the same name.
@@ -63,7 +66,7 @@ impl Kernel {
     }
 }
 
-use Access::{Phase, Read, ReadWrite, Uniform};
+use Access::{Phase, Read, ReadWrite, Uniform, Write};
 
 const BASE: &[&str] = &["types", "dispatch"];
 const KICK: &[&str] = &["types", "dispatch", "kick"];
@@ -86,36 +89,36 @@ pub const KERNELS: &[Kernel] = &[
     kernel!("integrate", INTEGRATE, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "residual": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "force": Read, "torque": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "wall_reaction": Read, "control": ReadWrite]),
     kernel!("servo_move", BASE, ["params": Uniform, "phase": Phase, "walls": ReadWrite, "wall_reaction": Read, "servo": ReadWrite]),
     kernel!("decide_rebuild", BASE, ["params": Uniform, "control": ReadWrite, "args": ReadWrite]),
-    kernel!("save_starts", BASE, ["params": Uniform, "pair_start": Read, "old_start": ReadWrite]),
-    kernel!("save_pairs", BASE, ["params": Uniform, "pair_j": Read, "hist": Read, "old_j": ReadWrite, "old_hist0": ReadWrite, "old_hist1": ReadWrite, "old_hist2": ReadWrite, "control": Read]),
-    kernel!("clear_cells", BASE, ["params": Uniform, "cell_count": ReadWrite, "cell_fill": ReadWrite]),
-    kernel!("hash_cells", GRID, ["params": Uniform, "pos": ReadWrite, "residual": ReadWrite, "image": ReadWrite, "built_at": ReadWrite, "cell_of": ReadWrite, "cell_count": ReadWrite, "control": ReadWrite, "pair_start": ReadWrite, "rev_start": ReadWrite, "rev_fill": ReadWrite]),
-    kernel!("scan_blocks", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite]),
+    kernel!("save_starts", BASE, ["params": Uniform, "pair_start": Read, "old_start": Write]),
+    kernel!("save_pairs", BASE, ["params": Uniform, "pair_j": Read, "hist": Read, "old_j": Write, "old_hist0": Write, "old_hist1": Write, "old_hist2": Write, "control": Read]),
+    kernel!("clear_cells", BASE, ["params": Uniform, "cell_count": Write, "cell_fill": Write]),
+    kernel!("hash_cells", GRID, ["params": Uniform, "pos": ReadWrite, "residual": ReadWrite, "image": ReadWrite, "built_at": Write, "cell_of": Write, "cell_count": ReadWrite, "control": ReadWrite, "pair_start": Write, "rev_start": Write, "rev_fill": Write]),
+    kernel!("scan_blocks", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": Write]),
     kernel!("scan_add", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite]),
-    kernel!("scatter_cells", BASE, ["params": Uniform, "cell_of": Read, "cell_count": Read, "cell_fill": ReadWrite, "cell_grains": ReadWrite]),
-    kernel!("detect_count", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": ReadWrite, "control": ReadWrite]),
-    kernel!("pairs_ready", BASE, ["params": Uniform, "pair_start": Read, "control": ReadWrite, "args": ReadWrite]),
-    kernel!("detect_fill", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Read, "pair_i": ReadWrite, "pair_j": ReadWrite]),
-    kernel!("remap_history", BASE, ["params": Uniform, "pair_i": Read, "pair_j": Read, "old_start": Read, "old_j": Read, "old_hist0": Read, "old_hist1": Read, "old_hist2": Read, "hist": ReadWrite, "control": Read]),
+    kernel!("scatter_cells", BASE, ["params": Uniform, "cell_of": Read, "cell_count": Read, "cell_fill": ReadWrite, "cell_grains": Write]),
+    kernel!("detect_count", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Write, "control": ReadWrite]),
+    kernel!("pairs_ready", BASE, ["params": Uniform, "pair_start": Read, "control": ReadWrite, "args": Write]),
+    kernel!("detect_fill", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Read, "pair_i": Write, "pair_j": ReadWrite]),
+    kernel!("remap_history", BASE, ["params": Uniform, "pair_i": Read, "pair_j": Read, "old_start": Read, "old_j": Read, "old_hist0": Read, "old_hist1": Read, "old_hist2": Read, "hist": Write, "control": Read]),
     kernel!("reverse_count", BASE, ["params": Uniform, "pair_j": Read, "rev_start": ReadWrite, "control": Read]),
-    kernel!("reverse_fill", BASE, ["params": Uniform, "pair_j": Read, "rev_start": Read, "rev_fill": ReadWrite, "rev_pair": ReadWrite, "control": Read]),
+    kernel!("reverse_fill", BASE, ["params": Uniform, "pair_j": Read, "rev_start": Read, "rev_fill": ReadWrite, "rev_pair": Write, "control": Read]),
     kernel!("reverse_sort", BASE, ["params": Uniform, "rev_start": Read, "rev_pair": ReadWrite]),
-    kernel!("find_bridge_events", FORCES, ["params": Uniform, "pos": Read, "residual": Read, "pair_i": Read, "pair_j": Read, "hist": Read, "bridge_event": ReadWrite, "control": Read]),
+    kernel!("find_bridge_events", FORCES, ["params": Uniform, "pos": Read, "residual": Read, "pair_i": Read, "pair_j": Read, "hist": Read, "bridge_event": Write, "control": Read]),
     kernel!("update_bridges", FORCES, ["params": Uniform, "pair_i": Read, "pair_j": Read, "bridge_event": Read, "hist": ReadWrite, "liquid": ReadWrite, "control": Read]),
-    kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": ReadWrite, "out_fj": ReadWrite, "out_ti": ReadWrite, "out_tj": ReadWrite, "control": Read]),
-    kernel!("wall_contacts", WALLS, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_force": ReadWrite, "wall_torque": ReadWrite, "wall_partials": ReadWrite]),
-    kernel!("wall_reduce", BASE, ["params": Uniform, "wall_partials": Read, "wall_reaction": ReadWrite]),
-    kernel!("gather", KICK, ["params": Uniform, "vel": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "wall_force": Read, "wall_torque": Read, "force": ReadWrite, "torque": ReadWrite, "phase": Phase, "omega": ReadWrite, "walls": ReadWrite, "wall_reaction": Read]),
-    kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "wall_force": Read, "wall_torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": ReadWrite]),
-    kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_ti": Read, "control": Read, "pair_rows": ReadWrite]),
-    kernel!("reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": ReadWrite]),
+    kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": Write, "out_fj": Write, "out_ti": Write, "out_tj": Write, "control": Read]),
+    kernel!("wall_contacts", WALLS, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_force": Write, "wall_torque": Write, "wall_partials": Write]),
+    kernel!("wall_reduce", BASE, ["params": Uniform, "wall_partials": Read, "wall_reaction": Write]),
+    kernel!("gather", KICK, ["params": Uniform, "vel": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "wall_force": Read, "wall_torque": Read, "force": Write, "torque": Write, "phase": Phase, "omega": ReadWrite, "walls": ReadWrite, "wall_reaction": Read]),
+    kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "wall_force": Read, "wall_torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": Write]),
+    kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_ti": Read, "control": Read, "pair_rows": Write]),
+    kernel!("reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": Write]),
 ];
 
 /// Contact dynamics' sweep kernels ([`crate::gpu::GpuSweeps`]), in the order a sweep runs them.
 pub const CD_KERNELS: &[Kernel] = &[
-    kernel!("cd_sweep_colour", CD, ["cd": Uniform, "phase": Phase, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "measure": ReadWrite, "sweeps": Read]),
-    kernel!("cd_sweep_tail", CD, ["cd": Uniform, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "wall_vel": ReadWrite, "measure": ReadWrite, "sweeps": Read]),
-    kernel!("cd_measure", CD, ["cd": Uniform, "measure": Read, "blocks": ReadWrite, "sweeps": Read]),
+    kernel!("cd_sweep_colour", CD, ["cd": Uniform, "phase": Phase, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "measure": Write, "sweeps": Read]),
+    kernel!("cd_sweep_tail", CD, ["cd": Uniform, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "wall_vel": ReadWrite, "measure": Write, "sweeps": Read]),
+    kernel!("cd_measure", CD, ["cd": Uniform, "measure": Read, "blocks": Write, "sweeps": Read]),
     kernel!("cd_decide", CD, ["cd": Uniform, "blocks": Read, "sweeps": ReadWrite]),
 ];
 

@@ -81,7 +81,7 @@ fn rank(t: wgpu::DeviceType) -> u32 {
 
 /// Storage buffers the busiest kernel binds.
 pub fn storage_buffers_needed() -> u64 {
-    KERNELS.iter().chain(CD_KERNELS).map(|k| k.bindings.iter().filter(|(_, a)| matches!(a, Access::Read | Access::ReadWrite)).count() as u64).max().unwrap_or(0)
+    KERNELS.iter().chain(CD_KERNELS).map(|k| k.bindings.iter().filter(|(_, a)| matches!(a, Access::Read | Access::ReadWrite | Access::Write)).count() as u64).max().unwrap_or(0)
 }
 
 /// Opens the best adapter, or the first whose name contains `name` (case-insensitive).

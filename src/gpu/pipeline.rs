@@ -17,7 +17,7 @@ pub fn compute_pipeline(device: &wgpu::Device, k: &Kernel, constants: &[(&str, f
                 ty: match access {
                     Access::Uniform | Access::Phase => wgpu::BufferBindingType::Uniform,
                     Access::Read => wgpu::BufferBindingType::Storage { read_only: true },
-                    Access::ReadWrite => wgpu::BufferBindingType::Storage { read_only: false },
+                    Access::ReadWrite | Access::Write => wgpu::BufferBindingType::Storage { read_only: false },
                 },
                 has_dynamic_offset: *access == Access::Phase,
                 min_binding_size: None,

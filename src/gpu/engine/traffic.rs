@@ -1,8 +1,8 @@
 //! The bytes a step that keeps its neighbour list moves to and from the GPU's memory, counted
 //! from the kernel table: each kernel the plan dispatches with work (the rebuild kernels run
 //! with zero workgroups on such steps; `decide_rebuild` runs) streams each storage buffer it
-//! binds once, a read-only one read and a read-write one read and written (an upper bound
-//! where a kernel only writes one), the per-pair buffers at the live pair count.
+//! binds once: a read-only one read, a read-write one read and written, one the kernel only
+//! stores to ([`Access::Write`]) written; the per-pair buffers at the live pair count.
 
 use super::*;
 use crate::kernels::{kernel, Access};
@@ -21,7 +21,7 @@ impl GpuEngine {
                 .bindings
                 .iter()
                 .map(|&(buffer, access)| match access {
-                    Access::Read => used(buffer),
+                    Access::Read | Access::Write => used(buffer),
                     Access::ReadWrite => 2 * used(buffer),
                     Access::Uniform | Access::Phase => 0,
                 })
