@@ -102,6 +102,8 @@ struct Outputs<T> {
 
 /// Pairs sorted into touching and open at a time.
 const WINDOW: usize = 256;
+// The touching and open lists index a window with `u8`.
+const _: () = assert!(WINDOW <= 256);
 
 /// What the touch test of one window of pairs reads and finds.
 struct Window<T> {
@@ -122,8 +124,8 @@ struct Window<T> {
 pub struct Scratch<T> {
     win: Window<T>,
     /// The window's touching pairs, then its open ones, in pair order.
-    touching: [u16; WINDOW],
-    open: [u16; WINDOW],
+    touching: [u8; WINDOW],
+    open: [u8; WINDOW],
 }
 
 impl<T: Real> Scratch<T> {
@@ -250,8 +252,8 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
         let (mut n_touching, mut n_open) = (0, 0);
         for m in 0..len {
             let t = win.touching[m];
-            touching[n_touching] = m as u16;
-            open[n_open] = m as u16;
+            touching[n_touching] = m as u8;
+            open[n_open] = m as u8;
             n_touching += t as usize;
             n_open += !t as usize;
         }
