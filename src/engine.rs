@@ -21,6 +21,18 @@ pub enum SimError {
         /// The capacity.
         capacity: usize,
     },
+    /// The GPU's pair buffers filled up between two of the checks that grow them.
+    #[error(
+        "the GPU's pair buffers overflowed by step {step}: the neighbour list grew to {pairs} pairs, above the {capacity} they held (they grow at each statistics read, and the list grew faster); fix: give a shorter simulation.stats_interval, lower simulation.skin, or run with --backend cpu"
+    )]
+    PairBuffers {
+        /// Step at which it was seen.
+        step: u64,
+        /// Pairs the list needed.
+        pairs: u64,
+        /// Pairs the buffers held.
+        capacity: u64,
+    },
     /// The GPU failed to answer a readback (device lost, mapping refused).
     #[error("the GPU failed while reading back {what}: {reason}; fix: check the GPU driver (a device lost after a long dispatch is often the driver's watchdog) or run with --backend cpu")]
     Device {

@@ -536,3 +536,28 @@ fn history_survives_a_rebuild_on_the_gpu() {
     assert_eq!(spring, spring_rebuilt);
     assert_eq!(plain, rebuilt);
 }
+
+#[test]
+fn a_dense_start_with_a_wide_skin_fits_the_gpus_pair_buffers() {
+    // The gas with a skin of 1.5 mean diameters lists about twice the pairs per grain the
+    // buffers start with: the engine must size them to its first list before the first step.
+    let scene = common::parse(&common::edit(&std::fs::read_to_string(common::scene_path("quickstart.toml")).unwrap(), &[("region = { shape", "random_speed = 2.0\nregion = { shape"), ("dt = \"auto\"", "dt = \"auto\"\nskin = 1.5e-3")]));
+    let Some(mut g) = common::gpu_engine(&scene) else { return };
+    let mut c: CpuEngine<f32> = common::engine(&scene);
+    let n = scene.grains.len() as f64;
+    let listed = c.pair_list().1.len() as f64;
+    println!("{:.1} pairs per grain listed, buffers for {:.1} per grain before the first step", listed / n, g.pair_capacity() as f64 / n);
+    assert!(listed > 1.5 * grains::gpu::INITIAL_PAIRS_PER_GRAIN as f64 * n, "the skin must list more pairs than the initial buffers hold");
+    assert!(g.pair_capacity() as f64 >= listed);
+    g.advance(100).unwrap();
+    c.advance(100).unwrap();
+    let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
+    let bits = |f: &grains::engine::Frame| -> Vec<u64> { f.position.iter().chain(&f.velocity).flat_map(|v| v.map(f64::to_bits)).collect() };
+    let differing = bits(&fg).iter().zip(&bits(&fc)).filter(|(a, b)| a != b).count();
+    let worst = fg.position.iter().zip(&fc.position).flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k]).abs())).fold(0.0, f64::max);
+    println!("after 100 steps: {differing} position and velocity components differ, largest position difference {worst:.3e} m");
+    if g.adapter().device_type == wgpu::DeviceType::Cpu {
+        assert_eq!(differing, 0, "bitwise on a software adapter");
+    }
+    assert!(worst < F32_POSITION_TOLERANCE * 1e-3, "positions within f32 round-off of a 1 mm grain");
+}

@@ -357,6 +357,7 @@ impl GpuEngine {
         engine.allocate_pairs(pair_capacity);
         engine.build_pipelines(scene);
         engine.build_bind_groups();
+        engine.make_room_for_the_first_list()?;
         Ok(engine)
     }
 

@@ -56,12 +56,7 @@ impl GpuEngine {
             self.run(pass, "save_starts", Size::Indirect(args::GRAIN_STARTS), None);
             self.run(pass, "save_pairs", Size::Indirect(args::OLD_PAIRS), None);
         }
-        self.run(pass, "clear_cells", Size::Indirect(args::HASH), None);
-        self.run(pass, "hash_cells", Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "cell", "cell_sums", args::HASH_BLOCKS, self.params.hash_size as u64);
-        self.run(pass, "scatter_cells", Size::Indirect(args::GRAINS), None);
-        self.run(pass, "detect_count", Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
+        self.encode_pair_count(pass);
         self.run(pass, "pairs_ready", Size::One, None);
         self.run(pass, "detect_fill", Size::Indirect(args::GRAINS), None);
         if keeps_history {
@@ -71,6 +66,17 @@ impl GpuEngine {
         self.scan(pass, "rev", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
         self.run(pass, "reverse_fill", Size::Indirect(args::NEW_PAIRS), None);
         self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
+    }
+
+    /// The rebuild's hashing and pair count, at the sizes `decide_rebuild` wrote: then
+    /// `pair_start` holds each grain's first pair and, last, the number of pairs.
+    pub(super) fn encode_pair_count(&self, pass: &mut wgpu::ComputePass) {
+        self.run(pass, "clear_cells", Size::Indirect(args::HASH), None);
+        self.run(pass, "hash_cells", Size::Indirect(args::GRAINS), None);
+        self.scan(pass, "cell", "cell_sums", args::HASH_BLOCKS, self.params.hash_size as u64);
+        self.run(pass, "scatter_cells", Size::Indirect(args::GRAINS), None);
+        self.run(pass, "detect_count", Size::Indirect(args::GRAINS), None);
+        self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
     }
 
     /// The kernels of a plan entry other than the rebuild check, with their sizes and phases:

@@ -39,22 +39,47 @@ impl GpuEngine {
             return Err(SimError::Capacity { step: self.step, grain: c.overflow_grain, count: c.overflow_count as usize, capacity: self.params.max_neighbours as usize });
         }
         if c.pair_overflow != 0 {
-            return Err(SimError::Capacity {
-                step: self.step,
-                grain: NONE,
-                count: self.params.pair_capacity as usize + 1,
-                capacity: self.params.pair_capacity as usize,
-            });
+            return Err(SimError::PairBuffers { step: self.step, pairs: self.listed_pairs()?, capacity: self.params.pair_capacity as u64 });
         }
-        if c.n_pairs as f64 > PAIR_GROWTH_THRESHOLD * self.params.pair_capacity as f64 {
+        self.make_room_for(c.n_pairs as u64);
+        Ok(())
+    }
+
+    /// The number of pairs the last rebuild's count found (the end of `pair_start`), which
+    /// may exceed the buffers' capacity.
+    fn listed_pairs(&self) -> Result<u64, SimError> {
+        Ok(self.read(&[("pair_start", 4 * self.n as u64, 4)])?[0][0] as u64)
+    }
+
+    /// Grows the pair buffers, keeping what they hold, to twice `pairs` when `pairs` fill more
+    /// than [`PAIR_GROWTH_THRESHOLD`] of them (at most what a storage binding holds).
+    fn make_room_for(&mut self, pairs: u64) {
+        if pairs as f64 > PAIR_GROWTH_THRESHOLD * self.params.pair_capacity as f64 {
             let binding = self.gpu.limits.max_storage_buffer_binding_size;
             let per_pair = 16 * (self.params.hist_blocks as u64).max(1);
-            let grown = (2 * c.n_pairs as u64).min(binding / per_pair);
+            let grown = (2 * pairs).min(binding / per_pair);
             if grown > self.params.pair_capacity as u64 {
                 self.allocate_pairs(grown);
                 self.build_bind_groups();
             }
         }
+    }
+
+    /// Sizes the pair buffers for the list the first rebuild will build, counted by the
+    /// rebuild's own kernels before the first step (the control record then put back as it
+    /// was): a scene that starts dense with a wide skin would otherwise fill the initial
+    /// buffers before the first check could grow them.
+    pub(super) fn make_room_for_the_first_list(&mut self) -> Result<(), SimError> {
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.run(&mut pass, "decide_rebuild", Size::One, None);
+            self.encode_pair_count(&mut pass);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        let pairs = self.listed_pairs()?;
+        self.gpu.queue.write_buffer(&self.buffers["control"], 0, bytemuck::bytes_of(&self.control));
+        self.make_room_for(pairs);
         Ok(())
     }
 
