@@ -6,23 +6,32 @@ use super::schema::{GeneratorSpec, RegionSpec};
 use super::{sphere_mass, Grains, SceneError};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 /// Attempts per grain before the region counts as full.
 pub const MAX_ATTEMPTS: usize = 20_000;
 
-/// A uniform grid of already placed grains for overlap queries during placement.
+/// A uniform grid of already placed grains for overlap queries during placement (hashed with
+/// `rustc_hash`'s multiply-rotate hash: std's SipHash took a third of the placement's time).
 struct PlacementGrid {
     cell: f64,
-    cells: HashMap<[i64; 3], Vec<u32>>,
+    cells: FxHashMap<[i64; 3], Vec<u32>>,
+    /// The lowest and highest cell key holding a grain, per axis.
+    occupied: [[i64; 2]; 3],
 }
 
 impl PlacementGrid {
+    fn new(cell: f64) -> Self {
+        PlacementGrid { cell, cells: FxHashMap::default(), occupied: [[i64::MAX, i64::MIN]; 3] }
+    }
     fn key(&self, p: [f64; 3]) -> [i64; 3] {
         [(p[0] / self.cell).floor() as i64, (p[1] / self.cell).floor() as i64, (p[2] / self.cell).floor() as i64]
     }
     fn insert(&mut self, i: u32, p: [f64; 3]) {
         let k = self.key(p);
+        for (range, &k) in self.occupied.iter_mut().zip(&k) {
+            *range = [range[0].min(k), range[1].max(k)];
+        }
         self.cells.entry(k).or_default().push(i);
     }
     /// True when a sphere at `p` of radius `r` overlaps a placed grain, or a periodic image
@@ -46,6 +55,10 @@ impl PlacementGrid {
 
     fn overlaps_here(&self, grains: &Grains, p: [f64; 3], r: f64) -> bool {
         let k = self.key(p);
+        // No grain in the 27 cells around `p` (most periodic images of a point inside).
+        if (0..3).any(|a| k[a] + 1 < self.occupied[a][0] || k[a] - 1 > self.occupied[a][1]) {
+            return false;
+        }
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
@@ -91,7 +104,7 @@ pub(super) fn place(
         return Err(c.invalid(key("random_speed"), spec.random_speed, "must be zero or positive", "give a speed in m/s"));
     }
     let r_max_all = grains.radius.iter().copied().fold(0.5 * d.max, f64::max);
-    let mut grid = PlacementGrid { cell: 2.0 * r_max_all, cells: HashMap::new() };
+    let mut grid = PlacementGrid::new(2.0 * r_max_all);
     for i in 0..grains.len() {
         grid.insert(i as u32, grains.position[i]);
     }
@@ -184,5 +197,53 @@ fn random_direction(rng: &mut ChaCha8Rng) -> [f64; 3] {
             let n = n2.sqrt();
             return [v[0] / n, v[1] / n, v[2] / n];
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The placement grid's overlap query against a brute-force test over every grain and its
+    //! periodic images, so that what the grid skips (empty cells, images far from every grain)
+    //! never changes an answer.
+    use super::*;
+
+    #[test]
+    fn the_grids_overlap_query_is_the_brute_force_one() {
+        // Grains in a box periodic in x and y (about 0.25 solid fraction), queried at random
+        // points, many near a periodic face or beyond the grains' extent in z.
+        let (side, height, r) = (10.0e-3, 6.0e-3, 0.5e-3);
+        let periodic = [Some([0.0, side]), Some([0.0, side]), None];
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut grains = Grains::default();
+        let mut grid = PlacementGrid::new(2.0 * r);
+        for _ in 0..150 {
+            let p = [rng.random_range(0.0..side), rng.random_range(0.0..side), rng.random_range(0.0..height)];
+            grid.insert(grains.len() as u32, p);
+            grains.push(r, 1.0, p, [0.0; 3], [0.0; 3], 0);
+        }
+        let brute = |p: [f64; 3], rq: f64| {
+            grains.position.iter().zip(&grains.radius).any(|(q, &rj)| {
+                let d: Vec<f64> = (0..3)
+                    .map(|a| {
+                        let d = p[a] - q[a];
+                        match periodic[a] {
+                            Some([lo, hi]) => d - (hi - lo) * (d / (hi - lo)).round(),
+                            None => d,
+                        }
+                    })
+                    .collect();
+                d.iter().map(|x| x * x).sum::<f64>() < (rq + rj) * (rq + rj)
+            })
+        };
+        let (mut hits, mut misses) = (0, 0);
+        for _ in 0..20_000 {
+            let p = [rng.random_range(-0.2 * side..1.2 * side), rng.random_range(0.0..side), rng.random_range(-2.0e-3..height + 3.0e-3)];
+            // Queries inside the box only in the periodic axes' sense: fold x as placement does.
+            let p = [p[0].rem_euclid(side), p[1], p[2]];
+            let expected = brute(p, r);
+            assert_eq!(grid.overlaps(&grains, p, r, &periodic), expected, "query at {p:?}");
+            if expected { hits += 1 } else { misses += 1 }
+        }
+        assert!(hits > 2000 && misses > 2000, "both answers exercised: {hits} overlaps, {misses} free");
     }
 }
