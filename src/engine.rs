@@ -21,9 +21,10 @@ pub enum SimError {
         /// The capacity.
         capacity: usize,
     },
-    /// The GPU's pair buffers filled up between two of the checks that grow them.
+    /// The GPU's pair buffers filled up between two of the checks that grow them
+    /// ([`crate::gpu::SUBMITS_PER_CHECK`]).
     #[error(
-        "the GPU's pair buffers overflowed by step {step}: the neighbour list grew to {pairs} pairs, above the {capacity} they held (they grow at each statistics read, and the list grew faster); fix: give a shorter simulation.stats_interval, lower simulation.skin, or run with --backend cpu"
+        "the GPU's pair buffers overflowed by step {step}: the neighbour list grew to {pairs} pairs, above the {capacity} they held (they grow when 75% full at checks every 512 steps and at each statistics read, and the list more than doubled in between); fix: lower simulation.skin, or run with --backend cpu"
     )]
     PairBuffers {
         /// Step at which it was seen.

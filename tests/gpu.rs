@@ -561,3 +561,36 @@ fn a_dense_start_with_a_wide_skin_fits_the_gpus_pair_buffers() {
     }
     assert!(worst < F32_POSITION_TOLERANCE * 1e-3, "positions within f32 round-off of a 1 mm grain");
 }
+
+#[test]
+fn a_long_advance_grows_the_pair_buffers_as_a_pour_compacts() {
+    // 600 grains falling into a box under 50 g with a skin of 0.8 diameters: the list grows
+    // to over 9 pairs per grain within 10,000 steps, past the buffers' initial 6.
+    // One advance over all of them (checked every SUBMITS_PER_CHECK submissions inside) must
+    // give the bits of twenty advances of 500 (each checked at its end).
+    let quickstart = std::fs::read_to_string(common::scene_path("quickstart.toml")).unwrap();
+    let scene = common::parse(&common::edit(
+        &quickstart,
+        &[
+            ("max = [10.0e-3, 10.0e-3, 18.0e-3]", "max = [10.0e-3, 10.0e-3, 30.0e-3]"),
+            ("gravity = [0.0, 0.0, -9.81]", "gravity = [0.0, 0.0, -500.0]"),
+            ("dt = \"auto\"", "dt = 1.0e-6\nskin = 0.8e-3\nmax_neighbours = 64"),
+        ],
+    ));
+    let run = |advances: u64| -> Option<(Vec<u64>, f64, f64)> {
+        let mut g = common::gpu_engine(&scene)?;
+        let start = g.pair_capacity() as f64;
+        for _ in 0..advances {
+            g.advance(10_000 / advances).unwrap();
+        }
+        let f = g.frame(false).unwrap();
+        let bits = f.position.iter().chain(&f.velocity).flat_map(|v| v.map(f64::to_bits)).collect();
+        Some((bits, g.pair_list().unwrap().1.len() as f64, start))
+    };
+    let Some((once, pairs, start)) = run(1) else { return };
+    let (chunked, _, _) = run(20).unwrap();
+    let n = scene.grains.len() as f64;
+    println!("pairs per grain at the end {:.1}, buffers for {:.1} per grain at the start", pairs / n, start / n);
+    assert!(pairs > 1.5 * start, "the list must outgrow the initial buffers");
+    assert_eq!(once, chunked, "one advance and twenty give the same bits");
+}

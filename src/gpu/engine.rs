@@ -31,6 +31,10 @@ pub const INITIAL_PAIRS_PER_GRAIN: u64 = 6;
 pub const PAIR_GROWTH_THRESHOLD: f64 = 0.75;
 /// Steps recorded per queue submission.
 pub const STEPS_PER_SUBMIT: u64 = 16;
+/// Submissions between two checks of the control record inside one `advance` (the pair
+/// buffers grow at a check, so a long advance over a compacting pour checks every 512 steps
+/// rather than only at its end; each check waits for the device once).
+pub const SUBMITS_PER_CHECK: u64 = 32;
 
 /// Buffers a checkpoint leaves out: the scene's constants (set up again from the scene) and
 /// scratch space every step or statistics read rewrites before reading it.
@@ -503,6 +507,9 @@ impl Engine for GpuEngine {
             self.step += chunk;
             self.time += chunk as f64 * self.dt;
             done += chunk;
+            if done < n && (done / STEPS_PER_SUBMIT).is_multiple_of(SUBMITS_PER_CHECK) {
+                self.check()?;
+            }
         }
         self.check()
     }
