@@ -209,8 +209,9 @@ mod tests {
 
     #[test]
     fn the_grids_overlap_query_is_the_brute_force_one() {
-        // Grains in a box periodic in x and y (about 0.25 solid fraction), queried at random
-        // points, many near a periodic face or beyond the grains' extent in z.
+        // 150 grains at random in a box periodic in x and y (free to overlap one another: only
+        // the queries are tested), queried at random points, many near a periodic face or
+        // beyond the grains' extent in z.
         let (side, height, r) = (10.0e-3, 6.0e-3, 0.5e-3);
         let periodic = [Some([0.0, side]), Some([0.0, side]), None];
         let mut rng = ChaCha8Rng::seed_from_u64(7);
@@ -238,7 +239,7 @@ mod tests {
         let (mut hits, mut misses) = (0, 0);
         for _ in 0..20_000 {
             let p = [rng.random_range(-0.2 * side..1.2 * side), rng.random_range(0.0..side), rng.random_range(-2.0e-3..height + 3.0e-3)];
-            // Queries inside the box only in the periodic axes' sense: fold x as placement does.
+            // x folded into the box, as placement's regions lie inside it.
             let p = [p[0].rem_euclid(side), p[1], p[2]];
             let expected = brute(p, r);
             assert_eq!(grid.overlaps(&grains, p, r, &periodic), expected, "query at {p:?}");
