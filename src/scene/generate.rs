@@ -6,45 +6,77 @@ use super::schema::{GeneratorSpec, RegionSpec};
 use super::{sphere_mass, Grains, SceneError};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rustc_hash::FxHashMap;
 
 /// Attempts per grain before the region counts as full.
 pub const MAX_ATTEMPTS: usize = 20_000;
 
-/// A uniform grid of already placed grains for overlap queries during placement (hashed with
-/// `rustc_hash`'s multiply-rotate hash: std's SipHash took a third of the placement's time).
+/// No grain: the end of a cell's list.
+const NONE: u32 = u32::MAX;
+
+/// A uniform grid of already placed grains for overlap queries during placement: a dense
+/// array of cells over the box that holds the region and the grains already there, each cell
+/// the head of a list threaded through the grains (`next`). Its cells are at least a grain's
+/// diameter and grow until there are at most [`CELLS_PER_GRAIN`] per grain, so a region far
+/// larger than its grains does not allocate a cell per diameter.
 struct PlacementGrid {
     cell: f64,
-    cells: FxHashMap<[i64; 3], Vec<u32>>,
-    /// The lowest and highest cell key holding a grain, per axis.
+    /// The grid's lower corner (m).
+    origin: [f64; 3],
+    /// Cells per axis.
+    dims: [i64; 3],
+    /// The last grain placed in each cell, or [`NONE`].
+    head: Vec<u32>,
+    /// The grain placed in the same cell before each grain, or [`NONE`].
+    next: Vec<u32>,
+    /// The lowest and highest cell holding a grain, per axis.
     occupied: [[i64; 2]; 3],
 }
 
+/// Most cells a placement grid makes per grain it may hold.
+const CELLS_PER_GRAIN: f64 = 4.0;
+
 impl PlacementGrid {
-    fn new(cell: f64) -> Self {
-        PlacementGrid { cell, cells: FxHashMap::default(), occupied: [[i64::MAX, i64::MIN]; 3] }
+    /// A grid over `bounds` (lower and upper corners, m) for `capacity` grains, whose cells are
+    /// at least `cell` (m) wide.
+    fn new(bounds: [[f64; 3]; 2], cell: f64, capacity: usize) -> Self {
+        let extent: Vec<f64> = (0..3).map(|a| (bounds[1][a] - bounds[0][a]).max(0.0)).collect();
+        let volume: f64 = extent.iter().map(|e| e + cell).product();
+        let cell = cell.max((volume / (CELLS_PER_GRAIN * capacity.max(1) as f64)).cbrt());
+        let dims = [0, 1, 2].map(|a| (extent[a] / cell).floor() as i64 + 1);
+        let cells = dims.iter().product::<i64>() as usize;
+        PlacementGrid { cell, origin: bounds[0], dims, head: vec![NONE; cells], next: Vec::with_capacity(capacity), occupied: [[i64::MAX, i64::MIN]; 3] }
     }
     fn key(&self, p: [f64; 3]) -> [i64; 3] {
-        [(p[0] / self.cell).floor() as i64, (p[1] / self.cell).floor() as i64, (p[2] / self.cell).floor() as i64]
+        [0, 1, 2].map(|a| ((p[a] - self.origin[a]) / self.cell).floor() as i64)
     }
+    /// The index of cell `k`, or `None` outside the grid.
+    fn index(&self, k: [i64; 3]) -> Option<usize> {
+        (0..3).all(|a| (0..self.dims[a]).contains(&k[a])).then(|| ((k[2] * self.dims[1] + k[1]) * self.dims[0] + k[0]) as usize)
+    }
+    /// Adds grain `i`, the next grain (grains are added in order), at `p`, inside the grid.
     fn insert(&mut self, i: u32, p: [f64; 3]) {
+        debug_assert_eq!(i as usize, self.next.len(), "grains are added in order");
         let k = self.key(p);
+        let c = self.index(k).expect("a placed grain lies inside the grid's bounds");
         for (range, &k) in self.occupied.iter_mut().zip(&k) {
             *range = [range[0].min(k), range[1].max(k)];
         }
-        self.cells.entry(k).or_default().push(i);
+        self.next.push(self.head[c]);
+        self.head[c] = i;
     }
     /// True when a sphere at `p` of radius `r` overlaps a placed grain, or a periodic image
     /// of one. Correct while `r` and every placed radius are at most `cell / 2`.
     fn overlaps(&self, grains: &Grains, p: [f64; 3], r: f64, periodic: &[Option<[f64; 2]>; 3]) -> bool {
+        // Each axis' image shifts: none, or one period up and one down.
         let shifts = |a: usize| match periodic[a] {
-            Some([lo, hi]) => vec![0.0, hi - lo, lo - hi],
-            None => vec![0.0],
+            Some([lo, hi]) => ([0.0, hi - lo, lo - hi], 3),
+            None => ([0.0; 3], 1),
         };
-        for sx in shifts(0) {
-            for sy in shifts(1) {
-                for sz in shifts(2) {
-                    if self.overlaps_here(grains, [p[0] + sx, p[1] + sy, p[2] + sz], r) {
+        let [(sx, nx), (sy, ny), (sz, nz)] = [shifts(0), shifts(1), shifts(2)];
+        for &dx in &sx[..nx] {
+            for &dy in &sy[..ny] {
+                for &dz in &sz[..nz] {
+                    if self.overlaps_here(grains, [p[0] + dx, p[1] + dy, p[2] + dz], r) {
                         return true;
                     }
                 }
@@ -59,23 +91,40 @@ impl PlacementGrid {
         if (0..3).any(|a| k[a] + 1 < self.occupied[a][0] || k[a] - 1 > self.occupied[a][1]) {
             return false;
         }
-        for dx in -1..=1 {
+        for dz in -1..=1 {
             for dy in -1..=1 {
-                for dz in -1..=1 {
-                    let Some(list) = self.cells.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) else { continue };
-                    for &j in list {
+                for dx in -1..=1 {
+                    let Some(c) = self.index([k[0] + dx, k[1] + dy, k[2] + dz]) else { continue };
+                    let mut j = self.head[c];
+                    while j != NONE {
                         let q = grains.position[j as usize];
                         let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
                         let s = r + grains.radius[j as usize];
                         if d2 < s * s {
                             return true;
                         }
+                        j = self.next[j as usize];
                     }
                 }
             }
         }
         false
     }
+}
+
+/// The lower and upper corners of a box holding `region` and every grain of `grains` (m).
+fn bounds_of(region: &RegionSpec, grains: &Grains) -> [[f64; 3]; 2] {
+    let mut b = match *region {
+        RegionSpec::Box { min, max } => [min, max],
+        RegionSpec::Cylinder { center, radius, z_min, z_max } => [[center[0] - radius, center[1] - radius, z_min], [center[0] + radius, center[1] + radius, z_max]],
+    };
+    for p in &grains.position {
+        for a in 0..3 {
+            b[0][a] = b[0][a].min(p[a]);
+            b[1][a] = b[1][a].max(p[a]);
+        }
+    }
+    b
 }
 
 /// Places generator `k`'s grains into `grains` (after those already there).
@@ -104,7 +153,7 @@ pub(super) fn place(
         return Err(c.invalid(key("random_speed"), spec.random_speed, "must be zero or positive", "give a speed in m/s"));
     }
     let r_max_all = grains.radius.iter().copied().fold(0.5 * d.max, f64::max);
-    let mut grid = PlacementGrid::new(2.0 * r_max_all);
+    let mut grid = PlacementGrid::new(bounds_of(&spec.region, grains), 2.0 * r_max_all, grains.len() + spec.count);
     for i in 0..grains.len() {
         grid.insert(i as u32, grains.position[i]);
     }
@@ -216,7 +265,7 @@ mod tests {
         let periodic = [Some([0.0, side]), Some([0.0, side]), None];
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let mut grains = Grains::default();
-        let mut grid = PlacementGrid::new(2.0 * r);
+        let mut grid = PlacementGrid::new([[0.0; 3], [side, side, height]], 2.0 * r, 150);
         for _ in 0..150 {
             let p = [rng.random_range(0.0..side), rng.random_range(0.0..side), rng.random_range(0.0..height)];
             grid.insert(grains.len() as u32, p);
