@@ -1,5 +1,6 @@
 // One invocation counts the pairs one grain owns (partners of higher id within reach) and
-// flags a grain over the neighbour capacity.
+// flags a grain over the neighbour capacity. It also clears the grain's counter for
+// reverse_fill: rev_fill lives in cell_fill's buffer, which scatter_cells uses until then.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> residual: array<vec4<f32>>;
@@ -7,6 +8,7 @@
 @group(0) @binding(4) var<storage, read> cell_grains: array<u32>;
 @group(0) @binding(5) var<storage, read_write> pair_start: array<u32>;
 @group(0) @binding(6) var<storage, read_write> control: Control;
+@group(0) @binding(7) var<storage, read_write> rev_fill: array<u32>;
 
 @compute @workgroup_size(64)
 fn detect_count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -14,6 +16,7 @@ fn detect_count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
     if (i >= params.n_grains) {
         return;
     }
+    rev_fill[i] = 0u;
     let pi = pos[i];
     let b = neighbour_buckets(pi.xyz);
     var count = 0u;

@@ -10,7 +10,6 @@
 @group(0) @binding(7) var<storage, read_write> control: Control;
 @group(0) @binding(8) var<storage, read_write> pair_start: array<u32>;
 @group(0) @binding(9) var<storage, read_write> rev_start: array<u32>;
-@group(0) @binding(10) var<storage, read_write> rev_fill: array<u32>;
 
 @compute @workgroup_size(64)
 fn hash_cells(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
@@ -23,7 +22,6 @@ fn hash_cells(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
         return;
     }
     rev_start[i] = 0u;
-    rev_fill[i] = 0u;
     var p = pos[i];
     var r = residual[i];
     if (any(p.xyz != p.xyz) || any(abs(p.xyz) > vec3<f32>(3.0e38))) {

@@ -38,10 +38,10 @@ pub const SUBMITS_PER_CHECK: u64 = 32;
 
 /// Buffers a checkpoint leaves out: the scene's constants (set up again from the scene) and
 /// scratch space every step or statistics read rewrites before reading it.
-const NOT_STATE: [&str; 18] = [
+const NOT_STATE: [&str; 17] = [
     "params", "phase", "material", "coeffs", // constants
     "cell_of", "cell_grains", "cell_count", "cell_fill", "hash_sums", "grain_sums", "spare_sum", // the hash grid
-    "old_start", "rev_fill", "bridge_event", // rebuild and bridge scratch
+    "old_start", "bridge_event", // rebuild and bridge scratch
     "wall_partials", "grain_rows", "pair_rows", "stats", // reductions
 ];
 
@@ -50,8 +50,10 @@ const NOT_STATE: [&str; 18] = [
 /// are rewritten: `rev_pair` (rewritten by the rebuild's `reverse_fill`) and the pair force
 /// records (rewritten by the force evaluation every plan runs after a rebuild, and read only
 /// after it). The replaced list needs no buffers of its own: 20 bytes per pair of capacity on
-/// a dry bed, 36 with rolling springs.
-const REBUILD_SCRATCH: [(&str, &str); 4] = [("old_j", "rev_pair"), ("old_hist0", "out_fi"), ("old_hist1", "out_tj"), ("old_hist2", "out_ti")];
+/// a dry bed, 36 with rolling springs. Likewise `reverse_fill`'s per-grain counters sit in
+/// `cell_fill` (hash buckets, at least one per grain), dead once `scatter_cells` has run;
+/// `detect_count` clears them.
+const REBUILD_SCRATCH: [(&str, &str); 5] = [("old_j", "rev_pair"), ("old_hist0", "out_fi"), ("old_hist1", "out_tj"), ("old_hist2", "out_ti"), ("rev_fill", "cell_fill")];
 
 /// Why the GPU engine refused a scene.
 #[derive(Debug, thiserror::Error)]
@@ -320,7 +322,6 @@ impl GpuEngine {
         for name in ["pair_start", "old_start", "rev_start"] {
             zeroed(name, 4 * (n + 1));
         }
-        zeroed("rev_fill", 4 * n);
         let wall_hist = if hist_blocks > 0 { 16 * n * scene.walls.len() as u64 * hist_blocks } else { 16 };
         zeroed("wall_hist", wall_hist);
         // Per wall: the reaction, then the contacts' stiffness and damping (servo walls).
