@@ -25,57 +25,89 @@ fn every_kernel_parses_and_validates() {
     }
 }
 
+/// The global variable a pointer expression of `f` goes through, if any.
+fn root(f: &naga::Function, mut e: naga::Handle<naga::Expression>) -> Option<naga::Handle<naga::GlobalVariable>> {
+    loop {
+        match f.expressions[e] {
+            naga::Expression::Access { base, .. } | naga::Expression::AccessIndex { base, .. } => e = base,
+            naga::Expression::GlobalVariable(g) => return Some(g),
+            _ => return None,
+        }
+    }
+}
+
+/// Every statement of `block`, nested blocks included.
+fn each_statement(block: &naga::Block, visit: &mut impl FnMut(&naga::Statement)) {
+    for st in block.iter() {
+        visit(st);
+        match st {
+            naga::Statement::Block(b) => each_statement(b, visit),
+            naga::Statement::If { accept, reject, .. } => {
+                each_statement(accept, visit);
+                each_statement(reject, visit);
+            }
+            naga::Statement::Loop { body, continuing, .. } => {
+                each_statement(body, visit);
+                each_statement(continuing, visit);
+            }
+            naga::Statement::Switch { cases, .. } => cases.iter().for_each(|c| each_statement(&c.body, visit)),
+            _ => {}
+        }
+    }
+}
+
+/// Every function of `m`, entry points included.
+fn functions(m: &naga::Module) -> impl Iterator<Item = &naga::Function> {
+    m.functions.iter().map(|(_, f)| f).chain(m.entry_points.iter().map(|e| &e.function))
+}
+
 /// The global variables some function of `m` loads from (reads, or reads and modifies with an
 /// atomic): the root of every pointer a `Load` or an atomic goes through. Functions the kernel
 /// never calls count too, so a binding they load is taken as loaded (the safe side).
 fn loaded_globals(m: &naga::Module) -> std::collections::HashSet<naga::Handle<naga::GlobalVariable>> {
-    fn root(f: &naga::Function, mut e: naga::Handle<naga::Expression>) -> Option<naga::Handle<naga::GlobalVariable>> {
-        loop {
-            match f.expressions[e] {
-                naga::Expression::Access { base, .. } | naga::Expression::AccessIndex { base, .. } => e = base,
-                naga::Expression::GlobalVariable(g) => return Some(g),
-                _ => return None,
-            }
-        }
-    }
-    fn atomics(f: &naga::Function, block: &naga::Block, out: &mut std::collections::HashSet<naga::Handle<naga::GlobalVariable>>) {
-        for st in block.iter() {
-            match st {
-                naga::Statement::Atomic { pointer, .. } => out.extend(root(f, *pointer)),
-                naga::Statement::Block(b) => atomics(f, b, out),
-                naga::Statement::If { accept, reject, .. } => {
-                    atomics(f, accept, out);
-                    atomics(f, reject, out);
-                }
-                naga::Statement::Loop { body, continuing, .. } => {
-                    atomics(f, body, out);
-                    atomics(f, continuing, out);
-                }
-                naga::Statement::Switch { cases, .. } => cases.iter().for_each(|c| atomics(f, &c.body, out)),
-                _ => {}
-            }
-        }
-    }
     let mut out = std::collections::HashSet::new();
-    for f in m.functions.iter().map(|(_, f)| f).chain(m.entry_points.iter().map(|e| &e.function)) {
+    for f in functions(m) {
         for (_, e) in f.expressions.iter() {
             if let naga::Expression::Load { pointer } = e {
                 out.extend(root(f, *pointer));
             }
         }
-        atomics(f, &f.body, &mut out);
+        each_statement(&f.body, &mut |st| {
+            if let naga::Statement::Atomic { pointer, .. } = st {
+                out.extend(root(f, *pointer));
+            }
+        });
+    }
+    out
+}
+
+/// The global variables some function of `m` stores to.
+fn stored_globals(m: &naga::Module) -> std::collections::HashSet<naga::Handle<naga::GlobalVariable>> {
+    let mut out = std::collections::HashSet::new();
+    for f in functions(m) {
+        each_statement(&f.body, &mut |st| {
+            if let naga::Statement::Store { pointer, .. } = st {
+                out.extend(root(f, *pointer));
+            }
+        });
     }
     out
 }
 
 /// Each kernel's bindings in the table as its shader declares them, in order, with their use:
 /// a read-write binding that no function loads is `Write` (the traffic count takes it once),
-/// one that some function loads is `ReadWrite`.
+/// one that some function loads is `ReadWrite`; every storage binding is loaded or stored.
 #[test]
 fn the_kernel_table_matches_each_shaders_bindings() {
     for k in KERNELS.iter().chain(CD_KERNELS) {
         let m = module(&k.wgsl(), k.name);
         let loaded = loaded_globals(&m);
+        let stored = stored_globals(&m);
+        // A storage binding no function loads or stores would be bound and counted as traffic
+        // for nothing (or, as once, a clear someone forgot); uniforms are bound by convention.
+        for (h, v) in m.global_variables.iter().filter(|(_, v)| v.binding.is_some() && matches!(v.space, naga::AddressSpace::Storage { .. })) {
+            assert!(loaded.contains(&h) || stored.contains(&h), "{}: storage binding {:?} is declared but never loaded or stored", k.name, v.name);
+        }
         let mut declared: Vec<(u32, String, Access)> = m
             .global_variables
             .iter()
