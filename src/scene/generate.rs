@@ -53,9 +53,10 @@ impl PlacementGrid {
     fn index(&self, k: [i64; 3]) -> Option<usize> {
         (0..3).all(|a| (0..self.dims[a]).contains(&k[a])).then(|| ((k[2] * self.dims[1] + k[1]) * self.dims[0] + k[0]) as usize)
     }
-    /// Adds grain `i`, the next grain (grains are added in order), at `p`, inside the grid.
-    fn insert(&mut self, i: u32, p: [f64; 3]) {
-        debug_assert_eq!(i as usize, self.next.len(), "grains are added in order");
+    /// Adds the next grain (grains are added in id order, so its id is the count so far) at
+    /// `p`, inside the grid.
+    fn insert(&mut self, p: [f64; 3]) {
+        let i = self.next.len() as u32;
         let k = self.key(p);
         let c = self.index(k).expect("a placed grain lies inside the grid's bounds");
         for (range, &k) in self.occupied.iter_mut().zip(&k) {
@@ -154,8 +155,8 @@ pub(super) fn place(
     }
     let r_max_all = grains.radius.iter().copied().fold(0.5 * d.max, f64::max);
     let mut grid = PlacementGrid::new(bounds_of(&spec.region, grains), 2.0 * r_max_all, grains.len() + spec.count);
-    for i in 0..grains.len() {
-        grid.insert(i as u32, grains.position[i]);
+    for &p in &grains.position {
+        grid.insert(p);
     }
     // One stream per generator so that adding a generator leaves the others unchanged.
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(k as u64 + 1)));
@@ -187,7 +188,7 @@ pub(super) fn place(
                 v[a] += spec.random_speed * dir[a];
             }
         }
-        grid.insert(grains.len() as u32, p);
+        grid.insert(p);
         grains.push(r, sphere_mass(r, density), p, v, [0.0; 3], material);
         solid += 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
     }
@@ -268,7 +269,7 @@ mod tests {
         let mut grid = PlacementGrid::new([[0.0; 3], [side, side, height]], 2.0 * r, 150);
         for _ in 0..150 {
             let p = [rng.random_range(0.0..side), rng.random_range(0.0..side), rng.random_range(0.0..height)];
-            grid.insert(grains.len() as u32, p);
+            grid.insert(p);
             grains.push(r, 1.0, p, [0.0; 3], [0.0; 3], 0);
         }
         let brute = |p: [f64; 3], rq: f64| {
