@@ -1,61 +1,160 @@
-// One invocation sums the load on one grain in a fixed order: gravity, the pairs it owns,
-// the pairs where it is partner, its wall contacts. No float atomics. force.w counts the
-// grain's pairs that push (f_n > 0), for the statistics' rattlers. With phase.kick > 0 it
-// then kicks the grain (and invocation 0 the piston) under that load: the kick after an
-// evaluation, in the same dispatch. A partner's force is out_fj where the pair pass stores it
-// (PARTNER_FORCE_STORED), else the owner's reversed: subtracting out_fi adds the same bits.
+// One invocation sums the load on one grain in a fixed order: gravity, the pairs it owns, the
+// pairs where it is partner, then its contacts with every wall (the grain-grain laws with an
+// infinite partner; their springs advance here). No float atomics. Each workgroup sums the
+// forces its grains put on each wall (row entries 0..MAX_WALLS: xyz force, w contacts as u32
+// bits) and, for servo walls (WALL_RESPONSE), their contacts' normal tangent stiffness and
+// damping coefficient (entries MAX_WALLS..: x N/m, y N s/m), which wall_reduce totals. For the
+// statistics, force.w packs the grain's pairs that push (f_n > 0) with its wall contacts
+// sliding and rolling (WALL_COUNTS_*), torque.w is the magnitude of its wall force. With
+// phase.kick > 0 it then kicks the grain under that load: the kick after an evaluation, in the
+// same dispatch (the piston's waits for wall_reduce). A partner's force is out_fj where the
+// pair pass stores it (PARTNER_FORCE_STORED), else the owner's reversed: subtracting out_fi
+// adds the same bits.
 override PARTNER_FORCE_STORED: bool;
+override WALL_RESPONSE: bool = false;
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read_write> vel: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> pair_start: array<u32>;
-@group(0) @binding(3) var<storage, read> rev_start: array<u32>;
-@group(0) @binding(4) var<storage, read> rev_pair: array<u32>;
-@group(0) @binding(5) var<storage, read> out_fi: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read> out_fj: array<vec4<f32>>;
-@group(0) @binding(7) var<storage, read> out_ti: array<vec4<f32>>;
-@group(0) @binding(8) var<storage, read> out_tj: array<vec4<f32>>;
-@group(0) @binding(9) var<storage, read> wall_force: array<vec4<f32>>;
-@group(0) @binding(10) var<storage, read> wall_torque: array<vec4<f32>>;
-@group(0) @binding(11) var<storage, read_write> force: array<vec4<f32>>;
-@group(0) @binding(12) var<storage, read_write> torque: array<vec4<f32>>;
-@group(0) @binding(13) var<uniform> phase: Phase;
-@group(0) @binding(14) var<storage, read_write> omega: array<vec4<f32>>;
-@group(0) @binding(15) var<storage, read_write> walls: array<Wall>;
-@group(0) @binding(16) var<storage, read> wall_reaction: array<vec4<f32>>;
+@group(0) @binding(1) var<uniform> phase: Phase;
+@group(0) @binding(2) var<storage, read_write> vel: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> omega: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read> pair_start: array<u32>;
+@group(0) @binding(5) var<storage, read> rev_start: array<u32>;
+@group(0) @binding(6) var<storage, read> rev_pair: array<u32>;
+@group(0) @binding(7) var<storage, read> out_fi: array<vec4<f32>>;
+@group(0) @binding(8) var<storage, read> out_fj: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read> out_ti: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read> out_tj: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read> pos: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read> residual: array<vec4<f32>>;
+@group(0) @binding(13) var<storage, read> material: array<u32>;
+@group(0) @binding(14) var<storage, read> coeffs: array<PairCoeffs>;
+@group(0) @binding(15) var<storage, read> walls: array<Wall>;
+@group(0) @binding(16) var<storage, read_write> wall_hist: array<vec4<f32>>;
+@group(0) @binding(17) var<storage, read_write> wall_partials: array<vec4<f32>>;
+@group(0) @binding(18) var<storage, read_write> force: array<vec4<f32>>;
+@group(0) @binding(19) var<storage, read_write> torque: array<vec4<f32>>;
+
+var<workgroup> reaction: array<vec4<f32>, 512>; // WG x MAX_WALLS
+
+// A grain's load from the walls and what the statistics count of it.
+struct WallLoad {
+    force: vec3<f32>,
+    torque: vec3<f32>,
+    sliding: u32,
+    rolling: u32,
+}
 
 @compute @workgroup_size(64)
 fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat_index(wid, lid, nwg);
-    if (i == 0u && params.piston != NONE && phase.kick > 0.0) {
-        kick_piston(phase.kick);
-    }
-    if (i >= params.n_grains) {
-        return;
-    }
-    var f = params.gravity.xyz * vel[i].w;
+    let live = i < params.n_grains;
+    var f = vec3<f32>(0.0);
     var t = vec3<f32>(0.0);
     var pushing = 0.0;
-    let end = min(pair_start[i + 1u], params.pair_capacity);
-    for (var k = pair_start[i]; k < end; k++) {
-        f += out_fi[k].xyz;
-        t += out_ti[k].xyz;
-        pushing += select(0.0, 1.0, out_fi[k].w > 0.0);
-    }
-    for (var s = rev_start[i]; s < rev_start[i + 1u]; s++) {
-        let k = rev_pair[s];
-        if (PARTNER_FORCE_STORED) {
-            f += out_fj[k].xyz;
-        } else {
-            f -= out_fi[k].xyz;
+    if (live) {
+        f = params.gravity.xyz * vel[i].w;
+        let end = min(pair_start[i + 1u], params.pair_capacity);
+        for (var k = pair_start[i]; k < end; k++) {
+            f += out_fi[k].xyz;
+            t += out_ti[k].xyz;
+            pushing += select(0.0, 1.0, out_fi[k].w > 0.0);
         }
-        t += out_tj[k].xyz;
-        pushing += select(0.0, 1.0, out_fi[k].w > 0.0);
+        for (var s = rev_start[i]; s < rev_start[i + 1u]; s++) {
+            let k = rev_pair[s];
+            if (PARTNER_FORCE_STORED) {
+                f += out_fj[k].xyz;
+            } else {
+                f -= out_fi[k].xyz;
+            }
+            t += out_tj[k].xyz;
+            pushing += select(0.0, 1.0, out_fi[k].w > 0.0);
+        }
     }
-    let load = f + wall_force[i].xyz;
-    let moment = t + wall_torque[i].xyz;
-    force[i] = vec4<f32>(load, pushing);
-    torque[i] = vec4<f32>(moment, 0.0);
+    var w = WallLoad(vec3<f32>(0.0), vec3<f32>(0.0), 0u, 0u);
+    // (A uniform branch: every invocation of the workgroup reaches the reduction's barriers.)
+    if (params.n_walls > 0u) {
+        w = wall_loads(i, live, lid, (wid.y * nwg.x + wid.x) * 2u * MAX_WALLS);
+    }
+    if (!live) {
+        return;
+    }
+    let load = f + w.force;
+    let moment = t + w.torque;
+    force[i] = vec4<f32>(load, f32(u32(pushing) + w.sliding * WALL_COUNTS_SLIDING + w.rolling * WALL_COUNTS_ROLLING));
+    torque[i] = vec4<f32>(moment, length(w.force));
     if (phase.kick > 0.0) {
         kick_grain(i, load, moment, phase.kick);
     }
+}
+
+// Grain i's contacts with every wall (when live), their springs advanced; the workgroup's sums
+// on each wall go to wall_partials[row..].
+fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
+    var out = WallLoad(vec3<f32>(0.0), vec3<f32>(0.0), 0u, 0u);
+    var response: array<vec2<f32>, MAX_WALLS>;
+    for (var w = 0u; w < MAX_WALLS; w++) {
+        response[w] = vec2<f32>(0.0);
+        reaction[lid * MAX_WALLS + w] = vec4<f32>(0.0);
+    }
+    if (live) {
+        let p = pos[i];
+        let v = vel[i];
+        let om = omega[i];
+        for (var w = 0u; w < params.n_walls; w++) {
+            let wall = walls[w];
+            let base = (i * params.n_walls + w) * params.hist_blocks;
+            let frame = wall_frame(wall, p.xyz, residual[i]);
+            if (frame.w >= p.w) {
+                for (var b = 0u; b < params.hist_blocks; b++) { wall_hist[base + b] = vec4<f32>(0.0); }
+                continue;
+            }
+            let g = geometry_grain_wall(frame.xyz, frame.w, p.w, v.w);
+            let kin = Kinematics(v.xyz, wall.velocity.xyz, om.xyz, vec3<f32>(0.0));
+            let bodies = Bodies(v.w, om.w, 0.0, 0.0, true);
+            let c = coeffs[wall.material * params.n_materials + material[i]];
+            // Walls are not wetted: their contacts keep springs only.
+            var h = empty_history();
+            var b = base;
+            if (HAS_TANGENTIAL_HISTORY) { h.tangential = wall_hist[b].xyz; h.sliding = wall_hist[b].w != 0.0; b += 1u; }
+            if (HAS_ROLLING_HISTORY) { h.rolling = wall_hist[b].xyz; }
+            let f = contact_force(c, g, kin, bodies, &h, phase.elapsed);
+            b = base;
+            if (HAS_TANGENTIAL_HISTORY) { wall_hist[b] = vec4<f32>(h.tangential, select(0.0, 1.0, h.sliding)); b += 1u; }
+            if (HAS_ROLLING_HISTORY) { wall_hist[b] = vec4<f32>(h.rolling, 0.0); }
+            out.force += f.f_i;
+            out.torque += f.t_i;
+            reaction[lid * MAX_WALLS + w] = vec4<f32>(-f.f_i, bitcast<f32>(1u));
+            out.sliding += select(0u, 1u, f.regime == REGIME_SLIDING);
+            out.rolling += select(0u, 1u, f.regime == REGIME_ROLLING);
+            if (WALL_RESPONSE) {
+                response[w] = vec2<f32>(normal_stiffness(c, g), normal_damping(c, g));
+            }
+        }
+    }
+    reduce_walls(lid, row);
+    if (WALL_RESPONSE) {
+        for (var w = 0u; w < MAX_WALLS; w++) {
+            reaction[lid * MAX_WALLS + w] = vec4<f32>(response[w], 0.0, 0.0);
+        }
+        reduce_walls(lid, row + MAX_WALLS);
+    }
+    return out;
+}
+
+// Sums `reaction` over the workgroup's lanes by a fixed-order tree into wall_partials[at..].
+fn reduce_walls(lid: u32, at: u32) {
+    workgroupBarrier();
+    for (var stride = WG / 2u; stride > 0u; stride /= 2u) {
+        if (lid < stride) {
+            for (var w = 0u; w < MAX_WALLS; w++) {
+                reaction[lid * MAX_WALLS + w] = add_wall_row(reaction[lid * MAX_WALLS + w], reaction[(lid + stride) * MAX_WALLS + w]);
+            }
+        }
+        workgroupBarrier();
+    }
+    if (lid == 0u) {
+        for (var w = 0u; w < MAX_WALLS; w++) {
+            wall_partials[at + w] = reaction[w];
+        }
+    }
+    workgroupBarrier();
 }

@@ -7,14 +7,13 @@
 @group(0) @binding(2) var<storage, read> residual: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> vel: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> omega: array<vec4<f32>>;
-@group(0) @binding(5) var<storage, read> force: array<vec4<f32>>; // w: pushing pairs
-@group(0) @binding(6) var<storage, read> wall_force: array<vec4<f32>>;
-@group(0) @binding(7) var<storage, read> wall_torque: array<vec4<f32>>;
-@group(0) @binding(8) var<storage, read> image: array<vec4<i32>>;
-@group(0) @binding(9) var<storage, read> material: array<u32>;
-@group(0) @binding(10) var<storage, read> coeffs: array<PairCoeffs>;
-@group(0) @binding(11) var<storage, read> walls: array<Wall>;
-@group(0) @binding(12) var<storage, read_write> grain_rows: array<f32>;
+@group(0) @binding(5) var<storage, read> force: array<vec4<f32>>; // w: pushing pairs and wall contacts' regimes (gather)
+@group(0) @binding(6) var<storage, read> torque: array<vec4<f32>>; // w: |wall force|
+@group(0) @binding(7) var<storage, read> image: array<vec4<i32>>;
+@group(0) @binding(8) var<storage, read> material: array<u32>;
+@group(0) @binding(9) var<storage, read> coeffs: array<PairCoeffs>;
+@group(0) @binding(10) var<storage, read> walls: array<Wall>;
+@group(0) @binding(11) var<storage, read_write> grain_rows: array<f32>;
 
 var<workgroup> row: array<f32, WG * STAT_ROW>;
 
@@ -42,10 +41,11 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         row[r + G_ANGULAR] = l.x;
         row[r + G_ANGULAR + 1u] = l.y;
         row[r + G_ANGULAR + 2u] = l.z;
-        row[r + G_WALL_FORCE] = length(wall_force[i].xyz);
-        row[r + G_WALL_SLIDING] = count_field(u32(wall_force[i].w));
-        row[r + G_WALL_ROLLING] = count_field(u32(wall_torque[i].w));
-        var contacts = force[i].w;
+        let counts = u32(force[i].w);
+        row[r + G_WALL_FORCE] = torque[i].w;
+        row[r + G_WALL_SLIDING] = count_field((counts / WALL_COUNTS_SLIDING) % (WALL_COUNTS_ROLLING / WALL_COUNTS_SLIDING));
+        row[r + G_WALL_ROLLING] = count_field(counts / WALL_COUNTS_ROLLING);
+        var contacts = f32(counts % WALL_COUNTS_SLIDING);
         var wall_contacts = 0u;
         for (var k = 0u; k < params.n_walls; k++) {
             let frame = wall_frame(walls[k], p.xyz, residual[i]);

@@ -1,9 +1,13 @@
 // One workgroup sums the per-workgroup wall rows in a fixed order into each wall's totals:
 // entries 0..MAX_WALLS (xyz: force the grains exert, w: contacts, u32 bits), then MAX_WALLS.. (the
-// contacts' summed stiffness and damping, for servo walls; zero otherwise).
+// contacts' summed stiffness and damping, for servo walls; zero otherwise). With phase.kick > 0
+// it then kicks the piston under those totals: the kick after an evaluation, whose grains the
+// gather kicked.
 @group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read> wall_partials: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read_write> wall_reaction: array<vec4<f32>>;
+@group(0) @binding(1) var<uniform> phase: Phase;
+@group(0) @binding(2) var<storage, read> wall_partials: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> wall_reaction: array<vec4<f32>>;
+@group(0) @binding(4) var<storage, read_write> walls: array<Wall>;
 
 var<workgroup> acc: array<vec4<f32>, 512>;
 
@@ -11,6 +15,10 @@ var<workgroup> acc: array<vec4<f32>, 512>;
 fn wall_reduce(@builtin(local_invocation_index) lid: u32) {
     for (var half = 0u; half < 2u; half++) {
         reduce_half(lid, half * MAX_WALLS);
+    }
+    // Invocation 0 wrote the totals it reads.
+    if (lid == 0u && params.piston != NONE && phase.kick > 0.0) {
+        kick_piston(phase.kick);
     }
 }
 

@@ -2,8 +2,9 @@
 //! includes, and its bindings in binding order. The GPU engine builds its pipelines and bind
 //! groups from it; `tests/shaders.rs` checks it against naga's reflection of each shader.
 //! The CPU engine's twins carry the same names (`src/cpu/`: `hash_cells`, `detect_pairs`,
-//! `remap_history`, `pair_force`, `wall_contacts`, `gather`, `integrate::{kick, drift}`, which the
-//! GPU's `integrate` runs as one dispatch when a kick is followed by a drift);
+//! `remap_history`, `pair_force`, `wall_contacts`, `gather`, `integrate::{kick, drift}`; the
+//! GPU's `integrate` runs a kick and the drift after it as one dispatch, and its `gather` the
+//! wall contacts, as the CPU's gather sweep does);
 //! the GPU-only kernels (scans, scatter, reverse list, reductions) are what a CPU does
 //! serially in a loop.
 
@@ -47,6 +48,7 @@ pub fn shared(name: &str) -> &'static str {
         "walls" => include_str!("../shaders/shared/walls.wgsl"),
         "reduce" => include_str!("../shaders/shared/reduce.wgsl"),
         "kick" => include_str!("../shaders/shared/kick.wgsl"),
+        "piston" => include_str!("../shaders/shared/piston.wgsl"),
         "position" => include_str!("../shaders/shared/position.wgsl"),
         "cd" => include_str!("../shaders/shared/cd.wgsl"),
         other => panic!("no shared WGSL file {other}"),
@@ -69,12 +71,12 @@ impl Kernel {
 use Access::{Phase, Read, ReadWrite, Uniform, Write};
 
 const BASE: &[&str] = &["types", "dispatch"];
-const KICK: &[&str] = &["types", "dispatch", "kick"];
-const INTEGRATE: &[&str] = &["types", "dispatch", "kick", "position"];
+const PISTON: &[&str] = &["types", "dispatch", "piston"];
+const INTEGRATE: &[&str] = &["types", "dispatch", "kick", "piston", "position"];
 const GRID: &[&str] = &["types", "dispatch", "position", "grid"];
 const DETECT: &[&str] = &["types", "dispatch", "position", "grid", "neighbours"];
 const FORCES: &[&str] = &["types", "dispatch", "position", "grid", "model"];
-const WALLS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls"];
+const GATHER: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "kick"];
 const CD: &[&str] = &["types", "dispatch", "cd"];
 const STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "reduce"];
 
@@ -106,10 +108,9 @@ pub const KERNELS: &[Kernel] = &[
     kernel!("find_bridge_events", FORCES, ["params": Uniform, "pos": Read, "residual": Read, "pair_i": Read, "pair_j": Read, "hist": Read, "bridge_event": Write, "control": Read]),
     kernel!("update_bridges", FORCES, ["params": Uniform, "pair_i": Read, "pair_j": Read, "bridge_event": Read, "hist": ReadWrite, "liquid": ReadWrite, "control": Read]),
     kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": Write, "out_fj": Write, "out_ti": Write, "out_tj": Write, "control": Read]),
-    kernel!("wall_contacts", WALLS, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_force": Write, "wall_torque": Write, "wall_partials": Write]),
-    kernel!("wall_reduce", BASE, ["params": Uniform, "wall_partials": Read, "wall_reaction": Write]),
-    kernel!("gather", KICK, ["params": Uniform, "vel": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "wall_force": Read, "wall_torque": Read, "force": Write, "torque": Write, "phase": Phase, "omega": ReadWrite, "walls": ReadWrite, "wall_reaction": Read]),
-    kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "wall_force": Read, "wall_torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": Write]),
+    kernel!("gather", GATHER, ["params": Uniform, "phase": Phase, "vel": ReadWrite, "omega": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_partials": Write, "force": Write, "torque": Write]),
+    kernel!("wall_reduce", PISTON, ["params": Uniform, "phase": Phase, "wall_partials": Read, "wall_reaction": ReadWrite, "walls": ReadWrite]),
+    kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": Write]),
     kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_ti": Read, "control": Read, "pair_rows": Write]),
     kernel!("reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": Write]),
 ];

@@ -169,6 +169,18 @@ fn pair_force_wall_contacts_and_gather_match_the_cpu_twins() {
         println!("periodic {periodic}: gpu {} sliding, {} rolling; cpu {} sliding, {} rolling", sg.sliding, sg.rolling, sc.sliding, sc.rolling);
         assert!(sc.sliding > 0 && sc.rolling > 0, "the gas slides and rolls");
         assert_eq!((sg.sliding, sg.rolling), (sc.sliding, sc.rolling), "contacts per regime");
+        // What the gather leaves for the statistics beside each load (the pairs that push it,
+        // its wall contacts' regimes, its wall force): the rattlers and the unbalanced force,
+        // whose mean contact force counts the walls' contacts.
+        println!(
+            "periodic {periodic}: wall contacts gpu {} cpu {}, rattlers {} / {}, unbalanced force {:.6e} / {:.6e}, loaded grains {:.6e} / {:.6e}",
+            sg.wall_contacts, sc.wall_contacts, sg.rattlers, sc.rattlers, sg.unbalanced_force, sc.unbalanced_force, sg.unbalanced_force_loaded, sc.unbalanced_force_loaded
+        );
+        assert!(periodic || sc.wall_contacts > 0, "the walls hold grains");
+        assert_eq!((sg.wall_contacts, sg.rattlers), (sc.wall_contacts, sc.rattlers));
+        for (a, b) in [(sg.unbalanced_force, sc.unbalanced_force), (sg.unbalanced_force_loaded, sc.unbalanced_force_loaded)] {
+            assert!((a - b).abs() <= F32_STATS_TOLERANCE * b.abs(), "unbalanced force: gpu {a:e} cpu {b:e}");
+        }
     }
 }
 

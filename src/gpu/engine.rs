@@ -308,7 +308,7 @@ impl GpuEngine {
             buffers.insert(name, b);
         };
         let v = 16 * n;
-        for name in ["force", "torque", "built_at", "wall_force", "wall_torque"] {
+        for name in ["force", "torque", "built_at"] {
             zeroed(name, v);
         }
         zeroed("image", if periodic { v } else { 16 });
@@ -421,8 +421,8 @@ impl GpuEngine {
             let mut constants: Vec<(&str, f64)> = if k.includes.contains(&"model") { model_constants.to_vec() } else { Vec::new() };
             match k.name {
                 "integrate" => constants.push(orientation),
-                "wall_contacts" => constants.push(wall_response),
-                "pair_force" | "gather" => constants.push(partner_force),
+                "pair_force" => constants.push(partner_force),
+                "gather" => constants.extend([partner_force, wall_response]),
                 _ => {}
             }
             let (layout, pipeline) = super::pipeline::compute_pipeline(&self.gpu.device, k, &constants);

@@ -13,8 +13,8 @@ pub enum Dispatch {
     Integrate,
     /// `decide_rebuild` and the rebuild kernels (zero workgroups when the list is good).
     RebuildIfNeeded,
-    /// `find_bridge_events` and `update_bridges` (capillary scenes), `pair_force`,
-    /// `wall_contacts`, `wall_reduce` and `gather`, which kicks too when the phase has a kick.
+    /// `find_bridge_events` and `update_bridges` (capillary scenes), `pair_force`, `gather`
+    /// (with the wall contacts) and `wall_reduce`, which kick too when the phase has a kick.
     Forces,
 }
 

@@ -82,7 +82,8 @@ impl GpuEngine {
     /// The kernels of a plan entry other than the rebuild check, with their sizes and phases:
     /// `integrate` (then `servo_move` after a drift in servo scenes); or
     /// `find_bridge_events` and `update_bridges` (capillary scenes), `pair_force`,
-    /// `wall_contacts` (+ `wall_reduce`), `gather` (and the kick after it).
+    /// `gather` (with the wall contacts, and the kick after it), `wall_reduce` (and the
+    /// piston's kick) where there are walls.
     pub(super) fn kernels_of(&self, e: &Entry) -> Vec<(&'static str, Size, Option<Phase>)> {
         let phase = Some(e.phase);
         let mut k = Vec::new();
@@ -100,11 +101,10 @@ impl GpuEngine {
                     k.push(("update_bridges", Size::One, None));
                 }
                 k.push(("pair_force", Size::Indirect(args::PAIRS), phase));
-                if self.has_walls {
-                    k.push(("wall_contacts", Size::Grains, phase));
-                    k.push(("wall_reduce", Size::One, None));
-                }
                 k.push(("gather", Size::Grains, phase));
+                if self.has_walls {
+                    k.push(("wall_reduce", Size::One, phase));
+                }
             }
         }
         k
