@@ -38,10 +38,10 @@ pub const SUBMITS_PER_CHECK: u64 = 32;
 
 /// Buffers a checkpoint leaves out: the scene's constants (set up again from the scene) and
 /// scratch space every step or statistics read rewrites before reading it.
-const NOT_STATE: [&str; 17] = [
+const NOT_STATE: [&str; 14] = [
     "params", "phase", "material", "coeffs", // constants
-    "cell_of", "cell_grains", "cell_count", "cell_fill", "hash_sums", "grain_sums", "spare_sum", // the hash grid
-    "old_start", "bridge_event", // rebuild and bridge scratch
+    "cell_count", "cell_fill", "hash_sums", "grain_sums", "spare_sum", // the hash grid
+    "bridge_event", // bridge scratch
     "wall_partials", "grain_rows", "pair_rows", "stats", // reductions
 ];
 
@@ -52,8 +52,22 @@ const NOT_STATE: [&str; 17] = [
 /// after it). The replaced list needs no buffers of its own: 20 bytes per pair of capacity on
 /// a dry bed, 36 with rolling springs. Likewise `reverse_fill`'s per-grain counters sit in
 /// `cell_fill` (hash buckets, at least one per grain), dead once `scatter_cells` has run;
-/// `detect_count` clears them.
-const REBUILD_SCRATCH: [(&str, &str); 5] = [("old_j", "rev_pair"), ("old_hist0", "out_fi"), ("old_hist1", "out_tj"), ("old_hist2", "out_ti"), ("rev_fill", "cell_fill")];
+/// `detect_count` clears them. And the per-grain scratch of the rebuild (the saved pair starts,
+/// 4 B per grain and one; each grain's bucket and the grains sorted by bucket, 4 B per grain
+/// each) sits in buffers dead between the kick that reads the last loads and the evaluation
+/// that rewrites them, where every rebuild runs (`force`, `torque`: 16 B per grain), or
+/// between one evaluation's `wall_reduce` and the next one's gather (`wall_partials`: 256 B
+/// per 64 grains).
+const REBUILD_SCRATCH: [(&str, &str); 8] = [
+    ("old_j", "rev_pair"),
+    ("old_hist0", "out_fi"),
+    ("old_hist1", "out_tj"),
+    ("old_hist2", "out_ti"),
+    ("rev_fill", "cell_fill"),
+    ("old_start", "force"),
+    ("cell_of", "torque"),
+    ("cell_grains", "wall_partials"),
+];
 
 /// Why the GPU engine refused a scene.
 #[derive(Debug, thiserror::Error)]
@@ -312,20 +326,21 @@ impl GpuEngine {
             zeroed(name, v);
         }
         zeroed("image", if periodic { v } else { 16 });
-        zeroed("cell_of", 4 * n);
-        zeroed("cell_grains", 4 * n);
         zeroed("cell_count", 4 * hash_size);
         zeroed("cell_fill", 4 * hash_size);
         zeroed("hash_sums", 4 * hash_size.div_ceil(2048));
         zeroed("grain_sums", 4 * (n + 1).div_ceil(2048));
         zeroed("spare_sum", 4);
-        for name in ["pair_start", "old_start", "rev_start"] {
+        for name in ["pair_start", "rev_start"] {
             zeroed(name, 4 * (n + 1));
         }
         let wall_hist = if hist_blocks > 0 { 16 * n * scene.walls.len() as u64 * hist_blocks } else { 16 };
         zeroed("wall_hist", wall_hist);
         // Per wall: the reaction, then the contacts' stiffness and damping (servo walls).
-        zeroed("wall_partials", workgroup::rows(n) * 2 * MAX_WALLS as u64 * 16);
+        let wall_partials = workgroup::rows(n) * 2 * MAX_WALLS as u64 * 16;
+        zeroed("wall_partials", wall_partials);
+        // The rebuild's scratch fits the buffers that hold it (REBUILD_SCRATCH).
+        debug_assert!(v.max(16) >= 4 * (n + 1) && wall_partials >= 4 * n);
         zeroed("wall_reaction", 2 * MAX_WALLS as u64 * 16);
         zeroed("grain_rows", workgroup::rows(n) * STAT_ROW as u64 * 4);
         zeroed("stats", 2 * STAT_ROW as u64 * 4);
