@@ -34,6 +34,18 @@ pub enum SimError {
         /// Pairs the buffers held.
         capacity: u64,
     },
+    /// The GPU had not the memory to grow its pair buffers.
+    #[error("the GPU ran out of memory at step {step} growing its pair buffers to {pairs} pairs ({mib:.0} MiB): {reason}; fix: run fewer grains on this device, lower simulation.skin, or run with --backend cpu")]
+    DeviceMemory {
+        /// Step at which it was seen.
+        step: u64,
+        /// Pairs the buffers were to hold.
+        pairs: u64,
+        /// The new pair buffers' size (MiB).
+        mib: f64,
+        /// The driver's reason.
+        reason: String,
+    },
     /// The GPU failed to answer a readback (device lost, mapping refused).
     #[error("the GPU failed while reading back {what}: {reason}; fix: check the GPU driver (a device lost after a long dispatch is often the driver's watchdog) or run with --backend cpu")]
     Device {

@@ -86,6 +86,16 @@ pub enum GpuSetupError {
         /// How to fix.
         fix: &'static str,
     },
+    /// The device had not the memory for the scene's buffers.
+    #[error("\"{adapter}\" could not allocate the {mib:.0} MiB of buffers the scene needs: {reason}; fix: run fewer grains on this device, or run with --backend cpu")]
+    Memory {
+        /// Adapter.
+        adapter: String,
+        /// The buffers' size (MiB).
+        mib: f64,
+        /// The driver's reason.
+        reason: String,
+    },
 }
 
 /// The GPU engine (f32).
@@ -265,6 +275,8 @@ impl GpuEngine {
         let periodic = scene.periodic.iter().any(Option::is_some);
 
         let device = &gpu.device;
+        // A device without the memory reports it here, not through wgpu's handler (a panic).
+        let out_of_memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
         let mut buffers = HashMap::new();
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let mut init = |name: &'static str, bytes: &[u8], extra: wgpu::BufferUsages| {
@@ -344,6 +356,10 @@ impl GpuEngine {
         zeroed("wall_reaction", 2 * MAX_WALLS as u64 * 16);
         zeroed("grain_rows", workgroup::rows(n) * STAT_ROW as u64 * 4);
         zeroed("stats", 2 * STAT_ROW as u64 * 4);
+        if let Some(e) = pollster::block_on(out_of_memory.pop()) {
+            let mib = buffers.values().map(wgpu::Buffer::size).sum::<u64>() as f64 / (1u64 << 20) as f64;
+            return Err(GpuSetupError::Memory { adapter, mib, reason: e.to_string() }.into());
+        }
 
         let mut engine = GpuEngine {
             gpu,
@@ -374,7 +390,7 @@ impl GpuEngine {
             control,
             dispatches: std::cell::Cell::new(0),
         };
-        engine.allocate_pairs(pair_capacity);
+        engine.allocate_pairs(pair_capacity).map_err(|reason| GpuSetupError::Memory { adapter: engine.gpu.info.name.clone(), mib: engine.pair_bytes(pair_capacity) as f64 / (1u64 << 20) as f64, reason })?;
         engine.build_pipelines(scene);
         engine.build_bind_groups();
         engine.make_room_for_the_first_list()?;
@@ -398,15 +414,34 @@ impl GpuEngine {
         ]
     }
 
-    /// (Re)allocates the per-pair buffers for `capacity` pairs.
-    fn allocate_pairs(&mut self, capacity: u64) {
+    /// The per-pair buffers' names and sizes for `capacity` pairs (B).
+    fn pair_buffer_sizes(&self, capacity: u64) -> Vec<(&'static str, u64)> {
+        let mut sizes: Vec<(&'static str, u64)> = self.pair_buffers().iter().map(|&(name, per_pair)| (name, (per_pair * capacity).max(16))).collect();
+        sizes.push(("pair_rows", (workgroup::rows(capacity) * STAT_ROW as u64 * 4).max(16)));
+        sizes
+    }
+
+    /// The per-pair buffers' bytes for `capacity` pairs.
+    fn pair_bytes(&self, capacity: u64) -> u64 {
+        self.pair_buffer_sizes(capacity).iter().map(|s| s.1).sum()
+    }
+
+    /// (Re)allocates the per-pair buffers for `capacity` pairs, keeping what the live pairs
+    /// hold; the driver's reason when the device has not the memory (the buffers held are then
+    /// kept as they were).
+    fn allocate_pairs(&mut self, capacity: u64) -> Result<(), String> {
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let mut sizes: Vec<(&'static str, u64)> = self.pair_buffers().iter().map(|&(name, per_pair)| (name, per_pair * capacity)).collect();
-        sizes.push(("pair_rows", workgroup::rows(capacity) * STAT_ROW as u64 * 4));
+        let out_of_memory = self.gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let grown: Vec<(&'static str, wgpu::Buffer)> = self
+            .pair_buffer_sizes(capacity)
+            .into_iter()
+            .map(|(name, size)| (name, self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size, usage: storage, mapped_at_creation: false })))
+            .collect();
+        if let Some(e) = pollster::block_on(out_of_memory.pop()) {
+            return Err(e.to_string());
+        }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        for (name, size) in sizes {
-            let b = self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size: size.max(16), usage: storage, mapped_at_creation: false });
-            // Growing keeps what the live pairs hold.
+        for (name, b) in grown {
             if let Some(old) = self.buffers.get(name) {
                 encoder.copy_buffer_to_buffer(old, 0, &b, 0, old.size().min(b.size()));
             }
@@ -415,6 +450,7 @@ impl GpuEngine {
         self.gpu.queue.submit([encoder.finish()]);
         self.params.pair_capacity = capacity as u32;
         self.gpu.queue.write_buffer(&self.buffers["params"], 0, bytemuck::bytes_of(&self.params));
+        Ok(())
     }
 
     fn build_pipelines(&mut self, scene: &Scene) {

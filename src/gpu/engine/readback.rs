@@ -41,8 +41,7 @@ impl GpuEngine {
         if c.pair_overflow != 0 {
             return Err(SimError::PairBuffers { step: self.step, pairs: self.listed_pairs()?, capacity: self.params.pair_capacity as u64 });
         }
-        self.make_room_for(c.n_pairs as u64);
-        Ok(())
+        self.make_room_for(c.n_pairs as u64)
     }
 
     /// The number of pairs the last rebuild's count found (the end of `pair_start`), which
@@ -53,16 +52,18 @@ impl GpuEngine {
 
     /// Grows the pair buffers, keeping what they hold, to twice `pairs` when `pairs` fill more
     /// than [`PAIR_GROWTH_THRESHOLD`] of them (at most what a storage binding holds).
-    fn make_room_for(&mut self, pairs: u64) {
+    fn make_room_for(&mut self, pairs: u64) -> Result<(), SimError> {
         if pairs as f64 > PAIR_GROWTH_THRESHOLD * self.params.pair_capacity as f64 {
             let binding = self.gpu.limits.max_storage_buffer_binding_size;
             let per_pair = 16 * (self.params.hist_blocks as u64).max(1);
             let grown = (2 * pairs).min(binding / per_pair);
             if grown > self.params.pair_capacity as u64 {
-                self.allocate_pairs(grown);
+                let mib = self.pair_bytes(grown) as f64 / (1u64 << 20) as f64;
+                self.allocate_pairs(grown).map_err(|reason| SimError::DeviceMemory { step: self.step, pairs: grown, mib, reason })?;
                 self.build_bind_groups();
             }
         }
+        Ok(())
     }
 
     /// Sizes the pair buffers for the list the first rebuild will build, counted by the
@@ -79,8 +80,7 @@ impl GpuEngine {
         self.gpu.queue.submit([encoder.finish()]);
         let pairs = self.listed_pairs()?;
         self.gpu.queue.write_buffer(&self.buffers["control"], 0, bytemuck::bytes_of(&self.control));
-        self.make_room_for(pairs);
-        Ok(())
+        self.make_room_for(pairs)
     }
 
     /// Rebuilds the neighbour list at the next step, whatever the displacements.

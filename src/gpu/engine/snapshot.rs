@@ -218,7 +218,7 @@ impl GpuEngine {
     pub(super) fn restore_state(&mut self, s: &crate::engine::EngineState) -> anyhow::Result<()> {
         let counters = s.ints("counters", Some(3))?;
         if counters[2] != self.params.pair_capacity as u64 {
-            self.allocate_pairs(counters[2]);
+            self.allocate_pairs(counters[2]).map_err(|reason| anyhow::anyhow!("the GPU could not allocate the checkpoint's {} pairs of buffers: {reason}; fix: resume on a device with more memory, or with --backend cpu", counters[2]))?;
             self.build_bind_groups();
         }
         for (key, words) in &s.ints {
