@@ -79,7 +79,10 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index
     }
     let load = f + w.force;
     let moment = t + w.torque;
-    force[i] = vec4<f32>(load, f32(u32(pushing) + w.sliding * WALL_COUNTS_SLIDING + w.rolling * WALL_COUNTS_ROLLING));
+    // (A grain pushed by 65536 pairs or more counts 65535: the statistics only ask whether it
+    // is a rattler.)
+    let pushed = min(u32(pushing), WALL_COUNTS_SLIDING - 1u);
+    force[i] = vec4<f32>(load, f32(pushed + w.sliding * WALL_COUNTS_SLIDING + w.rolling * WALL_COUNTS_ROLLING));
     torque[i] = vec4<f32>(moment, length(w.force));
     if (phase.kick > 0.0) {
         kick_grain(i, load, moment, phase.kick);

@@ -15,7 +15,7 @@ fn wall_frame(w: Wall, p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
 }
 
 // The statistics' count of a grain's wall contacts, packed into its force.w beside the pairs
-// that push it (fewer than WALL_COUNTS_SLIDING): sliding ones times WALL_COUNTS_SLIDING,
+// that push it (at most WALL_COUNTS_SLIDING - 1): sliding ones times WALL_COUNTS_SLIDING,
 // rolling ones times WALL_COUNTS_ROLLING (each at most MAX_WALLS; the sum stays below 2^24, an
 // integer an f32 holds exactly).
 const WALL_COUNTS_SLIDING: u32 = 65536u;
