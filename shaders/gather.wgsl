@@ -7,7 +7,10 @@
 // statistics, force.w packs the grain's pairs that push (f_n > 0) with its wall contacts
 // sliding and rolling (WALL_COUNTS_*), torque.w is the magnitude of its wall force. With
 // phase.kick > 0 it then kicks the grain under that load: the kick after an evaluation, in the
-// same dispatch (the piston's waits for wall_reduce). A partner's force is out_fj where the
+// same dispatch (the piston's waits for wall_reduce). With phase.drift > 0 it runs the next
+// step's first sweep too, carried into this one by a run of steps: a kick by phase.then_kick
+// under the same load, then the drift (and the load is not stored: nothing reads it before the
+// next evaluation). A partner's force is out_fj where the
 // pair pass stores it (PARTNER_FORCE_STORED), else the owner's reversed: subtracting out_fi
 // adds the same bits.
 override PARTNER_FORCE_STORED: bool;
@@ -23,8 +26,8 @@ override WALL_RESPONSE: bool = false;
 @group(0) @binding(8) var<storage, read> out_fj: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read> out_ti: array<vec4<f32>>;
 @group(0) @binding(10) var<storage, read> out_tj: array<vec4<f32>>;
-@group(0) @binding(11) var<storage, read> pos: array<vec4<f32>>;
-@group(0) @binding(12) var<storage, read> residual: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read_write> pos: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read_write> residual: array<vec4<f32>>;
 @group(0) @binding(13) var<storage, read> material: array<u32>;
 @group(0) @binding(14) var<storage, read> coeffs: array<PairCoeffs>;
 @group(0) @binding(15) var<storage, read> walls: array<Wall>;
@@ -32,6 +35,9 @@ override WALL_RESPONSE: bool = false;
 @group(0) @binding(17) var<storage, read_write> wall_partials: array<vec4<f32>>;
 @group(0) @binding(18) var<storage, read_write> force: array<vec4<f32>>;
 @group(0) @binding(19) var<storage, read_write> torque: array<vec4<f32>>;
+@group(0) @binding(20) var<storage, read> built_at: array<vec4<f32>>;
+@group(0) @binding(21) var<storage, read_write> quat: array<vec4<f32>>;
+@group(0) @binding(22) var<storage, read_write> control: Control;
 
 var<workgroup> reaction: array<vec4<f32>, 512>; // WG x MAX_WALLS
 
@@ -82,10 +88,17 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index
     // (A grain pushed by 65536 pairs or more counts 65535: the statistics only ask whether it
     // is a rattler.)
     let pushed = min(u32(pushing), WALL_COUNTS_SLIDING - 1u);
-    force[i] = vec4<f32>(load, f32(pushed + w.sliding * WALL_COUNTS_SLIDING + w.rolling * WALL_COUNTS_ROLLING));
-    torque[i] = vec4<f32>(moment, length(w.force));
+    let carries = phase.drift > 0.0;
+    if (!carries) {
+        force[i] = vec4<f32>(load, f32(pushed + w.sliding * WALL_COUNTS_SLIDING + w.rolling * WALL_COUNTS_ROLLING));
+        torque[i] = vec4<f32>(moment, length(w.force));
+    }
     if (phase.kick > 0.0) {
         kick_grain(i, load, moment, phase.kick);
+    }
+    if (carries) {
+        kick_grain(i, load, moment, phase.then_kick);
+        drift_grain(i, phase.drift);
     }
 }
 

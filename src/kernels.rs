@@ -49,6 +49,7 @@ pub fn shared(name: &str) -> &'static str {
         "reduce" => include_str!("../shaders/shared/reduce.wgsl"),
         "kick" => include_str!("../shaders/shared/kick.wgsl"),
         "piston" => include_str!("../shaders/shared/piston.wgsl"),
+        "drift" => include_str!("../shaders/shared/drift.wgsl"),
         "position" => include_str!("../shaders/shared/position.wgsl"),
         "cd" => include_str!("../shaders/shared/cd.wgsl"),
         other => panic!("no shared WGSL file {other}"),
@@ -72,11 +73,11 @@ use Access::{Phase, Read, ReadWrite, Uniform, Write};
 
 const BASE: &[&str] = &["types", "dispatch"];
 const PISTON: &[&str] = &["types", "dispatch", "piston"];
-const INTEGRATE: &[&str] = &["types", "dispatch", "kick", "piston", "position"];
+const INTEGRATE: &[&str] = &["types", "dispatch", "kick", "piston", "position", "drift"];
 const GRID: &[&str] = &["types", "dispatch", "position", "grid"];
 const DETECT: &[&str] = &["types", "dispatch", "position", "grid", "neighbours"];
 const FORCES: &[&str] = &["types", "dispatch", "position", "grid", "model"];
-const GATHER: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "kick"];
+const GATHER: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "kick", "drift"];
 const CD: &[&str] = &["types", "dispatch", "cd"];
 const STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "reduce"];
 
@@ -108,7 +109,7 @@ pub const KERNELS: &[Kernel] = &[
     kernel!("find_bridge_events", FORCES, ["params": Uniform, "pos": Read, "residual": Read, "pair_i": Read, "pair_j": Read, "hist": Read, "bridge_event": Write, "control": Read]),
     kernel!("update_bridges", FORCES, ["params": Uniform, "pair_i": Read, "pair_j": Read, "bridge_event": Read, "hist": ReadWrite, "liquid": ReadWrite, "control": Read]),
     kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": Write, "out_fj": Write, "out_ti": Write, "out_tj": Write, "control": Read]),
-    kernel!("gather", GATHER, ["params": Uniform, "phase": Phase, "vel": ReadWrite, "omega": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_partials": Write, "force": Write, "torque": Write]),
+    kernel!("gather", GATHER, ["params": Uniform, "phase": Phase, "vel": ReadWrite, "omega": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "pos": ReadWrite, "residual": ReadWrite, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_partials": Write, "force": Write, "torque": Write, "built_at": Read, "quat": ReadWrite, "control": ReadWrite]),
     kernel!("wall_reduce", PISTON, ["params": Uniform, "phase": Phase, "wall_partials": Read, "wall_reaction": ReadWrite, "walls": ReadWrite]),
     kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": Write]),
     kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_ti": Read, "control": Read, "pair_rows": Write]),

@@ -79,6 +79,16 @@ impl Schedule {
         Schedule { prologue: vec![Op::RebuildIfNeeded, Op::Forces { elapsed: 0.0 }], needs_loads: matches!(step[0], Kick { .. }), first, step, first_sweeps, step_sweeps }
     }
 
+    /// The kick and drift (s) of a later step's first sweep where a run of steps may run it in
+    /// the last sweep of the step before: that sweep evaluates forces and kicks, the first
+    /// kicks and drifts, and only the step's end comes between them (velocity Verlet).
+    pub fn carried(&self) -> Option<(f64, f64)> {
+        match (self.step_sweeps.last(), self.step_sweeps.first()) {
+            (Some(Sweep::ForcesKick { .. }), Some(&Sweep::KickDrift { kick, tau })) => Some((kick, tau)),
+            _ => None,
+        }
+    }
+
     /// The sweeps of step number `step` (0 = the first): its operations, each kick merged
     /// into the sweep next to it ([`sweeps`]).
     pub fn sweeps(&self, step: u64) -> &[Sweep] {

@@ -251,6 +251,35 @@ fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
     }
 }
 
+/// The oedometer's piston under a target pressure, GPU against the CPU f32 twin: it is kicked
+/// and drifted in the dispatches after the grains' (its kicks wait for the walls' sums, and a
+/// run of steps carries each step's first kick and drift into the step before's), with the
+/// same operations in the same order. On a software adapter its height and speed stay bitwise
+/// equal; on a hardware GPU within f32 round-off.
+#[test]
+fn the_piston_moves_on_the_gpu_as_on_the_cpu() {
+    let scene = common::shipped("oedometer.toml");
+    let Some(mut g) = common::gpu_engine(&scene) else { return };
+    let mut c: CpuEngine<f32> = common::engine(&scene);
+    let d_mean = 2.0 * scene.grains.radius.iter().sum::<f64>() / scene.grains.len() as f64;
+    let exact = g.adapter().device_type == wgpu::DeviceType::Cpu;
+    g.set_piston_pressure(1.0e3);
+    c.set_piston_pressure(1.0e3);
+    for _ in 0..3 {
+        g.advance(200).unwrap();
+        c.advance(200).unwrap();
+        let (pg, pc) = (g.stats().unwrap().piston.unwrap(), c.stats().unwrap().piston.unwrap());
+        println!("piston z gpu {:.9e} cpu {:.9e} m, velocity gpu {:.9e} cpu {:.9e} m/s", pg.z, pc.z, pg.velocity, pc.velocity);
+        assert!(pc.velocity < 0.0, "the piston falls");
+        if exact {
+            assert_eq!((pg.z, pg.velocity), (pc.z, pc.velocity));
+        } else {
+            assert!((pg.z - pc.z).abs() <= F32_POSITION_TOLERANCE * d_mean, "piston height");
+            assert!((pg.velocity - pc.velocity).abs() <= F32_STATS_TOLERANCE * pc.velocity.abs(), "piston velocity");
+        }
+    }
+}
+
 /// Servo wall pressures, GPU against CPU f32, relative, on a hardware GPU. Both add each
 /// wall's reaction and contact stiffness in the GPU's workgroup order (`grains::workgroup`),
 /// but a hardware GPU fuses multiply-adds, so a pressure-controlled wall's speed differs by

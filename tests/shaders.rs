@@ -160,7 +160,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
         gravity, cell, periodic_lo, periodic_len, periodic_dims, skin, k_n, c_n, reach, kappa, kt_ratio,
         damping_ratio, k_r, gamma_r, mu_r, static_damping, rolling_as_written, theta, capillary_c, bridge_cap, kt_law
     ]);
-    check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, _pad0]);
+    check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, then_kick]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);
     check_struct!(&m, layout::Wall, "Wall", [kind, material, _pad0, _pad1, point, normal, velocity, piston]);
     check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite]);

@@ -39,7 +39,7 @@ struct Phase {
     kick: f32,     // kick duration (s); 0: no kick
     drift: f32,    // drift duration (s); 0: no drift
     elapsed: f32,  // time since the previous force evaluation (s), for the springs
-    _pad0: f32,
+    then_kick: f32, // an evaluation carrying the next step's kick (s) and drift (`drift`); 0 otherwise
 }
 
 // Coefficients of a pair of materials, [material_i * n_materials + material_j].

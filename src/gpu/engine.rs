@@ -317,7 +317,7 @@ impl GpuEngine {
         let dt = scene.time_step.dt;
         let plans = Plans::of(&Schedule::new(scene.integrator, dt));
         let mut phases: Vec<Phase> = Vec::new();
-        for e in plans.entries() {
+        for e in &plans.entries() {
             if !phases.contains(&e.phase) {
                 phases.push(e.phase);
             }
@@ -473,7 +473,7 @@ impl GpuEngine {
             match k.name {
                 "integrate" => constants.push(orientation),
                 "pair_force" => constants.push(partner_force),
-                "gather" => constants.extend([partner_force, wall_response]),
+                "gather" => constants.extend([partner_force, wall_response, orientation]),
                 _ => {}
             }
             let (layout, pipeline) = super::pipeline::compute_pipeline(&self.gpu.device, k, &constants);
@@ -548,10 +548,11 @@ impl Engine for GpuEngine {
             {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
                 if self.plans.needs_loads && !self.forces_valid {
-                    self.encode_plan(&mut pass, None);
+                    self.encode_plan(&mut pass, None, false, false);
                 }
                 for s in 0..chunk {
-                    self.encode_plan(&mut pass, Some(self.step + s));
+                    let in_run = done + s;
+                    self.encode_plan(&mut pass, Some(self.step + s), in_run > 0, in_run + 1 < n);
                 }
             }
             self.gpu.queue.submit([encoder.finish()]);

@@ -80,8 +80,10 @@ pub struct Phase {
     pub drift: f32,
     /// Time since the previous force evaluation (s).
     pub elapsed: f32,
-    /// Padding.
-    pub _pad0: f32,
+    /// A force evaluation's dispatches that run the next step's kick and drift too (a run of
+    /// steps carries each step's first sweep into the step before: [`crate::gpu::plan`]): that
+    /// kick's duration (s), the drift's being `drift`; 0 otherwise.
+    pub then_kick: f32,
 }
 
 /// Coefficients of a pair of materials (WGSL `PairCoeffs`).

@@ -1,7 +1,10 @@
 //! How the GPU engine encodes the schedule: each of its sweeps ([`Sweep`]) is one entry (a
 //! kick and the drift after it in `integrate`; an evaluation's gather and the kick after it in
 //! `gather`), with the arithmetic of running them apart, so the step costs fewer dispatches and
-//! gives the same bits.
+//! gives the same bits. Inside a run of steps, each step's first sweep (a kick and a drift)
+//! runs in the dispatches of the step before's last (a force evaluation and a kick), where
+//! the schedule allows it ([`Schedule::carried`]): one dispatch and one pass over the grains
+//! fewer per step, each grain still kicked, kicked and drifted in that order.
 
 use super::layout::Phase;
 use crate::schedule::{sweeps, Op, Schedule, Sweep};
@@ -14,8 +17,12 @@ pub enum Dispatch {
     /// `decide_rebuild` and the rebuild kernels (zero workgroups when the list is good).
     RebuildIfNeeded,
     /// `find_bridge_events` and `update_bridges` (capillary scenes), `pair_force`, `gather`
-    /// (with the wall contacts) and `wall_reduce`, which kick too when the phase has a kick.
+    /// (with the wall contacts) and `wall_reduce`, which kick too when the phase has a kick
+    /// (and run the next step's kick and drift when it has a drift, then `servo_move` in servo
+    /// scenes).
     Forces,
+    /// Nothing: operations the step before's last entry ran.
+    Carried,
 }
 
 /// One entry of a plan: the dispatches, their phase uniform and the operations they run.
@@ -55,20 +62,41 @@ pub struct Plans {
     pub needs_loads: bool,
     first: Vec<Entry>,
     later: Vec<Entry>,
+    /// The kick and drift (s) a step's last entry runs for the next step in a run of steps
+    /// ([`Schedule::carried`]).
+    carry: Option<(f32, f32)>,
 }
 
 impl Plans {
     /// The plans of `schedule`.
     pub fn of(schedule: &Schedule) -> Self {
-        Plans { prologue: plan(&schedule.prologue), needs_loads: schedule.needs_loads, first: plan(&schedule.first), later: plan(&schedule.step) }
+        let carry = schedule.carried().map(|(kick, drift)| (kick as f32, drift as f32));
+        Plans { prologue: plan(&schedule.prologue), needs_loads: schedule.needs_loads, first: plan(&schedule.first), later: plan(&schedule.step), carry }
     }
     /// The plan of step number `step` (0 = the first), as [`Schedule::sweeps`].
     pub fn step(&self, step: u64) -> &[Entry] {
         if step == 0 { &self.first } else { &self.later }
     }
-    /// Every entry of every plan.
-    pub fn entries(&self) -> impl Iterator<Item = &Entry> {
-        self.prologue.iter().chain(&self.first).chain(&self.later)
+    /// The plan of step number `step` inside a run of steps: its first entry left to the
+    /// step before (`carried_in`, [`Dispatch::Carried`]) and the next step's first entry run in
+    /// its last (`carry_out`), where the schedule allows it.
+    pub fn step_in_run(&self, step: u64, carried_in: bool, carry_out: bool) -> Vec<Entry> {
+        let mut plan = self.step(step).to_vec();
+        if let Some((kick, drift)) = self.carry {
+            if carried_in {
+                plan[0].dispatch = Dispatch::Carried;
+            }
+            if let Some(last) = plan.last_mut().filter(|_| carry_out) {
+                (last.phase.then_kick, last.phase.drift) = (kick, drift);
+            }
+        }
+        plan
+    }
+
+    /// Every entry of every plan, a run's included.
+    pub fn entries(&self) -> Vec<Entry> {
+        let runs = [0, 1].into_iter().flat_map(|step| self.step_in_run(step, step > 0, true));
+        self.prologue.iter().chain(&self.first).chain(&self.later).cloned().chain(runs).collect()
     }
 }
 

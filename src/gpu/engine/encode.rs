@@ -83,7 +83,8 @@ impl GpuEngine {
     /// `integrate` (then `servo_move` after a drift in servo scenes); or
     /// `find_bridge_events` and `update_bridges` (capillary scenes), `pair_force`,
     /// `gather` (with the wall contacts, and the kick after it), `wall_reduce` (and the
-    /// piston's kick) where there are walls.
+    /// piston's kick) where there are walls, then `servo_move` where they carry a drift in
+    /// servo scenes; nothing for a carried entry.
     pub(super) fn kernels_of(&self, e: &Entry) -> Vec<(&'static str, Size, Option<Phase>)> {
         let phase = Some(e.phase);
         let mut k = Vec::new();
@@ -94,7 +95,7 @@ impl GpuEngine {
                     k.push(("servo_move", Size::One, phase));
                 }
             }
-            Dispatch::RebuildIfNeeded => {}
+            Dispatch::RebuildIfNeeded | Dispatch::Carried => {}
             Dispatch::Forces => {
                 if self.history.bridge {
                     k.push(("find_bridge_events", Size::Indirect(args::PAIRS), None));
@@ -104,6 +105,9 @@ impl GpuEngine {
                 k.push(("gather", Size::Grains, phase));
                 if self.has_walls {
                     k.push(("wall_reduce", Size::One, phase));
+                }
+                if self.servo.is_some() && e.phase.drift > 0.0 {
+                    k.push(("servo_move", Size::One, phase));
                 }
             }
         }
@@ -121,13 +125,14 @@ impl GpuEngine {
     }
 
     /// Encodes the plan of step number `step`, or the prologue's with `None`, and traces its
-    /// operations.
-    pub(super) fn encode_plan(&mut self, pass: &mut wgpu::ComputePass, step: Option<u64>) {
+    /// operations; inside a run of steps, its first entry left to the step before
+    /// (`carried_in`) and the next step's run in its last (`carry_out`).
+    pub(super) fn encode_plan(&mut self, pass: &mut wgpu::ComputePass, step: Option<u64>, carried_in: bool, carry_out: bool) {
         let entries = match step {
-            None => &self.plans.prologue,
-            Some(n) => self.plans.step(n),
+            None => self.plans.prologue.clone(),
+            Some(n) => self.plans.step_in_run(n, carried_in, carry_out),
         };
-        for e in entries {
+        for e in &entries {
             self.encode(pass, e);
             for &op in &e.ops {
                 self.trace.record(op);
@@ -144,7 +149,7 @@ impl GpuEngine {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.encode_plan(&mut pass, None);
+            self.encode_plan(&mut pass, None, false, false);
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.forces_valid = true;

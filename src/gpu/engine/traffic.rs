@@ -28,7 +28,8 @@ impl GpuEngine {
                 .sum()
         };
         let mut out: Vec<(&'static str, u64)> = Vec::new();
-        for e in self.plans.step(1) {
+        // A later step inside a run of steps.
+        for e in &self.plans.step_in_run(1, true, true) {
             let names: Vec<&'static str> = if e.dispatch == Dispatch::RebuildIfNeeded { vec!["decide_rebuild"] } else { self.kernels_of(e).into_iter().map(|k| k.0).collect() };
             for name in names {
                 match out.iter_mut().find(|x| x.0 == name) {
