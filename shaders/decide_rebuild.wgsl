@@ -1,6 +1,7 @@
 // One invocation decides whether this step rebuilds the neighbour list (a grain moved half
 // the skin since the last build, or the state went non-finite) and writes the dispatch sizes
-// of the rebuild kernels accordingly (zero when not rebuilding).
+// of the rebuild kernels accordingly (zero when not rebuilding). After a pair buffer overflow
+// it does nothing, so that the steps stay stopped where the overflow left them.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read_write> control: Control;
 @group(0) @binding(2) var<storage, read_write> args: array<DispatchArgs>;
@@ -11,6 +12,10 @@ fn blocks(n: u32) -> DispatchArgs {
 
 @compute @workgroup_size(1)
 fn decide_rebuild() {
+    if (control.pair_overflow != 0u) {
+        return;
+    }
+    control.rebuild_checks += 1u;
     let d2 = bitcast<f32>(atomicExchange(&control.max_disp2, 0u));
     let half = 0.5 * params.skin;
     let rebuild = !(d2 < half * half);

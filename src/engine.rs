@@ -21,10 +21,9 @@ pub enum SimError {
         /// The capacity.
         capacity: usize,
     },
-    /// The GPU's pair buffers filled up between two of the checks that grow them
-    /// ([`crate::gpu::SUBMITS_PER_CHECK`]).
+    /// The GPU's neighbour list outgrew what one storage binding of the device holds.
     #[error(
-        "the GPU's pair buffers overflowed by step {step}: the neighbour list grew to {pairs} pairs, above the {capacity} they held (they grow when 75% full at checks every 512 steps and at each statistics read, and the list more than doubled in between); fix: lower simulation.skin, or run with --backend cpu"
+        "the GPU's neighbour list grew to {pairs} pairs by step {step}, above the {capacity} one storage binding of this device holds; fix: lower simulation.skin, run fewer grains, or run with --backend cpu"
     )]
     PairBuffers {
         /// Step at which it was seen.

@@ -142,6 +142,13 @@ impl Trace {
     pub fn ops(&self) -> &[Op] {
         self.0.as_deref().unwrap_or(&[])
     }
+    /// Forgets what was recorded after the first `kept` operations (an engine that goes back
+    /// over operations it had encoded but not run).
+    pub fn keep_first(&mut self, kept: usize) {
+        if let Some(v) = &mut self.0 {
+            v.truncate(kept);
+        }
+    }
 }
 
 /// One pass of an engine over the grains: an operation alone, or a kick merged into the sweep

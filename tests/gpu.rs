@@ -580,18 +580,21 @@ fn history_survives_a_rebuild_on_the_gpu() {
 
 #[test]
 fn a_dense_start_with_a_wide_skin_fits_the_gpus_pair_buffers() {
-    // The gas with a skin of 1.5 mean diameters lists about twice the pairs per grain the
-    // buffers start with: the engine must size them to its first list before the first step.
+    // The gas with a skin of 1.5 mean diameters lists over ten pairs per grain: the engine
+    // must size the buffers to its first list before the first step, so that no rebuild
+    // stops on them.
     let scene = common::parse(&common::edit(&std::fs::read_to_string(common::scene_path("quickstart.toml")).unwrap(), &[("region = { shape", "random_speed = 2.0\nregion = { shape"), ("dt = \"auto\"", "dt = \"auto\"\nskin = 1.5e-3")]));
     let Some(mut g) = common::gpu_engine(&scene) else { return };
     let mut c: CpuEngine<f32> = common::engine(&scene);
     let n = scene.grains.len() as f64;
     let listed = c.pair_list().1.len() as f64;
     println!("{:.1} pairs per grain listed, buffers for {:.1} per grain before the first step", listed / n, g.pair_capacity() as f64 / n);
-    assert!(listed > 1.5 * grains::gpu::INITIAL_PAIRS_PER_GRAIN as f64 * n, "the skin must list more pairs than the initial buffers hold");
+    assert!(listed > 9.0 * n, "the skin must list many pairs per grain");
     assert!(g.pair_capacity() as f64 >= listed);
+    assert!(g.pair_capacity() as f64 <= grains::gpu::PAIR_HEADROOM * listed + 1.0, "the buffers hold the first list with the headroom, no more");
     g.advance(100).unwrap();
     c.advance(100).unwrap();
+    assert_eq!(g.pair_stops(), 0, "sized for the first list, no rebuild stops");
     let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
     let bits = |f: &grains::engine::Frame| -> Vec<u64> { f.position.iter().chain(&f.velocity).flat_map(|v| v.map(f64::to_bits)).collect() };
     let differing = bits(&fg).iter().zip(&bits(&fc)).filter(|(a, b)| a != b).count();
@@ -604,11 +607,14 @@ fn a_dense_start_with_a_wide_skin_fits_the_gpus_pair_buffers() {
 }
 
 #[test]
-fn a_long_advance_grows_the_pair_buffers_as_a_pour_compacts() {
+fn a_pour_that_outgrows_the_pair_buffers_stops_and_goes_on_with_the_same_bits() {
     // 600 grains falling into a box under 50 g with a skin of 0.8 diameters: the list grows
-    // to over 9 pairs per grain within 10,000 steps, past the buffers' initial 6.
-    // One advance over all of them (checked every SUBMITS_PER_CHECK submissions inside) must
-    // give the bits of twenty advances of 500 (each checked at its end).
+    // from about 2.3 pairs per grain to over 9 within 10,000 steps. With buffers for the
+    // first list's pairs exactly, the first rebuild that lists one more stops the run (inside
+    // a run of steps, each carrying the next one's kick and drift) until the host has grown
+    // them; with buffers for 1,024 pairs, the prologue's rebuild stops. One advance over all
+    // the steps (checked every SUBMITS_PER_CHECK submissions inside), twenty advances of 500
+    // (each checked at its end) and the CPU f32 twin must give the same bits.
     let quickstart = std::fs::read_to_string(common::scene_path("quickstart.toml")).unwrap();
     let scene = common::parse(&common::edit(
         &quickstart,
@@ -618,20 +624,32 @@ fn a_long_advance_grows_the_pair_buffers_as_a_pour_compacts() {
             ("dt = \"auto\"", "dt = 1.0e-6\nskin = 0.8e-3\nmax_neighbours = 64"),
         ],
     ));
-    let run = |advances: u64| -> Option<(Vec<u64>, f64, f64)> {
-        let mut g = common::gpu_engine(&scene)?;
-        let start = g.pair_capacity() as f64;
+    let mut c: CpuEngine<f32> = common::engine(&scene);
+    let first = c.pair_list().1.len() as u64;
+    let bits = |f: &grains::engine::Frame| -> Vec<u64> { f.position.iter().chain(&f.velocity).flat_map(|v| v.map(f64::to_bits)).collect() };
+    let run = |pairs: u64, advances: u64| -> Option<(Vec<u64>, u64, f64, bool)> {
+        let mut g = grains::gpu::GpuEngine::with_pair_capacity(common::gpu()?, &scene, Some(pairs)).unwrap_or_else(|e| panic!("{e}"));
         for _ in 0..advances {
             g.advance(10_000 / advances).unwrap();
         }
         let f = g.frame(false).unwrap();
-        let bits = f.position.iter().chain(&f.velocity).flat_map(|v| v.map(f64::to_bits)).collect();
-        Some((bits, g.pair_list().unwrap().1.len() as f64, start))
+        Some((bits(&f), g.pair_stops(), g.stats().unwrap().time, g.adapter().device_type == wgpu::DeviceType::Cpu))
     };
-    let Some((once, pairs, start)) = run(1) else { return };
-    let (chunked, _, _) = run(20).unwrap();
+    let Some((once, stops, time, software)) = run(first, 1) else { return };
+    let (chunked, chunked_stops, _, _) = run(first, 20).unwrap();
+    let (small, small_stops, _, _) = run(1024, 1).unwrap();
+    c.advance(10_000).unwrap();
     let n = scene.grains.len() as f64;
-    println!("pairs per grain at the end {:.1}, buffers for {:.1} per grain at the start", pairs / n, start / n);
-    assert!(pairs > 1.5 * start, "the list must outgrow the initial buffers");
+    println!("pairs per grain: {:.2} at the start, {:.2} at the end; rebuilds stopped on full buffers: {stops} in one advance, {chunked_stops} in twenty, {small_stops} from 1,024 pairs", first as f64 / n, c.pair_list().1.len() as f64 / n);
+    assert!(first as f64 > 1024.0 * 1.2, "the first list must outgrow 1,024 pairs");
+    assert!(stops > 0 && chunked_stops > 0 && small_stops > 0, "rebuilds must have stopped on full buffers");
     assert_eq!(once, chunked, "one advance and twenty give the same bits");
+    assert_eq!(once, small, "buffers that start smaller give the same bits");
+    assert_eq!(time, (0..10_000).fold(0.0, |t, _| t + scene.time_step.dt), "the clock counts every step once, stops and all");
+    let twin = bits(&c.frame(false).unwrap());
+    let differing = once.iter().zip(&twin).filter(|(a, b)| a != b).count();
+    println!("against the CPU f32 twin: {differing} of {} position and velocity components differ", twin.len());
+    if software {
+        assert_eq!(differing, 0, "bitwise on a software adapter");
+    }
 }

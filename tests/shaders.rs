@@ -163,7 +163,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, then_kick]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);
     check_struct!(&m, layout::Wall, "Wall", [kind, material, _pad0, _pad1, point, normal, velocity, piston]);
-    check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite]);
+    check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite, rebuild_checks]);
     check_struct!(&m, layout::DispatchArgs, "DispatchArgs", [x, y, z]);
     check_struct!(&m, layout::Servo, "Servo", [walls_lo, walls_hi, pressure, gain, max_speed, strain_rate, relaxation, work, work_lo, strain]);
     // Constants the host relies on.
@@ -190,7 +190,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
         assert!(*field < layout::STAT_ROW - 2, "{name} lies before the (largest, grain) pair");
     }
     assert_eq!(constant("NONE"), layout::NONE);
-    for (name, slot) in [("ARGS_GRAINS", layout::args::GRAINS), ("ARGS_HASH", layout::args::HASH), ("ARGS_HASH_BLOCKS", layout::args::HASH_BLOCKS), ("ARGS_GRAIN_BLOCKS", layout::args::GRAIN_BLOCKS), ("ARGS_ONE", layout::args::ONE), ("ARGS_OLD_PAIRS", layout::args::OLD_PAIRS), ("ARGS_PAIRS", layout::args::PAIRS), ("ARGS_NEW_PAIRS", layout::args::NEW_PAIRS), ("ARGS_GRAIN_STARTS", layout::args::GRAIN_STARTS), ("ARGS_SLOTS", layout::args::SLOTS)] {
+    for (name, slot) in [("ARGS_GRAINS", layout::args::GRAINS), ("ARGS_HASH", layout::args::HASH), ("ARGS_HASH_BLOCKS", layout::args::HASH_BLOCKS), ("ARGS_GRAIN_BLOCKS", layout::args::GRAIN_BLOCKS), ("ARGS_ONE", layout::args::ONE), ("ARGS_OLD_PAIRS", layout::args::OLD_PAIRS), ("ARGS_PAIRS", layout::args::PAIRS), ("ARGS_NEW_PAIRS", layout::args::NEW_PAIRS), ("ARGS_GRAIN_STARTS", layout::args::GRAIN_STARTS), ("ARGS_STEP_GRAINS", layout::args::STEP_GRAINS), ("ARGS_STEP_ONE", layout::args::STEP_ONE), ("ARGS_SLOTS", layout::args::SLOTS)] {
         assert_eq!(constant(name) as u64, slot, "{name}");
     }
 }

@@ -98,8 +98,11 @@ struct Control {
     n_pairs: u32,
     overflow_grain: atomic<u32>, // lowest grain over the neighbour capacity, or 0xffffffff
     overflow_count: atomic<u32>, // its pair count
-    pair_overflow: u32,        // 1 when the pair list outgrew its buffer
+    pair_overflow: u32,        // 1 when a rebuild found more pairs than the buffers hold: it
+                               // stopped before writing its list, and every step after it runs
+                               // no kernel until the host grows the buffers and goes on
     non_finite: atomic<u32>,   // lowest grain with a non-finite position, or 0xffffffff
+    rebuild_checks: u32,       // decide_rebuild runs so far (the host finds the one that stopped)
 }
 
 // Workgroup-size indirect dispatch arguments.
@@ -122,7 +125,9 @@ const ARGS_OLD_PAIRS: u32 = 5u;     // one per pair of the list being replaced, 
 const ARGS_PAIRS: u32 = 6u;         // one per current pair, always
 const ARGS_NEW_PAIRS: u32 = 7u;     // one per new pair, if rebuilding
 const ARGS_GRAIN_STARTS: u32 = 8u;  // one per entry of n_grains + 1, if rebuilding
-const ARGS_SLOTS: u32 = 9u;
+const ARGS_STEP_GRAINS: u32 = 9u;   // one per grain, until a pair buffer overflow stops the steps
+const ARGS_STEP_ONE: u32 = 10u;     // one workgroup, until a pair buffer overflow stops the steps
+const ARGS_SLOTS: u32 = 11u;
 
 const MAX_WALLS: u32 = 8u;
 // Elements one workgroup of the scan handles (src/gpu/layout.rs SCAN_BLOCK).

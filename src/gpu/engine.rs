@@ -23,12 +23,19 @@ use std::collections::HashMap;
 use crate::workgroup;
 use wgpu::util::DeviceExt;
 
-/// Pairs per grain the pair buffers start with; they grow at statistics reads when more than
-/// [`PAIR_GROWTH_THRESHOLD`] of them are in use. A dense packing with a skin of a tenth of a
-/// diameter lists about 3.7 per grain; 6 keeps 10^6 grains' buffers under 1 GiB.
-pub const INITIAL_PAIRS_PER_GRAIN: u64 = 6;
-/// Fill fraction of the pair buffers that makes them grow (to twice the pairs in use).
-pub const PAIR_GROWTH_THRESHOLD: f64 = 0.75;
+/// The pair buffers start with room for this many times the pairs of the first list (counted
+/// before the first step), and for one pair per grain at least. They need no more margin: a
+/// rebuild whose list outgrows them stops the run where it is, and the host grows them and
+/// goes on with the same bits ([`readback`]'s `check`). A dense packing with a skin of a tenth
+/// of a diameter lists about 3.7 pairs per grain: 76 B per pair of room on a dry bed.
+pub const PAIR_HEADROOM: f64 = 1.1;
+/// Fill fraction of the pair buffers that makes them grow at a check, before a rebuild has to
+/// stop on them: above the first list's share, so that a list that does not grow keeps the
+/// buffers it started with.
+pub const PAIR_GROWTH_THRESHOLD: f64 = 0.95;
+const _: () = assert!(PAIR_GROWTH_THRESHOLD * PAIR_HEADROOM > 1.0);
+/// Pairs the buffers grow to, over the pairs in use (at a check) or needed (after a stop).
+pub const PAIR_GROWTH: f64 = 1.5;
 /// Steps recorded per queue submission.
 pub const STEPS_PER_SUBMIT: u64 = 16;
 /// Submissions between two checks of the control record inside one `advance` (the pair
@@ -132,13 +139,52 @@ pub struct GpuEngine {
     time: f64,
     forces_valid: bool,
     control: Control,
+    /// The rebuild checks encoded since the last check of the control record, in order: where
+    /// a run stopped on full pair buffers goes on.
+    marks: Vec<RebuildMark>,
+    /// The device's count of rebuild checks run (`Control::rebuild_checks`) at the last check.
+    marks_base: u32,
+    /// Rebuilds that stopped on full pair buffers and went on once they had grown.
+    pair_stops: u64,
+    /// Whether the pair buffers grow at checks before a rebuild has to stop on them.
+    grow_ahead: bool,
     /// Dispatches recorded so far.
     dispatches: std::cell::Cell<u64>,
 }
 
+/// A rebuild check as encoded: the plan it belongs to, its entry there, and the step, time
+/// and trace length before it.
+#[derive(Clone, Copy, Debug)]
+struct RebuildMark {
+    /// The step number of the plan, or `None` for the prologue.
+    plan: Option<u64>,
+    /// Index of the rebuild check among the plan's entries.
+    entry: usize,
+    /// The plan's first entry left to the step before ([`Plans::step_in_run`]).
+    carried_in: bool,
+    /// The next step's first entry run in the plan's last.
+    carry_out: bool,
+    /// The engine's step counter while the plan runs.
+    step: u64,
+    /// Its time (s).
+    time: f64,
+    /// Operations traced before the rebuild check.
+    traced: usize,
+}
+
 impl GpuEngine {
-    /// Sets the engine up for a scene on an opened device and builds the first neighbour list.
+    /// Sets the engine up for a scene on an opened device, with pair buffers sized for the
+    /// first neighbour list ([`PAIR_HEADROOM`]).
     pub fn new(gpu: Gpu, scene: &Scene) -> Result<Self, anyhow::Error> {
+        Self::with_pair_capacity(gpu, scene, None)
+    }
+
+    /// [`Self::new`] with pair buffers for `pairs` pairs to start with, where given, instead
+    /// of the first list's count, and which grow only when a rebuild's list outgrows them
+    /// (that rebuild stops the run until they have grown; the path the tests take on
+    /// purpose), not ahead of it at the checks: for a caller that knows the list a run will
+    /// reach, or that would rather not hold the growth's margin.
+    pub fn with_pair_capacity(gpu: Gpu, scene: &Scene, pairs: Option<u64>) -> Result<Self, anyhow::Error> {
         let n = scene.grains.len() as u64;
         let adapter = gpu.info.name.clone();
         let limit = |what, need: u64, have: u64, fix| -> Result<(), GpuSetupError> {
@@ -155,7 +201,8 @@ impl GpuEngine {
         let layout_of_history = scene.model.history_layout();
         let hist_blocks = [layout_of_history.tangential, layout_of_history.rolling, layout_of_history.bridge].into_iter().filter(|&b| b).count() as u64;
         let per_pair_bytes = 16 * hist_blocks.max(1);
-        let pair_capacity = (INITIAL_PAIRS_PER_GRAIN * n).max(1024).min(binding / per_pair_bytes).min(binding / 16);
+        // Room for the first list comes once its pairs are counted (make_room_for_the_first_list).
+        let pair_capacity = pairs.unwrap_or(n.max(1024)).max(1).min(binding / per_pair_bytes).min(binding / 16);
         limit("bytes of wall history", 16 * n * scene.walls.len() as u64 * hist_blocks, binding, "use fewer walls or grains")?;
 
         let model = &scene.model;
@@ -295,7 +342,9 @@ impl GpuEngine {
         init("walls", bytemuck::cast_slice(&walls_bytes), wgpu::BufferUsages::empty());
         let control = Control { max_disp2: f32::INFINITY.to_bits(), overflow_grain: NONE, non_finite: NONE, ..Default::default() };
         init("control", bytemuck::bytes_of(&control), wgpu::BufferUsages::empty());
-        init("args", bytemuck::cast_slice(&vec![DispatchArgs { x: 0, y: 1, z: 1 }; args::SLOTS as usize]), wgpu::BufferUsages::INDIRECT);
+        let mut dispatch_args = vec![DispatchArgs { x: 0, y: 1, z: 1 }; args::SLOTS as usize];
+        (dispatch_args[args::STEP_GRAINS as usize], dispatch_args[args::STEP_ONE as usize]) = (DispatchArgs::items(n), DispatchArgs::ONE);
+        init("args", bytemuck::cast_slice(&dispatch_args), wgpu::BufferUsages::INDIRECT);
         let quat: Vec<[f32; 4]> = if scene.track_orientation { vec![[1.0, 0.0, 0.0, 0.0]; g.len()] } else { vec![[0.0; 4]] };
         init("quat", bytemuck::cast_slice(&quat), wgpu::BufferUsages::empty());
         init("params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
@@ -388,12 +437,18 @@ impl GpuEngine {
             time: 0.0,
             forces_valid: false,
             control,
+            marks: Vec::new(),
+            marks_base: 0,
+            pair_stops: 0,
+            grow_ahead: pairs.is_none(),
             dispatches: std::cell::Cell::new(0),
         };
         engine.allocate_pairs(pair_capacity).map_err(|reason| GpuSetupError::Memory { adapter: engine.gpu.info.name.clone(), mib: engine.pair_bytes(pair_capacity) as f64 / (1u64 << 20) as f64, reason })?;
         engine.build_pipelines(scene);
         engine.build_bind_groups();
-        engine.make_room_for_the_first_list()?;
+        if pairs.is_none() {
+            engine.make_room_for_the_first_list()?;
+        }
         Ok(engine)
     }
 
@@ -521,6 +576,11 @@ impl GpuEngine {
         self.params.pair_capacity
     }
 
+    /// Rebuilds so far that stopped on full pair buffers and went on once they had grown.
+    pub fn pair_stops(&self) -> u64 {
+        self.pair_stops
+    }
+
 }
 
 impl Engine for GpuEngine {
@@ -541,30 +601,34 @@ impl Engine for GpuEngine {
     }
 
     fn advance(&mut self, n: u64) -> Result<(), SimError> {
-        let mut done = 0;
-        while done < n {
-            let chunk = STEPS_PER_SUBMIT.min(n - done);
-            let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                if self.plans.needs_loads && !self.forces_valid {
-                    self.encode_plan(&mut pass, None, false, false);
+        let (start, end) = (self.step, self.step + n);
+        while self.step < end {
+            // Submissions of STEPS_PER_SUBMIT steps, then a check (which may take the run back
+            // to a rebuild that stopped on full pair buffers, and on from there).
+            for _ in 0..SUBMITS_PER_CHECK {
+                if self.step == end {
+                    break;
                 }
-                for s in 0..chunk {
-                    let in_run = done + s;
-                    self.encode_plan(&mut pass, Some(self.step + s), in_run > 0, in_run + 1 < n);
+                let chunk = STEPS_PER_SUBMIT.min(end - self.step);
+                let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+                {
+                    let mut pass = encoder.begin_compute_pass(&Default::default());
+                    if self.plans.needs_loads && !self.forces_valid {
+                        self.encode_plan(&mut pass, None, false, false);
+                    }
+                    for _ in 0..chunk {
+                        let s = self.step;
+                        self.encode_plan(&mut pass, Some(s), s > start, s + 1 < end);
+                        self.step += 1;
+                        self.time += self.dt;
+                    }
                 }
+                self.gpu.queue.submit([encoder.finish()]);
+                self.forces_valid = true;
             }
-            self.gpu.queue.submit([encoder.finish()]);
-            self.forces_valid = true;
-            self.step += chunk;
-            self.time += chunk as f64 * self.dt;
-            done += chunk;
-            if done < n && (done / STEPS_PER_SUBMIT).is_multiple_of(SUBMITS_PER_CHECK) {
-                self.check()?;
-            }
+            self.check()?;
         }
-        self.check()
+        Ok(())
     }
 
     fn stats(&mut self) -> Result<Stats, SimError> {

@@ -182,10 +182,12 @@ pub struct Control {
     pub overflow_grain: u32,
     /// Its pair count.
     pub overflow_count: u32,
-    /// 1 when the pair list outgrew its buffer.
+    /// 1 when a rebuild found more pairs than the buffers hold and stopped the run there.
     pub pair_overflow: u32,
     /// Lowest grain with a non-finite position, or [`NONE`].
     pub non_finite: u32,
+    /// `decide_rebuild` runs so far (wrapping).
+    pub rebuild_checks: u32,
 }
 
 /// Indirect dispatch arguments (WGSL `DispatchArgs`).
@@ -198,6 +200,22 @@ pub struct DispatchArgs {
     pub y: u32,
     /// Along z.
     pub z: u32,
+}
+
+impl DispatchArgs {
+    /// One workgroup.
+    pub const ONE: Self = DispatchArgs { x: 1, y: 1, z: 1 };
+
+    /// The workgroups for `n` items (WGSL `groups_for`).
+    pub fn items(n: u64) -> Self {
+        let (x, y) = crate::workgroup::groups(n);
+        DispatchArgs { x, y, z: 1 }
+    }
+
+    /// The scan's workgroups over `n` elements (WGSL `blocks` in `decide_rebuild`).
+    pub fn scan_blocks(n: u64) -> Self {
+        DispatchArgs { x: n.div_ceil(SCAN_BLOCK) as u32, y: 1, z: 1 }
+    }
 }
 
 /// "No grain" / "no wall" (WGSL `NONE`).
@@ -282,8 +300,12 @@ pub mod args {
     pub const NEW_PAIRS: u64 = 7;
     /// One per entry of n_grains + 1, if rebuilding.
     pub const GRAIN_STARTS: u64 = 8;
+    /// One per grain, until a pair buffer overflow stops the steps.
+    pub const STEP_GRAINS: u64 = 9;
+    /// One workgroup, until a pair buffer overflow stops the steps.
+    pub const STEP_ONE: u64 = 10;
     /// Slots.
-    pub const SLOTS: u64 = 9;
+    pub const SLOTS: u64 = 11;
 }
 
 /// A contact of contact dynamics' sweeps (WGSL `CdContact`, `shaders/shared/cd.wgsl`).

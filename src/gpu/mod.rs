@@ -10,4 +10,4 @@ pub mod plan;
 
 pub use device::{describe_all, open, Gpu, GpuError};
 pub use sweeps::{GpuSweeps, MAX_SWEEPS_PER_SUBMIT};
-pub use engine::{GpuEngine, GpuSetupError, INITIAL_PAIRS_PER_GRAIN, PAIR_GROWTH_THRESHOLD, STEPS_PER_SUBMIT, SUBMITS_PER_CHECK};
+pub use engine::{GpuEngine, GpuSetupError, PAIR_GROWTH, PAIR_GROWTH_THRESHOLD, PAIR_HEADROOM, STEPS_PER_SUBMIT, SUBMITS_PER_CHECK};

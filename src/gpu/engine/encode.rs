@@ -2,6 +2,11 @@
 
 use super::*;
 
+/// The steps' own sizes: every grain, or one workgroup, until a pair buffer overflow stops
+/// the run (then zero).
+const STEP_GRAINS: Size = Size::Indirect(args::STEP_GRAINS);
+const STEP_ONE: Size = Size::Indirect(args::STEP_ONE);
+
 /// How a kernel is dispatched.
 #[derive(Clone, Copy, Debug)]
 pub(super) enum Size {
@@ -51,15 +56,21 @@ impl GpuEngine {
     /// list is still good.
     pub(super) fn encode_rebuild_if_needed(&self, pass: &mut wgpu::ComputePass) {
         self.run(pass, "decide_rebuild", Size::One, None);
-        let keeps_history = self.params.hist_blocks > 0;
-        if keeps_history {
+        if self.params.hist_blocks > 0 {
             self.run(pass, "save_starts", Size::Indirect(args::GRAIN_STARTS), None);
             self.run(pass, "save_pairs", Size::Indirect(args::OLD_PAIRS), None);
         }
         self.encode_pair_count(pass);
+        self.encode_list_fill(pass);
+    }
+
+    /// The rebuild from its pair count on: `pairs_ready` (which stops the run instead where
+    /// the new list outgrows the pair buffers), the new list, its history and its reverse
+    /// lists. A rebuild stopped there goes on from here once the buffers have grown.
+    pub(super) fn encode_list_fill(&self, pass: &mut wgpu::ComputePass) {
         self.run(pass, "pairs_ready", Size::One, None);
         self.run(pass, "detect_fill", Size::Indirect(args::GRAINS), None);
-        if keeps_history {
+        if self.params.hist_blocks > 0 {
             self.run(pass, "remap_history", Size::Indirect(args::NEW_PAIRS), None);
         }
         self.run(pass, "reverse_count", Size::Indirect(args::NEW_PAIRS), None);
@@ -79,7 +90,8 @@ impl GpuEngine {
         self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
     }
 
-    /// The kernels of a plan entry other than the rebuild check, with their sizes and phases:
+    /// The kernels of a plan entry other than the rebuild check, with their sizes and phases
+    /// (from the steps' own indirect slots, which a pair buffer overflow zeroes):
     /// `integrate` (then `servo_move` after a drift in servo scenes); or
     /// `find_bridge_events` and `update_bridges` (capillary scenes), `pair_force`,
     /// `gather` (with the wall contacts, and the kick after it), `wall_reduce` (and the
@@ -90,24 +102,24 @@ impl GpuEngine {
         let mut k = Vec::new();
         match e.dispatch {
             Dispatch::Integrate => {
-                k.push(("integrate", Size::Grains, phase));
+                k.push(("integrate", STEP_GRAINS, phase));
                 if self.servo.is_some() && e.phase.drift > 0.0 {
-                    k.push(("servo_move", Size::One, phase));
+                    k.push(("servo_move", STEP_ONE, phase));
                 }
             }
             Dispatch::RebuildIfNeeded | Dispatch::Carried => {}
             Dispatch::Forces => {
                 if self.history.bridge {
                     k.push(("find_bridge_events", Size::Indirect(args::PAIRS), None));
-                    k.push(("update_bridges", Size::One, None));
+                    k.push(("update_bridges", STEP_ONE, None));
                 }
                 k.push(("pair_force", Size::Indirect(args::PAIRS), phase));
-                k.push(("gather", Size::Grains, phase));
+                k.push(("gather", STEP_GRAINS, phase));
                 if self.has_walls {
-                    k.push(("wall_reduce", Size::One, phase));
+                    k.push(("wall_reduce", STEP_ONE, phase));
                 }
                 if self.servo.is_some() && e.phase.drift > 0.0 {
-                    k.push(("servo_move", Size::One, phase));
+                    k.push(("servo_move", STEP_ONE, phase));
                 }
             }
         }
@@ -126,13 +138,20 @@ impl GpuEngine {
 
     /// Encodes the plan of step number `step`, or the prologue's with `None`, and traces its
     /// operations; inside a run of steps, its first entry left to the step before
-    /// (`carried_in`) and the next step's run in its last (`carry_out`).
+    /// (`carried_in`) and the next step's run in its last (`carry_out`). Each rebuild check
+    /// is marked, where the run may stop ([`RebuildMark`]).
     pub(super) fn encode_plan(&mut self, pass: &mut wgpu::ComputePass, step: Option<u64>, carried_in: bool, carry_out: bool) {
-        let entries = match step {
-            None => self.plans.prologue.clone(),
-            Some(n) => self.plans.step_in_run(n, carried_in, carry_out),
-        };
-        for e in &entries {
+        let at = RebuildMark { plan: step, entry: 0, carried_in, carry_out, step: self.step, time: self.time, traced: 0 };
+        self.encode_entries(pass, at);
+    }
+
+    /// Encodes the entries of `at`'s plan from `at.entry` on, marking each rebuild check.
+    pub(super) fn encode_entries(&mut self, pass: &mut wgpu::ComputePass, at: RebuildMark) {
+        let entries = self.plan_of(&at);
+        for (k, e) in entries.iter().enumerate().skip(at.entry) {
+            if e.dispatch == Dispatch::RebuildIfNeeded {
+                self.marks.push(RebuildMark { entry: k, traced: self.trace.ops().len(), ..at });
+            }
             self.encode(pass, e);
             for &op in &e.ops {
                 self.trace.record(op);
@@ -140,11 +159,19 @@ impl GpuEngine {
         }
     }
 
+    /// The entries of the plan `at` belongs to.
+    pub(super) fn plan_of(&self, at: &RebuildMark) -> Vec<Entry> {
+        match at.plan {
+            None => self.plans.prologue.clone(),
+            Some(n) => self.plans.step_in_run(n, at.carried_in, at.carry_out),
+        }
+    }
+
     /// Runs the schedule's prologue (the list built if need be, forces evaluated) where
     /// nothing has evaluated the loads yet: before the first step, or after wetting.
-    pub(super) fn ensure_loads(&mut self) {
+    pub(super) fn ensure_loads(&mut self) -> Result<(), SimError> {
         if self.forces_valid {
-            return;
+            return Ok(());
         }
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
@@ -153,6 +180,7 @@ impl GpuEngine {
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.forces_valid = true;
+        self.check()
     }
 
     /// Starts recording the operations encoded (see [`Trace`]).

@@ -33,15 +33,63 @@ impl GpuEngine {
     }
 
     /// Checks the flags the last steps raised, and grows the pair buffers when they fill up.
+    /// A rebuild that stopped the run on full pair buffers (`pairs_ready`) is found among the
+    /// checks encoded since the last time ([`RebuildMark`]): the buffers grow, keeping what
+    /// they hold, and the run goes on from that rebuild's pair count, then to the end of its
+    /// plan; the step counter and time are set back to that plan's, so the caller encodes the
+    /// steps after it again. Every kernel after the stop ran with zero workgroups and the
+    /// rebuild had touched nothing of the old list, so the bits are those of buffers that were
+    /// large enough.
     pub(super) fn check(&mut self) -> Result<(), SimError> {
-        let c = self.read_control()?;
-        if c.overflow_grain != NONE {
-            return Err(SimError::Capacity { step: self.step, grain: c.overflow_grain, count: c.overflow_count as usize, capacity: self.params.max_neighbours as usize });
+        loop {
+            let c = self.read_control()?;
+            if c.overflow_grain != NONE {
+                return Err(SimError::Capacity { step: self.step, grain: c.overflow_grain, count: c.overflow_count as usize, capacity: self.params.max_neighbours as usize });
+            }
+            let marks = std::mem::take(&mut self.marks);
+            let base = std::mem::replace(&mut self.marks_base, c.rebuild_checks);
+            if c.pair_overflow == 0 {
+                return if self.grow_ahead { self.make_room_for(c.n_pairs as u64) } else { Ok(()) };
+            }
+            let stopped = c.rebuild_checks.wrapping_sub(base) as usize;
+            let Some(&mark) = stopped.checked_sub(1).and_then(|k| marks.get(k)) else {
+                return Err(SimError::Device { what: "control".into(), reason: format!("a rebuild stopped on full pair buffers at rebuild check {stopped} of {} encoded since the last check", marks.len()) });
+            };
+            let needed = self.listed_pairs()?;
+            self.grow_pairs((needed as f64 * PAIR_GROWTH).ceil() as u64, needed)?;
+            self.go_on_after_stop(mark);
         }
-        if c.pair_overflow != 0 {
-            return Err(SimError::PairBuffers { step: self.step, pairs: self.listed_pairs()?, capacity: self.params.pair_capacity as u64 });
+    }
+
+    /// Goes on with the rebuild of `mark`, which stopped at its pair count, and the rest of
+    /// its plan: the flag lowered, the dispatch sizes the rest of the rebuild reads put back as
+    /// `decide_rebuild` set them (the steps' own too), the trace cut back to the rebuild.
+    fn go_on_after_stop(&mut self, mark: RebuildMark) {
+        let queue = &self.gpu.queue;
+        queue.write_buffer(&self.buffers["control"], std::mem::offset_of!(Control, pair_overflow) as u64, bytemuck::bytes_of(&0u32));
+        let n = self.n as u64;
+        let at = |slot: u64| slot * std::mem::size_of::<DispatchArgs>() as u64;
+        for (slot, a) in [(args::GRAINS, DispatchArgs::items(n)), (args::GRAIN_BLOCKS, DispatchArgs::scan_blocks(n + 1)), (args::ONE, DispatchArgs::ONE), (args::STEP_GRAINS, DispatchArgs::items(n)), (args::STEP_ONE, DispatchArgs::ONE)] {
+            queue.write_buffer(&self.buffers["args"], at(slot), bytemuck::bytes_of(&a));
         }
-        self.make_room_for(c.n_pairs as u64)
+        (self.step, self.time) = (mark.step, mark.time);
+        self.trace.keep_first(mark.traced);
+        let plan = self.plan_of(&mark);
+        for &op in &plan[mark.entry].ops {
+            self.trace.record(op);
+        }
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.encode_list_fill(&mut pass);
+            self.encode_entries(&mut pass, RebuildMark { entry: mark.entry + 1, ..mark });
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        if mark.plan.is_some() {
+            self.step += 1;
+            self.time += self.dt;
+        }
+        self.pair_stops += 1;
     }
 
     /// The number of pairs the last rebuild's count found (the end of `pair_start`), which
@@ -50,26 +98,36 @@ impl GpuEngine {
         Ok(self.read(&[("pair_start", 4 * self.n as u64, 4)])?[0][0] as u64)
     }
 
-    /// Grows the pair buffers, keeping what they hold, to twice `pairs` when `pairs` fill more
-    /// than [`PAIR_GROWTH_THRESHOLD`] of them (at most what a storage binding holds).
+    /// Grows the pair buffers, keeping what they hold, to [`PAIR_GROWTH`] times `pairs` when
+    /// `pairs` fill more than [`PAIR_GROWTH_THRESHOLD`] of them.
     fn make_room_for(&mut self, pairs: u64) -> Result<(), SimError> {
         if pairs as f64 > PAIR_GROWTH_THRESHOLD * self.params.pair_capacity as f64 {
-            let binding = self.gpu.limits.max_storage_buffer_binding_size;
-            let per_pair = 16 * (self.params.hist_blocks as u64).max(1);
-            let grown = (2 * pairs).min(binding / per_pair);
-            if grown > self.params.pair_capacity as u64 {
-                let mib = self.pair_bytes(grown) as f64 / (1u64 << 20) as f64;
-                self.allocate_pairs(grown).map_err(|reason| SimError::DeviceMemory { step: self.step, pairs: grown, mib, reason })?;
-                self.build_bind_groups();
-            }
+            self.grow_pairs((pairs as f64 * PAIR_GROWTH).ceil() as u64, pairs)?;
+        }
+        Ok(())
+    }
+
+    /// Grows the pair buffers, keeping what they hold, to `capacity` pairs, or to what one
+    /// storage binding holds if less, but not below `needed`.
+    fn grow_pairs(&mut self, capacity: u64, needed: u64) -> Result<(), SimError> {
+        let binding = self.gpu.limits.max_storage_buffer_binding_size;
+        let per_pair = 16 * (self.params.hist_blocks as u64).max(1);
+        let grown = capacity.min(binding / per_pair).min(binding / 16);
+        if grown < needed {
+            return Err(SimError::PairBuffers { step: self.step, pairs: needed, capacity: grown });
+        }
+        if grown > self.params.pair_capacity as u64 {
+            let mib = self.pair_bytes(grown) as f64 / (1u64 << 20) as f64;
+            self.allocate_pairs(grown).map_err(|reason| SimError::DeviceMemory { step: self.step, pairs: grown, mib, reason })?;
+            self.build_bind_groups();
         }
         Ok(())
     }
 
     /// Sizes the pair buffers for the list the first rebuild will build, counted by the
     /// rebuild's own kernels before the first step (the control record then put back as it
-    /// was): a scene that starts dense with a wide skin would otherwise fill the initial
-    /// buffers before the first check could grow them.
+    /// was): [`PAIR_HEADROOM`] times its pairs. (A list that outgrew them later would only
+    /// stop the run until they grew.)
     pub(super) fn make_room_for_the_first_list(&mut self) -> Result<(), SimError> {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
@@ -80,7 +138,7 @@ impl GpuEngine {
         self.gpu.queue.submit([encoder.finish()]);
         let pairs = self.listed_pairs()?;
         self.gpu.queue.write_buffer(&self.buffers["control"], 0, bytemuck::bytes_of(&self.control));
-        self.make_room_for(pairs)
+        self.grow_pairs((pairs as f64 * PAIR_HEADROOM).ceil() as u64, pairs)
     }
 
     /// Rebuilds the neighbour list at the next step, whatever the displacements.
@@ -139,7 +197,7 @@ impl GpuEngine {
 
     /// The statistics of the current state (loads evaluated first if nothing has).
     pub(super) fn statistics(&mut self) -> Result<Stats, SimError> {
-        self.ensure_loads();
+        self.ensure_loads()?;
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());

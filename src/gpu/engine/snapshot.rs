@@ -165,7 +165,7 @@ impl GpuEngine {
             anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
         };
         // The liquid goes to the pairs of the current list.
-        self.ensure_loads();
+        self.ensure_loads()?;
         let (n, np, blocks) = (self.n as u64, self.read_control()?.n_pairs as u64, self.params.hist_blocks as u64);
         let parts = self.read(&[("pos", 0, 16 * n), ("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("hist", 0, 16 * np * blocks), ("liquid", 0, 4 * n), ("residual", 0, 16 * n)])?;
         let pos: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
@@ -233,7 +233,8 @@ impl GpuEngine {
         }
         (self.step, self.forces_valid) = (counters[0], counters[1] != 0);
         self.time = s.reals("time", 1)?[0];
-        self.read_control()?;
+        self.marks.clear();
+        self.marks_base = self.read_control()?.rebuild_checks;
         Ok(())
     }
 }
