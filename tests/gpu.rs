@@ -653,3 +653,42 @@ fn a_pour_that_outgrows_the_pair_buffers_stops_and_goes_on_with_the_same_bits() 
         assert_eq!(differing, 0, "bitwise on a software adapter");
     }
 }
+
+#[test]
+fn rebuilds_that_stop_on_full_pair_buffers_keep_each_scenes_bits() {
+    // Runs that start with buffers for 16 pairs (every rebuild that outgrows them stops the
+    // run until they have grown, the prologue's first) against runs sized for the first list,
+    // on the GPU alone: seed 000's gas under optimized Verlet (two rebuild checks a step,
+    // rolling springs, orientations, a floor in a periodic box), the wet gas with rolling
+    // springs (three history blocks, bridges; wetted through a stopped prologue) and seed
+    // 001's servo box (servo walls moved in the carried steps).
+    let mut ovv = gas(true);
+    ovv.integrator = Integrator::OptimizedVerlet;
+    let mut wet = common::wet_gas();
+    wet.model.rolling = grains::model::RollingLaw::Sds { k_r: 50.0, gamma_r: 0.0, mu_r: 0.05 };
+    let servo = common::parse(&common::edit(
+        &std::fs::read_to_string(common::scene_path("dry_iso_100pa.toml")).unwrap(),
+        &[("count = 8000", "count = 300"), ("max = [28.0e-3, 28.0e-3, 28.0e-3]", "max = [9.4e-3, 9.4e-3, 9.4e-3]")],
+    ));
+    let wet_volume = wet.stages[0].wet_volume;
+    for (name, scene, volume) in [("optimized Verlet gas", &ovv, None), ("wet gas", &wet, wet_volume), ("servo box", &servo, None)] {
+        let run = |pairs: Option<u64>| -> Option<(Vec<u64>, u64, u64, u64)> {
+            let mut g = grains::gpu::GpuEngine::with_pair_capacity(common::gpu()?, scene, pairs).unwrap_or_else(|e| panic!("{e}"));
+            if let Some(v) = volume {
+                g.wet(v).unwrap();
+            }
+            for _ in 0..4 {
+                g.advance(150).unwrap();
+            }
+            let (f, s) = (g.frame(false).unwrap(), g.stats().unwrap());
+            let bits = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|v| v.map(f64::to_bits)).collect();
+            Some((bits, s.pairs, s.bridges, g.pair_stops()))
+        };
+        let Some((sized, pairs, bridges, sized_stops)) = run(None) else { return };
+        let (tight, tight_pairs, tight_bridges, stops) = run(Some(16)).unwrap();
+        println!("{name}: {pairs} pairs, {bridges} bridges; {stops} rebuilds stopped from 16 pairs, {sized_stops} sized for the first list");
+        assert!(stops > 0, "{name}: rebuilds must have stopped");
+        assert_eq!((tight_pairs, tight_bridges), (pairs, bridges), "{name}");
+        assert_eq!(tight, sized, "{name}: the same bits, stops or none");
+    }
+}

@@ -146,7 +146,8 @@ pub struct GpuEngine {
     marks_base: u32,
     /// Rebuilds that stopped on full pair buffers and went on once they had grown.
     pair_stops: u64,
-    /// Whether the pair buffers grow at checks before a rebuild has to stop on them.
+    /// Whether the pair buffers grow at checks before a rebuild has to stop on them, and with
+    /// a margin ([`PAIR_GROWTH`]) after a stop.
     grow_ahead: bool,
     /// Dispatches recorded so far.
     dispatches: std::cell::Cell<u64>,
@@ -180,10 +181,10 @@ impl GpuEngine {
     }
 
     /// [`Self::new`] with pair buffers for `pairs` pairs to start with, where given, instead
-    /// of the first list's count, and which grow only when a rebuild's list outgrows them
-    /// (that rebuild stops the run until they have grown; the path the tests take on
-    /// purpose), not ahead of it at the checks: for a caller that knows the list a run will
-    /// reach, or that would rather not hold the growth's margin.
+    /// of the first list's count, and which grow only when a rebuild's list outgrows them, to
+    /// that list's pairs exactly (that rebuild stops the run until they have grown; the path
+    /// the tests take on purpose), not ahead of it at the checks: for a caller that knows the
+    /// list a run will reach, or that would rather hold no margin at all.
     pub fn with_pair_capacity(gpu: Gpu, scene: &Scene, pairs: Option<u64>) -> Result<Self, anyhow::Error> {
         let n = scene.grains.len() as u64;
         let adapter = gpu.info.name.clone();

@@ -56,7 +56,8 @@ impl GpuEngine {
                 return Err(SimError::Device { what: "control".into(), reason: format!("a rebuild stopped on full pair buffers at rebuild check {stopped} of {} encoded since the last check", marks.len()) });
             };
             let needed = self.listed_pairs()?;
-            self.grow_pairs((needed as f64 * PAIR_GROWTH).ceil() as u64, needed)?;
+            let grown = if self.grow_ahead { (needed as f64 * PAIR_GROWTH).ceil() as u64 } else { needed };
+            self.grow_pairs(grown, needed)?;
             self.go_on_after_stop(mark);
         }
     }
