@@ -666,10 +666,13 @@ fn rebuilds_that_stop_on_full_pair_buffers_keep_each_scenes_bits() {
     ovv.integrator = Integrator::OptimizedVerlet;
     let mut wet = common::wet_gas();
     wet.model.rolling = grains::model::RollingLaw::Sds { k_r: 50.0, gamma_r: 0.0, mu_r: 0.05 };
+    // 2,500 grains: more than one scan block (2,048), so that the reverse lists' scan after a
+    // stop reads the block totals' slot the stop zeroed.
     let servo = common::parse(&common::edit(
         &std::fs::read_to_string(common::scene_path("dry_iso_100pa.toml")).unwrap(),
-        &[("count = 8000", "count = 300"), ("max = [28.0e-3, 28.0e-3, 28.0e-3]", "max = [9.4e-3, 9.4e-3, 9.4e-3]")],
+        &[("count = 8000", "count = 2500"), ("max = [28.0e-3, 28.0e-3, 28.0e-3]", "max = [19.0e-3, 19.0e-3, 19.0e-3]")],
     ));
+    assert!(servo.grains.len() as u64 + 1 > grains::gpu::layout::SCAN_BLOCK);
     let wet_volume = wet.stages[0].wet_volume;
     for (name, scene, volume) in [("optimized Verlet gas", &ovv, None), ("wet gas", &wet, wet_volume), ("servo box", &servo, None)] {
         let run = |pairs: Option<u64>| -> Option<(Vec<u64>, u64, u64, u64)> {

@@ -13,6 +13,11 @@ fn servo_pressure(walls: &[layout::Wall], reaction: &[[f32; 4]], planes: [usize;
     -(0..3).map(|c| r[c] as f64 * n[c] as f64).sum::<f64>() / area
 }
 
+/// `factor` times `pairs`, rounded up: pair buffers with a margin.
+fn with_margin(pairs: u64, factor: f64) -> u64 {
+    (pairs as f64 * factor).ceil() as u64
+}
+
 /// Force (N) and torque (N m) on one grain.
 pub type GrainLoad = ([f32; 3], [f32; 3]);
 
@@ -56,7 +61,7 @@ impl GpuEngine {
                 return Err(SimError::Device { what: "control".into(), reason: format!("a rebuild stopped on full pair buffers at rebuild check {stopped} of {} encoded since the last check", marks.len()) });
             };
             let needed = self.listed_pairs()?;
-            let grown = if self.grow_ahead { (needed as f64 * PAIR_GROWTH).ceil() as u64 } else { needed };
+            let grown = if self.grow_ahead { with_margin(needed, PAIR_GROWTH) } else { needed };
             self.grow_pairs(grown, needed)?;
             self.go_on_after_stop(mark);
         }
@@ -103,7 +108,7 @@ impl GpuEngine {
     /// `pairs` fill more than [`PAIR_GROWTH_THRESHOLD`] of them.
     fn make_room_for(&mut self, pairs: u64) -> Result<(), SimError> {
         if pairs as f64 > PAIR_GROWTH_THRESHOLD * self.params.pair_capacity as f64 {
-            self.grow_pairs((pairs as f64 * PAIR_GROWTH).ceil() as u64, pairs)?;
+            self.grow_pairs(with_margin(pairs, PAIR_GROWTH), pairs)?;
         }
         Ok(())
     }
@@ -139,7 +144,7 @@ impl GpuEngine {
         self.gpu.queue.submit([encoder.finish()]);
         let pairs = self.listed_pairs()?;
         self.gpu.queue.write_buffer(&self.buffers["control"], 0, bytemuck::bytes_of(&self.control));
-        self.grow_pairs((pairs as f64 * PAIR_HEADROOM).ceil() as u64, pairs)
+        self.grow_pairs(with_margin(pairs, PAIR_HEADROOM), pairs)
     }
 
     /// Rebuilds the neighbour list at the next step, whatever the displacements.
