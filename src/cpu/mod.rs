@@ -27,6 +27,7 @@ mod stats;
 mod traffic;
 mod wall_contacts;
 mod wall_springs;
+mod warm;
 
 pub use integrate::rotate;
 pub use pairs::{owned_pairs, PairList};
@@ -949,10 +950,12 @@ impl<T: Real> Engine for CpuEngine<T> {
         self.time
     }
     fn advance(&mut self, n: u64) -> Result<(), SimError> {
-        for _ in 0..n {
-            self.step()?;
-        }
-        Ok(())
+        warm::with_warm_pool(|| {
+            for _ in 0..n {
+                self.step()?;
+            }
+            Ok(())
+        })
     }
 
     fn set_piston_pressure(&mut self, pressure: f64) {
