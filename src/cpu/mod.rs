@@ -512,17 +512,14 @@ impl<T: Real> CpuEngine<T> {
         if let Some(k) = kick {
             self.kick_piston(k);
         }
-        // Compensated positions (f32) make this sweep 2.4x longer per grain; there, tasks of one
-        // chunk where there are chunks enough for two tasks of the usual size, so that a helper
-        // thread that wakes late still takes a share (10^4 grains, f32, two threads: 1.88e7-1.92e7
-        // -> 2.07e7-2.12e7 particle-steps/s; in f64 the same made it 2% slower, and splitting the
-        // 3000-grain pour's two chunks made it 19% slower).
-        let min_len = if T::COMPENSATED && self.body.len().div_ceil(CHUNK) >= 2 * PAR_MIN_CHUNKS { 1 } else { PAR_MIN_CHUNKS };
+        // Tasks of two chunks or more, in f32 too: with the pool kept warm (`warm`), the tasks
+        // of one chunk that once let a late-waking helper take a share of f32's longer sweep
+        // made two threads 5% slower (10^4 grains: 1.533e7 / 1.559e7 against 1.615e7 / 1.640e7).
         let grains = self.body.par_chunks_mut(CHUNK).zip(self.built_at.par_chunks(CHUNK)).zip(self.load.par_chunks(CHUNK).zip(self.prop.par_chunks(CHUNK)));
         let moved: Vec<T> = if T::COMPENSATED {
-            grains.zip(self.residual.par_chunks_mut(CHUNK)).with_min_len(min_len).map(|(((b, at), (l, p)), r)| integrate::kick_drift(b, r, at, l, p, kick, tau)).collect()
+            grains.zip(self.residual.par_chunks_mut(CHUNK)).with_min_len(PAR_MIN_CHUNKS).map(|(((b, at), (l, p)), r)| integrate::kick_drift(b, r, at, l, p, kick, tau)).collect()
         } else {
-            grains.with_min_len(min_len).map(|((b, at), (l, p))| integrate::kick_drift(b, &mut [], at, l, p, kick, tau)).collect()
+            grains.with_min_len(PAR_MIN_CHUNKS).map(|((b, at), (l, p))| integrate::kick_drift(b, &mut [], at, l, p, kick, tau)).collect()
         };
         if let Some(q) = &mut self.orientation {
             let body = &self.body;
