@@ -21,6 +21,7 @@ pub(crate) mod profile;
 pub(crate) mod reduce;
 mod reorder;
 mod snapshot;
+mod split;
 pub mod simd;
 mod state;
 mod stats;
@@ -56,7 +57,7 @@ use pair_force::{owner_block, OwnerBlock, TaskScratch};
 use profile::{Phase, PhaseClock};
 use reorder::Renumbering;
 use rayon::prelude::*;
-use reduce::{chunked, CHUNK, PAR_MIN_CHUNKS, PAR_MIN_ITEMS, PAR_MIN_PAIRS};
+use reduce::{chunked, CHUNK, PAR_MIN_ITEMS};
 use wall_contacts::{wall_block, WallTouch};
 use wall_springs::WallSprings;
 
@@ -470,12 +471,19 @@ impl<T: Real> CpuEngine<T> {
             material: &self.material,
         };
         let (pairs, body, prop, gravity) = (&self.pairs, &self.body, &self.prop, self.gravity);
-        let blocks = owner_blocks(pairs, self.slots.stride, &mut self.load, &mut self.share, &mut self.report, &mut self.force_i, &mut self.hist);
-        let min_blocks = (PAR_MIN_PAIRS * blocks.len()).div_ceil(pairs.len().max(1));
-        blocks.into_par_iter().with_min_len(min_blocks.max(1)).for_each_init(TaskScratch::default, |scratch, b| owner_block(b, scratch, pairs, body, prop, &ctx, gravity));
+        let bounds = self.split();
+        let mut blocks = owner_blocks(pairs, self.slots.stride, &mut self.load, &mut self.share, &mut self.report, &mut self.force_i, &mut self.hist).into_iter();
+        // Each part's owner blocks (parts start at block boundaries).
+        let parts: Vec<Vec<OwnerBlock<T>>> = bounds.windows(2).map(|w| blocks.by_ref().take(w[1].div_ceil(pair_force::OWNERS) - w[0] / pair_force::OWNERS).collect()).collect();
+        parts.into_par_iter().for_each(|part| {
+            let mut scratch = TaskScratch::default();
+            for b in part {
+                owner_block(b, &mut scratch, pairs, body, prop, &ctx, gravity);
+            }
+        });
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
-        let (sums, touches) = complete_loads(&ctx, pairs, &self.share, &self.id, &mut self.body, prop, &self.walls, &mut self.load, &mut self.wall_springs, kick);
+        let (sums, touches) = complete_loads(&ctx, pairs, &self.share, &self.id, &bounds, &mut self.body, prop, &self.walls, &mut self.load, &mut self.wall_springs, kick);
         self.wall_touches = touches;
         self.wall_reaction = sums.reaction;
         self.wall_count = sums.count;
@@ -483,6 +491,11 @@ impl<T: Real> CpuEngine<T> {
         self.wall_regimes = sums.regimes;
         self.forces_valid = true;
         self.clock.stop(Phase::Gather, t);
+    }
+
+    /// The slots' parts, one per thread of the pool ([`split::split`]).
+    fn split(&self) -> Vec<usize> {
+        split::split(&self.pairs, self.body.len(), rayon::current_num_threads())
     }
 
     /// Kick of every grain and of the piston by `tau` (s).
@@ -512,15 +525,17 @@ impl<T: Real> CpuEngine<T> {
         if let Some(k) = kick {
             self.kick_piston(k);
         }
-        // Tasks of two chunks or more, in f32 too: with the pool kept warm (`warm`), the tasks
-        // of one chunk that once let a late-waking helper take a share of f32's longer sweep
-        // made two threads 5% slower (10^4 grains: 1.533e7 / 1.559e7 against 1.615e7 / 1.640e7).
-        let grains = self.body.par_chunks_mut(CHUNK).zip(self.built_at.par_chunks(CHUNK)).zip(self.load.par_chunks(CHUNK).zip(self.prop.par_chunks(CHUNK)));
-        let moved: Vec<T> = if T::COMPENSATED {
-            grains.zip(self.residual.par_chunks_mut(CHUNK)).with_min_len(PAR_MIN_CHUNKS).map(|(((b, at), (l, p)), r)| integrate::kick_drift(b, r, at, l, p, kick, tau)).collect()
-        } else {
-            grains.with_min_len(PAR_MIN_CHUNKS).map(|((b, at), (l, p))| integrate::kick_drift(b, &mut [], at, l, p, kick, tau)).collect()
-        };
+        let bounds = self.split();
+        let (mut body, mut residual) = (&mut self.body[..], &mut self.residual[..]);
+        let parts: Vec<_> = bounds
+            .windows(2)
+            .map(|w| {
+                let grains = w[0]..w[1];
+                let r = if T::COMPENSATED { take_front(&mut residual, grains.len()) } else { &mut [] };
+                (take_front(&mut body, grains.len()), r, &self.built_at[grains.clone()], &self.load[grains.clone()], &self.prop[grains])
+            })
+            .collect();
+        let moved: Vec<T> = parts.into_par_iter().map(|(b, r, at, l, p)| integrate::kick_drift(b, r, at, l, p, kick, tau)).collect();
         if let Some(q) = &mut self.orientation {
             let body = &self.body;
             q.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, q)| *q = integrate::rotate(*q, body[i].omega, tau));
@@ -827,17 +842,18 @@ fn absorb<T: Real>(total: &mut [WallRow<T>], part: &mut [WallRow<T>]) {
     }
 }
 
-/// `gather`, then `wall_contacts`, over every grain in one sweep (chunk by chunk): each
-/// grain's load gets its partners' shares, then its wall load. Returns the per-wall sums
-/// ([`WallSums::of`]) and the wall contacts, sorted by grain id, then wall.
-/// With `kick` (s), each grain is then kicked by its load in the same sweep (see
-/// [`CpuEngine::kick`]; the piston's kick is the caller's).
+/// `gather`, then `wall_contacts`, over every grain in one sweep, one part of the slots
+/// ([`split::split`]'s `bounds`) a task: each grain's load gets its partners' shares, then its
+/// wall load. Returns the per-wall sums ([`WallSums::of`]) and the wall contacts, sorted by
+/// grain id, then wall. With `kick` (s), each grain is then kicked by its load in the same
+/// sweep (see [`CpuEngine::kick`]; the piston's kick is the caller's).
 #[allow(clippy::too_many_arguments)]
 fn complete_loads<T: Real>(
     ctx: &ForceContext<T>,
     pairs: &PairList,
     share: &[Load<T>],
     id: &[u32],
+    bounds: &[usize],
     body: &mut [Body<T>],
     prop: &[Props<T>],
     walls: &[WallState<T>],
@@ -846,31 +862,33 @@ fn complete_loads<T: Real>(
     kick: Option<T>,
 ) -> (WallSums<T>, Vec<WallTouch<T>>) {
     let per_grain = walls.len() * ctx.slots.stride;
-    let (entry, chunk_start) = (&wall_springs.entry, &wall_springs.chunk_start);
-    let run = |c: usize, loads: &mut [Load<T>], bodies: &mut [Body<T>], springs: &mut [T]| {
-        let grains = c * CHUNK..c * CHUNK + loads.len();
-        gather_block(c * CHUNK, loads, pairs, share);
-        let mut touches = Vec::new();
-        if !walls.is_empty() {
-            wall_block(c * CHUNK, loads, &entry[grains.clone()], chunk_start[c], springs, &id[grains.clone()], bodies, &prop[grains.clone()], walls, ctx, &mut touches);
-        }
-        if let Some(tau) = kick {
-            for ((b, l), p) in bodies.iter_mut().zip(loads.iter()).zip(&prop[grains]) {
-                integrate::kick(b, l, p, tau);
+    // Each part's first wall-spring entry (walls keep entries even where they keep no history).
+    let first_entries: Vec<u32> = bounds.iter().map(|&b| if walls.is_empty() { 0 } else { wall_springs.first_entry(b) }).collect();
+    let (entry, mut springs) = (&wall_springs.entry, &mut wall_springs.springs[..]);
+    let (mut loads, mut bodies) = (load, body);
+    let parts: Vec<_> = bounds
+        .windows(2)
+        .zip(first_entries.windows(2))
+        .map(|(w, e)| (w[0], e[0], take_front(&mut loads, w[1] - w[0]), take_front(&mut bodies, w[1] - w[0]), take_front(&mut springs, (e[1] - e[0]) as usize * per_grain)))
+        .collect();
+    let touches: Vec<Vec<WallTouch<T>>> = parts
+        .into_par_iter()
+        .map(|(first, base, loads, bodies, springs)| {
+            let grains = first..first + loads.len();
+            gather_block(first, loads, pairs, share);
+            let mut touches = Vec::new();
+            if !walls.is_empty() {
+                wall_block(first, loads, &entry[grains.clone()], base, springs, &id[grains.clone()], bodies, &prop[grains.clone()], walls, ctx, &mut touches);
             }
-        }
-        touches
-    };
-    let grains = load.par_chunks_mut(CHUNK).zip(body.par_chunks_mut(CHUNK));
-    let parts: Vec<Vec<WallTouch<T>>> = if per_grain == 0 {
-        grains.with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, (loads, bodies))| run(c, loads, bodies, &mut [])).collect()
-    } else {
-        // Each chunk's run of entries.
-        let mut rest = &mut wall_springs.springs[..];
-        let springs: Vec<&mut [T]> = chunk_start.windows(2).map(|w| take_front(&mut rest, (w[1] - w[0]) as usize * per_grain)).collect();
-        grains.zip(springs).with_min_len(PAR_MIN_CHUNKS).enumerate().map(|(c, ((loads, bodies), springs))| run(c, loads, bodies, springs)).collect()
-    };
-    let mut touches = parts.concat();
+            if let Some(tau) = kick {
+                for ((b, l), p) in bodies.iter_mut().zip(loads.iter()).zip(&prop[grains]) {
+                    integrate::kick(b, l, p, tau);
+                }
+            }
+            touches
+        })
+        .collect();
+    let mut touches = touches.concat();
     touches.sort_unstable_by_key(|t| (t.grain, t.wall));
     (WallSums::of(walls.len(), id.len(), &touches), touches)
 }
@@ -1017,7 +1035,7 @@ impl<T: Real> Engine for CpuEngine<T> {
         let l = &self.pairs;
         let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.material) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
         let ws = &self.wall_springs;
-        let walls = allocated(&ws.entry) + allocated(&ws.chunk_start) + allocated(&ws.springs) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
+        let walls = allocated(&ws.entry) + allocated(&ws.run_start) + allocated(&ws.springs) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
         let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
         grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)
     }

@@ -5,9 +5,10 @@
 //! rebuild's trigger) and the walls move less than half the skin (the trigger of a new choice,
 //! [`WallSprings::stale`]); its springs would be zero, so they are not kept, and the wall pass
 //! does not visit it. Each candidate's entry holds one history block per wall, as the dense
-//! array did per grain; the entries sit in slot order, so each chunk of slots has its own run.
+//! array did per grain; the entries sit in slot order, so each run of slots has its own run of
+//! entries.
 
-use super::reduce::CHUNK;
+use super::split::ALIGN;
 use super::state::Props;
 use super::wall_contacts::WallState;
 use crate::real::{Real, Vec3};
@@ -21,8 +22,9 @@ pub const NO_ENTRY: u32 = u32::MAX;
 pub struct WallSprings<T> {
     /// Each slot's entry, or [`NO_ENTRY`]; empty without walls.
     pub entry: Vec<u32>,
-    /// The first entry of each chunk of [`CHUNK`] slots, and the number of entries last.
-    pub chunk_start: Vec<u32>,
+    /// The first entry of each run of [`ALIGN`] slots (where a thread's part of the slots may
+    /// start), and the number of entries last.
+    pub run_start: Vec<u32>,
     /// The entries' history blocks, `walls x stride` reals each.
     pub springs: Vec<T>,
     /// The walls' surfaces when the candidates were chosen.
@@ -38,12 +40,12 @@ impl<T: Real> WallSprings<T> {
             return WallSprings::default();
         }
         let mut entry = Vec::with_capacity(built_at.len());
-        let mut chunk_start = Vec::with_capacity(built_at.len().div_ceil(CHUNK) + 1);
+        let mut run_start = Vec::with_capacity(built_at.len().div_ceil(ALIGN) + 1);
         let mut springs = Vec::new();
         let mut count = 0u32;
         for (s, (x, p)) in built_at.iter().zip(prop).enumerate() {
-            if s % CHUNK == 0 {
-                chunk_start.push(count);
+            if s % ALIGN == 0 {
+                run_start.push(count);
             }
             if !WallGeom::any_within(walls.iter().map(|w| &w.geom), *x, p.radius + skin) {
                 entry.push(NO_ENTRY);
@@ -56,8 +58,8 @@ impl<T: Real> WallSprings<T> {
                 _ => springs.resize(springs.len() + per_grain, T::ZERO),
             }
         }
-        chunk_start.push(count);
-        WallSprings { entry, chunk_start, springs, chosen_at: walls.iter().map(|w| w.geom).collect() }
+        run_start.push(count);
+        WallSprings { entry, run_start, springs, chosen_at: walls.iter().map(|w| w.geom).collect() }
     }
 
     /// True when a wall has moved half the skin or more since the candidates were chosen, so
@@ -85,9 +87,14 @@ impl<T: Real> WallSprings<T> {
         Self::choose(built_at, prop, walls, skin, per_grain, &every)
     }
 
+    /// The first entry at or after `slot`, a multiple of [`ALIGN`] or the number of grains.
+    pub fn first_entry(&self, slot: usize) -> u32 {
+        self.run_start[slot.div_ceil(ALIGN)]
+    }
+
     /// Number of candidates.
     pub fn candidates(&self) -> usize {
-        self.chunk_start.last().map_or(0, |&c| c as usize)
+        self.run_start.last().map_or(0, |&c| c as usize)
     }
 }
 
