@@ -32,16 +32,19 @@ fn slot_cost(pairs: &PairList, end: usize) -> u64 {
     OWNED_COST * pairs.owner_start[end] as u64 + PARTNERED_COST * pairs.rev_start[end] as u64 + GRAIN_COST * end as u64
 }
 
+/// The least cost of a part: [`PAR_MIN_PAIRS`] pairs' (a smaller part costs more to hand
+/// over than it saves), or that of some 5,000 grains with no pair.
+const MIN_PART_COST: u64 = PAR_MIN_PAIRS as u64 * (OWNED_COST + PARTNERED_COST);
+
 /// The boundaries of the parts of `n` grains' slots (`parts + 1` of them, from 0 to `n`) for
-/// a pool of `threads`: as many parts as threads, but no more than one per
-/// [`PAR_MIN_PAIRS`] pairs (a smaller part costs more to hand over than it saves).
+/// a pool of `threads`: as many parts as threads, but none below [`MIN_PART_COST`].
 pub fn split(pairs: &PairList, n: usize, threads: usize) -> Vec<usize> {
-    let parts = threads.min(pairs.len() / PAR_MIN_PAIRS).max(1);
-    if parts == 1 || pairs.owner_start.len() != n + 1 || pairs.rev_start.len() != n + 1 {
+    if pairs.owner_start.len() != n + 1 || pairs.rev_start.len() != n + 1 {
         return vec![0, n];
     }
-    let blocks = n.div_ceil(ALIGN);
     let total = slot_cost(pairs, n);
+    let parts = threads.min((total / MIN_PART_COST) as usize).max(1);
+    let blocks = n.div_ceil(ALIGN);
     let mut bounds = vec![0];
     for p in 1..parts {
         let target = total * p as u64 / parts as u64;
@@ -98,6 +101,8 @@ mod tests {
             assert!(costs.iter().all(|&c| c.abs_diff(even) <= block_cost), "{threads} threads: costs {costs:?}, even {even}");
         }
         assert!(split(&pairs, n, 2)[1] < n / 2);
+        // Too little work for two parts: 300 pairs; but 20,000 grains with none make two.
         assert_eq!(split(&list(100, |_| 3), 100, 2), vec![0, 100]);
+        assert_eq!(split(&list(20_000, |_| 0), 20_000, 2).len(), 3);
     }
 }
