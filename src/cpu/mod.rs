@@ -474,7 +474,7 @@ impl<T: Real> CpuEngine<T> {
         let bounds = self.split();
         let mut blocks = owner_blocks(pairs, self.slots.stride, &mut self.load, &mut self.share, &mut self.report, &mut self.force_i, &mut self.hist).into_iter();
         // Each part's owner blocks (parts start at block boundaries).
-        let parts: Vec<Vec<OwnerBlock<T>>> = bounds.windows(2).map(|w| blocks.by_ref().take(w[1].div_ceil(pair_force::OWNERS) - w[0] / pair_force::OWNERS).collect()).collect();
+        let parts: Vec<Vec<OwnerBlock<T>>> = bounds.windows(2).map(|w| blocks.by_ref().take(w[1].div_ceil(pair_force::OWNERS) - w[0].div_ceil(pair_force::OWNERS)).collect()).collect();
         parts.into_par_iter().for_each(|part| {
             let mut scratch = TaskScratch::default();
             for b in part {
