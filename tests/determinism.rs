@@ -36,8 +36,8 @@ fn check<T: Real>() {
     let (one, contacts) = trajectory_bits::<T>(1, 300);
     println!("{}: {} values compared after 300 steps, {contacts} contacts", T::NAME, one.len());
     assert!(contacts > 100, "the scene must be colliding");
-    // Two and three threads: the slots split in two and three parts (`cpu::split`), the
-    // parts' boundaries in different places.
+    // Two and three threads: the slots split in two and three parts (`cpu::split`; six where
+    // three threads share fewer cores), the parts' boundaries in different places.
     for threads in [2, 3] {
         let (other, _) = trajectory_bits::<T>(threads, 300);
         let first = one.iter().zip(&other).position(|(a, b)| a != b);

@@ -493,9 +493,9 @@ impl<T: Real> CpuEngine<T> {
         self.clock.stop(Phase::Gather, t);
     }
 
-    /// The slots' parts, one per thread of the pool ([`split::split`]).
+    /// The slots' parts, one per thread of the pool ([`split::split`], [`split::parts_for`]).
     fn split(&self) -> Vec<usize> {
-        split::split(&self.pairs, self.body.len(), rayon::current_num_threads())
+        split::split(&self.pairs, self.body.len(), split::parts_for(rayon::current_num_threads()))
     }
 
     /// Kick of every grain and of the piston by `tau` (s).
