@@ -863,7 +863,7 @@ fn complete_loads<T: Real>(
 ) -> (WallSums<T>, Vec<WallTouch<T>>) {
     let per_grain = walls.len() * ctx.slots.stride;
     // Each part's first wall-spring entry (walls keep entries even where they keep no history).
-    let first_entries: Vec<u32> = bounds.iter().map(|&b| if walls.is_empty() { 0 } else { wall_springs.first_entry(b) }).collect();
+    let first_entries: Vec<u32> = bounds.iter().map(|&b| wall_springs.first_entry(b)).collect();
     let (entry, mut springs) = (&wall_springs.entry, &mut wall_springs.springs[..]);
     let (mut loads, mut bodies) = (load, body);
     let parts: Vec<_> = bounds

@@ -87,9 +87,10 @@ impl<T: Real> WallSprings<T> {
         Self::choose(built_at, prop, walls, skin, per_grain, &every)
     }
 
-    /// The first entry at or after `slot`, a multiple of [`ALIGN`] or the number of grains.
+    /// The first entry at or after `slot`, a multiple of [`ALIGN`] or the number of grains
+    /// (0 without walls, where there are no entries).
     pub fn first_entry(&self, slot: usize) -> u32 {
-        self.run_start[slot.div_ceil(ALIGN)]
+        if self.run_start.is_empty() { 0 } else { self.run_start[slot.div_ceil(ALIGN)] }
     }
 
     /// Number of candidates.
