@@ -122,7 +122,6 @@ pub struct CpuEngine<T: Real> {
     /// coefficient (N s/m).
     wall_response: Vec<(T, T)>,
     // Pairs.
-    grid: CellGrid<T>,
     pairs: PairList,
     hist: Vec<T>,
     /// The partner's share of each pair's force and torque at the last evaluation (the
@@ -223,7 +222,6 @@ impl<T: Real> CpuEngine<T> {
             wall_count: vec![0; n_walls],
             wall_regimes: RegimeCounts::default(),
             wall_response: vec![(T::ZERO, T::ZERO); n_walls],
-            grid: CellGrid::default(),
             pairs: PairList::default(),
             hist: Vec::new(),
             share: Vec::new(),
@@ -261,19 +259,21 @@ impl<T: Real> CpuEngine<T> {
                 self.body.par_iter_mut().zip(self.image.par_iter_mut()).with_min_len(PAR_MIN_ITEMS).for_each(|(b, image)| wrap(b, &mut Vec3::default(), image));
             }
         }
-        if !hash_cells(&self.body, self.cutoff, &self.periodic, &mut self.grid) {
+        // The grid lives for the rebuild alone (6 bytes a grain at the bed's density).
+        let mut grid = CellGrid::default();
+        if !hash_cells(&self.body, self.cutoff, &self.periodic, &mut grid) {
             return Err(self.non_finite_error());
         }
         self.clock.stop(Phase::Hash, t);
         let t = self.clock.start();
-        let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &self.grid, &self.periodic, self.detect_reach, self.capacity)
+        let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grid, &self.periodic, self.detect_reach, self.capacity)
             .map_err(|(i, count)| SimError::Capacity { step: self.step, grain: self.id[i], count, capacity: self.capacity })?;
         self.clock.stop(Phase::Detect, t);
         let t = self.clock.start();
         self.hist = pairs::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
         self.pairs = pairs;
         if self.reorder_every > 0 && self.rebuilds.is_multiple_of(self.reorder_every) {
-            self.reorder();
+            self.reorder(&grid);
         }
         self.pairs.build_reverse(&self.slot);
         let n_pairs = self.pairs.len();
@@ -291,10 +291,9 @@ impl<T: Real> CpuEngine<T> {
         Ok(())
     }
 
-    /// `reorder`: renumbers the slots in Z order of the grid's cells (see [`reorder`]); the
-    /// grid then lists the new slots.
-    fn reorder(&mut self) {
-        let r = Renumbering::new(reorder::z_order(&self.grid, &self.body));
+    /// `reorder`: renumbers the slots in Z order of `grid`'s cells (see [`reorder`]).
+    fn reorder(&mut self, grid: &CellGrid<T>) {
+        let r = Renumbering::new(reorder::z_order(grid, &self.body));
         if r.is_identity() {
             return;
         }
@@ -307,16 +306,13 @@ impl<T: Real> CpuEngine<T> {
         r.apply(&mut self.built_at);
         r.apply(&mut self.image);
         r.apply(&mut self.liquid);
-        r.apply(&mut self.wall_springs.entry);
+        self.wall_springs = self.wall_springs.renumbered(&r.from, self.walls.len() * self.slots.stride);
         if let Some(q) = &mut self.orientation {
             r.apply(q);
         }
         (self.pairs, self.hist) = r.apply_pairs(&self.pairs, &self.hist, self.slots.stride);
         for (s, &id) in self.id.iter().enumerate() {
             self.slot[id as usize] = s as u32;
-        }
-        for s in &mut self.grid.cell_grains {
-            *s = r.to[*s as usize];
         }
         self.renumberings += 1;
     }
@@ -864,21 +860,21 @@ fn complete_loads<T: Real>(
     let per_grain = walls.len() * ctx.slots.stride;
     // Each part's first wall-spring entry (walls keep entries even where they keep no history).
     let first_entries: Vec<u32> = bounds.iter().map(|&b| wall_springs.first_entry(b)).collect();
-    let (entry, mut springs) = (&wall_springs.entry, &mut wall_springs.springs[..]);
+    let (candidate, mut springs) = (&wall_springs.candidate, &mut wall_springs.springs[..]);
     let (mut loads, mut bodies) = (load, body);
     let parts: Vec<_> = bounds
         .windows(2)
         .zip(first_entries.windows(2))
-        .map(|(w, e)| (w[0], e[0], take_front(&mut loads, w[1] - w[0]), take_front(&mut bodies, w[1] - w[0]), take_front(&mut springs, (e[1] - e[0]) as usize * per_grain)))
+        .map(|(w, e)| (w[0], take_front(&mut loads, w[1] - w[0]), take_front(&mut bodies, w[1] - w[0]), take_front(&mut springs, (e[1] - e[0]) as usize * per_grain)))
         .collect();
     let touches: Vec<Vec<WallTouch<T>>> = parts
         .into_par_iter()
-        .map(|(first, base, loads, bodies, springs)| {
+        .map(|(first, loads, bodies, springs)| {
             let grains = first..first + loads.len();
             gather_block(first, loads, pairs, share);
             let mut touches = Vec::new();
             if !walls.is_empty() {
-                wall_block(first, loads, &entry[grains.clone()], base, springs, &id[grains.clone()], bodies, &prop[grains.clone()], walls, ctx, &mut touches);
+                wall_block(first, loads, &candidate[first / split::ALIGN..], springs, &id[grains.clone()], bodies, &prop[grains.clone()], walls, ctx, &mut touches);
             }
             if let Some(tau) = kick {
                 for ((b, l), p) in bodies.iter_mut().zip(loads.iter()).zip(&prop[grains]) {
@@ -1035,9 +1031,9 @@ impl<T: Real> Engine for CpuEngine<T> {
         let l = &self.pairs;
         let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.material) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
         let ws = &self.wall_springs;
-        let walls = allocated(&ws.entry) + allocated(&ws.run_start) + allocated(&ws.springs) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
+        let walls = allocated(&ws.candidate) + allocated(&ws.run_start) + allocated(&ws.springs) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
         let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
-        grains + walls + pairs + allocated(&self.grid.cell_start) + allocated(&self.grid.cell_grains) + allocated(&self.coeffs)
+        grains + walls + pairs + allocated(&self.coeffs)
     }
 
     fn set_profiling(&mut self, on: bool) {

@@ -35,10 +35,10 @@ impl<T: Real> CpuEngine<T> {
         let force = bytes(&l.partner) + body + residual + prop + bytes(&r.flags) + live(2 * bytes(&self.hist) + pair_out) + bytes(&self.load);
         // The wall contacts run in the gather's sweep, on the loads it has in hand.
         // Only the candidates ([`super::wall_springs`]) are visited: their grains' state and their
-        // springs, read and written; every grain's entry is read.
+        // springs, read and written; every grain's candidate bit is read.
         let ws = &self.wall_springs;
         let candidates_of = |b: u64| b / self.body.len().max(1) as u64 * ws.candidates() as u64;
-        let walls = if self.walls.is_empty() { 0 } else { bytes(&ws.entry) + candidates_of(body + residual + prop) + 2 * bytes(&ws.springs) };
+        let walls = if self.walls.is_empty() { 0 } else { bytes(&ws.candidate) + candidates_of(body + residual + prop) + 2 * bytes(&ws.springs) };
         let gather = bytes(&self.share) + bytes(&l.rev_start) + bytes(&l.rev_pair) + 2 * bytes(&self.load);
         let mut out: Vec<(&'static str, u64)> = Vec::new();
         let mut add = |name: &'static str, b: u64| match out.iter_mut().find(|e| e.0 == name) {

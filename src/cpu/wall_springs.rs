@@ -6,7 +6,9 @@
 //! [`WallSprings::stale`]); its springs would be zero, so they are not kept, and the wall pass
 //! does not visit it. Each candidate's entry holds one history block per wall, as the dense
 //! array did per grain; the entries sit in slot order, so each run of slots has its own run of
-//! entries.
+//! entries. Which slots are candidates is one bit per slot (a word per run of [`ALIGN`]
+//! slots), and a candidate's entry is its run's first entry plus the candidates before it in
+//! the run: an eighth of a byte per grain where an entry index per slot took four.
 
 use super::split::ALIGN;
 use super::state::Props;
@@ -14,14 +16,15 @@ use super::wall_contacts::WallState;
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
 
-/// No entry: a grain no wall can reach.
-pub const NO_ENTRY: u32 = u32::MAX;
+/// One word of candidate bits per run of slots.
+const _: () = assert!(ALIGN == u64::BITS as usize);
 
 /// The candidates' wall springs.
 #[derive(Clone, Debug, Default)]
 pub struct WallSprings<T> {
-    /// Each slot's entry, or [`NO_ENTRY`]; empty without walls.
-    pub entry: Vec<u32>,
+    /// Bit `s % ALIGN` of word `s / ALIGN` is set when slot `s` is a candidate; empty without
+    /// walls.
+    pub candidate: Vec<u64>,
     /// The first entry of each run of [`ALIGN`] slots (where a thread's part of the slots may
     /// start), and the number of entries last.
     pub run_start: Vec<u32>,
@@ -29,6 +32,45 @@ pub struct WallSprings<T> {
     pub springs: Vec<T>,
     /// The walls' surfaces when the candidates were chosen.
     chosen_at: Vec<WallGeom<T>>,
+}
+
+/// True when slot `m` (counted from a multiple of [`ALIGN`]) is a candidate in `words`, the
+/// candidate bits from that slot on.
+#[inline(always)]
+pub fn is_candidate(words: &[u64], m: usize) -> bool {
+    words[m / ALIGN] >> (m % ALIGN) & 1 != 0
+}
+
+/// Candidates in slot order with their springs: what [`WallSprings::choose`] and
+/// [`WallSprings::renumbered`] fill.
+struct Builder<T> {
+    candidate: Vec<u64>,
+    run_start: Vec<u32>,
+    springs: Vec<T>,
+    count: u32,
+}
+
+impl<T: Real> Builder<T> {
+    fn new(n: usize) -> Self {
+        Builder { candidate: vec![0; n.div_ceil(ALIGN)], run_start: Vec::with_capacity(n.div_ceil(ALIGN) + 1), springs: Vec::new(), count: 0 }
+    }
+
+    /// Slot `s` (the next one): a candidate with `springs`, or none.
+    fn push(&mut self, s: usize, springs: Option<&[T]>) {
+        if s.is_multiple_of(ALIGN) {
+            self.run_start.push(self.count);
+        }
+        if let Some(h) = springs {
+            self.candidate[s / ALIGN] |= 1 << (s % ALIGN);
+            self.springs.extend_from_slice(h);
+            self.count += 1;
+        }
+    }
+
+    fn finish(mut self, chosen_at: Vec<WallGeom<T>>) -> WallSprings<T> {
+        self.run_start.push(self.count);
+        WallSprings { candidate: self.candidate, run_start: self.run_start, springs: self.springs, chosen_at }
+    }
 }
 
 impl<T: Real> WallSprings<T> {
@@ -39,27 +81,37 @@ impl<T: Real> WallSprings<T> {
         if walls.is_empty() {
             return WallSprings::default();
         }
-        let mut entry = Vec::with_capacity(built_at.len());
-        let mut run_start = Vec::with_capacity(built_at.len().div_ceil(ALIGN) + 1);
-        let mut springs = Vec::new();
-        let mut count = 0u32;
+        let zeros = vec![T::ZERO; per_grain];
+        let mut b = Builder::new(built_at.len());
         for (s, (x, p)) in built_at.iter().zip(prop).enumerate() {
-            if s % ALIGN == 0 {
-                run_start.push(count);
-            }
-            if !WallGeom::any_within(walls.iter().map(|w| &w.geom), *x, p.radius + skin) {
-                entry.push(NO_ENTRY);
-                continue;
-            }
-            entry.push(count);
-            count += 1;
-            match old.entry.get(s) {
-                Some(&e) if e != NO_ENTRY => springs.extend_from_slice(&old.springs[e as usize * per_grain..(e as usize + 1) * per_grain]),
-                _ => springs.resize(springs.len() + per_grain, T::ZERO),
-            }
+            let near = WallGeom::any_within(walls.iter().map(|w| &w.geom), *x, p.radius + skin);
+            b.push(s, near.then(|| old.springs_of(s, per_grain).unwrap_or(&zeros)));
         }
-        run_start.push(count);
-        WallSprings { entry, run_start, springs, chosen_at: walls.iter().map(|w| w.geom).collect() }
+        b.finish(walls.iter().map(|w| w.geom).collect())
+    }
+
+    /// The same candidates and springs in new slots: new slot `s` is old slot `from[s]`.
+    pub fn renumbered(&self, from: &[u32], per_grain: usize) -> Self {
+        if self.candidate.is_empty() {
+            return self.clone();
+        }
+        let mut b = Builder::new(from.len());
+        for (s, &o) in from.iter().enumerate() {
+            b.push(s, self.springs_of(o as usize, per_grain));
+        }
+        b.finish(self.chosen_at.clone())
+    }
+
+    /// Slot `s`'s entry, where it is a candidate.
+    pub fn entry(&self, s: usize) -> Option<usize> {
+        let word = *self.candidate.get(s / ALIGN)?;
+        let below = word & ((1u64 << (s % ALIGN)) - 1);
+        (word >> (s % ALIGN) & 1 != 0).then(|| self.run_start[s / ALIGN] as usize + below.count_ones() as usize)
+    }
+
+    /// Slot `s`'s springs, `per_grain` reals, where it is a candidate.
+    fn springs_of(&self, s: usize, per_grain: usize) -> Option<&[T]> {
+        self.entry(s).map(|e| &self.springs[e * per_grain..(e + 1) * per_grain])
     }
 
     /// True when a wall has moved half the skin or more since the candidates were chosen, so
@@ -72,10 +124,13 @@ impl<T: Real> WallSprings<T> {
     /// Every grain's springs, `per_grain` reals each (zeros where a grain has no entry): the
     /// dense layout of saved states.
     pub fn dense(&self, n: usize, per_grain: usize) -> Vec<T> {
-        let mut out = vec![T::ZERO; if self.entry.is_empty() { 0 } else { n * per_grain }];
-        for (s, &e) in self.entry.iter().enumerate() {
-            if e != NO_ENTRY {
-                out[s * per_grain..(s + 1) * per_grain].copy_from_slice(&self.springs[e as usize * per_grain..(e as usize + 1) * per_grain]);
+        if self.candidate.is_empty() {
+            return Vec::new();
+        }
+        let mut out = vec![T::ZERO; n * per_grain];
+        for s in 0..n {
+            if let Some(h) = self.springs_of(s, per_grain) {
+                out[s * per_grain..(s + 1) * per_grain].copy_from_slice(h);
             }
         }
         out
@@ -83,8 +138,11 @@ impl<T: Real> WallSprings<T> {
 
     /// [`Self::choose`] with the springs of a dense array ([`Self::dense`]).
     pub fn from_dense(dense: &[T], built_at: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], skin: T, per_grain: usize) -> Self {
-        let every = WallSprings { entry: (0..built_at.len() as u32).collect(), springs: dense.to_vec(), ..Default::default() };
-        Self::choose(built_at, prop, walls, skin, per_grain, &every)
+        let mut every = Builder::new(built_at.len());
+        for s in 0..built_at.len() {
+            every.push(s, dense.get(s * per_grain..(s + 1) * per_grain));
+        }
+        Self::choose(built_at, prop, walls, skin, per_grain, &every.finish(Vec::new()))
     }
 
     /// The first entry at or after `slot`, a multiple of [`ALIGN`] or the number of grains
@@ -156,7 +214,7 @@ duration = 1.0e-2
                 for wall in &e.walls {
                     if wall.geom.frame(b.pos, Vec3::ZERO).1 < p.radius {
                         contacts += 1;
-                        assert_ne!(e.wall_springs.entry[s], NO_ENTRY, "step {step}: grain {} touches a wall without an entry", e.id[s]);
+                        assert!(e.wall_springs.entry(s).is_some(), "step {step}: grain {} touches a wall without an entry", e.id[s]);
                     }
                 }
             }
