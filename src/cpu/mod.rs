@@ -9,6 +9,7 @@
 
 mod gather;
 mod grid;
+mod built_at;
 mod controllers;
 mod integrate;
 mod lanes;
@@ -100,7 +101,8 @@ pub struct CpuEngine<T: Real> {
     /// Material index by slot; empty in a scene of one material (all 0).
     material: Vec<u32>,
     load: Vec<Load<T>>,
-    built_at: Vec<Vec3<T>>,
+    /// Each grain's position at the last neighbour build, in f32 ([`built_at`]).
+    built_at: Vec<Vec3<f32>>,
     /// Periods each grain has been wrapped by (empty without periodic axes).
     image: Vec<[i32; 3]>,
     orientation: Option<Vec<[T; 4]>>,
@@ -162,11 +164,7 @@ impl<T: Real> CpuEngine<T> {
         let body: Vec<Body<T>> = (0..n).map(|i| Body { pos: positions[i], vel: Vec3::of(g.velocity[i]), omega: Vec3::of(g.angular_velocity[i]) }).collect();
         let residual = if T::COMPENSATED { residual } else { Vec::new() };
         let prop: Vec<Props<T>> = (0..n)
-            .map(|i| Props {
-                radius: T::of(g.radius[i]),
-                mass: T::of(g.mass[i]),
-                inertia: T::of(0.4 * g.mass[i] * g.radius[i] * g.radius[i]),
-            })
+            .map(|i| Props { radius: T::of(g.radius[i]), mass: T::of(g.mass[i]) })
             .collect();
         let r_max = g.radius.iter().copied().fold(0.0, f64::max);
         let model = scene.model.cast::<T>();
@@ -204,7 +202,7 @@ impl<T: Real> CpuEngine<T> {
             reorder_every: scene.reorder_every,
             id: (0..n as u32).collect(),
             slot: (0..n as u32).collect(),
-            built_at: body.iter().map(|b| b.pos).collect(),
+            built_at: body.iter().map(|b| built_at::record(b.pos)).collect(),
             image: if scene.periodic.iter().any(Option::is_some) { vec![[0; 3]; n] } else { Vec::new() },
             body,
             residual,
@@ -281,7 +279,7 @@ impl<T: Real> CpuEngine<T> {
         self.report.renew(n_pairs, self.slots.layout.bridge);
         renew(&mut self.force_i, if self.model.keeps_both_forces() { n_pairs } else { 0 });
         for (b, at) in self.body.iter().zip(self.built_at.iter_mut()) {
-            *at = b.pos;
+            *at = built_at::record(b.pos);
         }
         self.choose_wall_springs();
         self.rebuilds += 1;

@@ -272,7 +272,7 @@ impl<T: Real> CpuEngine<T> {
     pub(crate) fn moved2_of(&self, ids: impl Iterator<Item = u32>) -> f64 {
         ids.map(|i| {
             let s = self.slot[i as usize] as usize;
-            (self.body[s].pos - self.built_at[s]).norm2()
+            super::built_at::moved2(self.body[s].pos, self.built_at[s])
         })
         .fold(T::ZERO, T::max)
         .f64()

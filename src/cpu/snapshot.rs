@@ -61,7 +61,7 @@ impl<T: Real> CpuEngine<T> {
         if T::COMPENSATED {
             s.put_reals("residual", self.residual.iter().flat_map(v3));
         }
-        s.put_reals("built_at", self.built_at.iter().flat_map(v3));
+        s.put_reals("built_at", self.built_at.iter().flat_map(|v| v.f64()));
         s.put_ints("image", self.image.iter().flat_map(|i| i.map(|x| x as i64 as u64)));
         if let Some(q) = &self.orientation {
             s.put_reals("orientation", q.iter().flat_map(|q| q.map(T::f64)));
@@ -137,7 +137,7 @@ impl<T: Real> CpuEngine<T> {
             self.residual = s.reals("residual", 3 * n)?.chunks_exact(3).map(v3).collect();
         }
         for (b, c) in self.built_at.iter_mut().zip(s.reals("built_at", 3 * n)?.chunks_exact(3)) {
-            *b = v3(c);
+            *b = Vec3::of([c[0], c[1], c[2]]);
         }
         let images = s.ints("image", Some(3 * self.image.len()))?;
         for (i, c) in self.image.iter_mut().zip(images.chunks_exact(3)) {

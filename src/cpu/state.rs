@@ -23,8 +23,16 @@ pub struct Props<T> {
     pub radius: T,
     /// Mass (kg).
     pub mass: T,
-    /// Moment of inertia `2/5 m R^2` (kg m^2).
-    pub inertia: T,
+}
+
+impl<T: Real> Props<T> {
+    /// Moment of inertia `2/5 m R^2` (kg m^2), computed where it is read rather than kept (a
+    /// real a grain): in f64 the same bits as the scene's f64 product; the GPU's upload takes
+    /// it from this function, so its f32 twin has them too.
+    #[inline(always)]
+    pub fn inertia(&self) -> T {
+        T::of(0.4) * self.mass * self.radius * self.radius
+    }
 }
 
 /// Material index of slot `i` in `material`, the engine's indices by slot (empty in a scene

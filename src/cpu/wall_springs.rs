@@ -77,14 +77,16 @@ impl<T: Real> WallSprings<T> {
     /// Chooses the candidates: the grains whose position at the last rebuild (`built_at`) is
     /// nearer than their radius plus `skin` to a wall, now. Each keeps its springs from `old`
     /// (whose entries are by the same slots), or starts from zero. `per_grain` reals an entry.
-    pub fn choose(built_at: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], skin: T, per_grain: usize, old: &WallSprings<T>) -> Self {
+    pub fn choose(built_at: &[Vec3<f32>], prop: &[Props<T>], walls: &[WallState<T>], skin: T, per_grain: usize, old: &WallSprings<T>) -> Self {
         if walls.is_empty() {
             return WallSprings::default();
         }
         let zeros = vec![T::ZERO; per_grain];
         let mut b = Builder::new(built_at.len());
-        for (s, (x, p)) in built_at.iter().zip(prop).enumerate() {
-            let near = WallGeom::any_within(walls.iter().map(|w| &w.geom), *x, p.radius + skin);
+        for (s, (&at, p)) in built_at.iter().zip(prop).enumerate() {
+            // The kept position's rounding ([`super::built_at`]) widens the reach.
+            let (x, rounding) = super::built_at::recorded::<T>(at);
+            let near = WallGeom::any_within(walls.iter().map(|w| &w.geom), x, p.radius + skin + rounding);
             b.push(s, near.then(|| old.springs_of(s, per_grain).unwrap_or(&zeros)));
         }
         b.finish(walls.iter().map(|w| w.geom).collect())
@@ -137,7 +139,7 @@ impl<T: Real> WallSprings<T> {
     }
 
     /// [`Self::choose`] with the springs of a dense array ([`Self::dense`]).
-    pub fn from_dense(dense: &[T], built_at: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], skin: T, per_grain: usize) -> Self {
+    pub fn from_dense(dense: &[T], built_at: &[Vec3<f32>], prop: &[Props<T>], walls: &[WallState<T>], skin: T, per_grain: usize) -> Self {
         let mut every = Builder::new(built_at.len());
         for s in 0..built_at.len() {
             every.push(s, dense.get(s * per_grain..(s + 1) * per_grain));

@@ -225,18 +225,19 @@ pub(crate) fn engine_bytes(scene: &Scene, real: usize, pairs_per_grain: f64) -> 
     let capillary = matches!(model.cohesion, CohesionLaw::Capillary { .. });
     let owner_force = matches!(model.tangential, TangentialLaw::Oquendo(_));
     let some = |yes: bool, bytes: usize| if yes { bytes } else { 0 };
-    // Reals: body 9, properties 3, load 6, position at the last build 3, the position's
-    // residual 3 (f32), the orientation 4, the liquid 1. Then the id, the slot, the pair and
-    // reverse list starts, the cell list (u32 each), the material index where there are
-    // several, the periodic image counts, the wall springs' entry where there are walls.
+    // Reals: body 9, properties 2, load 6, the position's residual 3 (f32), the orientation
+    // 4, the liquid 1. The position at the last build, 3 f32. Then the id, the slot, the pair
+    // and reverse list starts (u32 each), the material index where there are several, the
+    // periodic image counts, the wall springs' candidate bit and run start where there are
+    // walls (`cpu::wall_springs`). The cell list lives for a rebuild alone.
     let walls = !scene.walls.is_empty();
-    let per_grain = (21 + some(real == 4, 3) + some(scene.track_orientation, 4) + some(capillary, 1)) * real + 5 * 4 + some(scene.materials.len() > 1, 4) + some(scene.periodic.iter().any(Option::is_some), 12) + some(walls, 4);
+    let per_grain = ((17 + some(real == 4, 3) + some(scene.track_orientation, 4) + some(capillary, 1)) * real + 3 * 4 + 4 * 4 + some(scene.materials.len() > 1, 4) + some(scene.periodic.iter().any(Option::is_some), 12)) as f64 + if walls { (1.0 + 4.0) / 64.0 } else { 0.0 };
     // The partner and the reverse index (u32), the history, the partner's share 6 and the
     // normal force 1 reals, the capillary force, the owner's force (seed 000's law), the flags.
     let per_pair = 8 + (stride + 7 + some(capillary, 1) + some(owner_force, 3)) * real + 1;
     // One history block per wall for each grain a wall can reach (`cpu::wall_springs`), as placed.
     let wall_springs = wall_candidates(scene) * scene.walls.len() * stride * real;
-    scene.grains.len() as f64 * (per_grain as f64 + pairs_per_grain * per_pair as f64) + wall_springs as f64
+    scene.grains.len() as f64 * (per_grain + pairs_per_grain * per_pair as f64) + wall_springs as f64
 }
 
 /// The grains nearer than their radius plus the skin to a wall, as placed: those whose wall
@@ -312,8 +313,8 @@ mod tests {
     use crate::cpu::CpuEngine;
     use crate::real::Real;
 
-    /// The estimate within this of the bytes the engine holds (what it leaves out: the cell
-    /// starts and the step's wall contacts, a few bytes of several hundred a grain).
+    /// The estimate within this of the bytes the engine holds (what it leaves out: the step's
+    /// wall contacts, a few bytes of several hundred a grain).
     const ESTIMATE_TOLERANCE: f64 = 0.02;
 
     /// `grains check`'s memory estimate, given the pairs per grain the engine listed, against
