@@ -16,7 +16,7 @@ pub fn kick<T: Real>(b: &mut Body<T>, l: &Load<T>, p: &Props<T>, tau: T) {
 
 /// Drift: `x += v tau`, the sum's rounding kept in `residual` where positions are compensated
 /// ([`position::advance`]). Returns the squared displacement of `pos` since the last neighbour
-/// build (a bound on it in f64: [`built_at::moved2`]).
+/// build, as kept ([`built_at::moved2`]).
 #[inline(always)]
 pub fn drift<T: Real>(b: &mut Body<T>, residual: &mut Vec3<T>, built_at: Vec3<f32>, tau: T) -> T {
     position::advance(&mut b.pos, residual, b.vel * tau);

@@ -39,7 +39,7 @@ pub(crate) use parts::{state_of_rows, touch_of_row, touches_state, RowWidths, Ro
 pub(crate) use wall_contacts::WallTouch as WallContact;
 pub use pair_force::ForceContext;
 pub use profile::PHASE_NAMES;
-pub use state::{Body, HistorySlots, Load, PairFlags, PairReports, Props};
+pub use state::{Body, HistorySlots, Images, Load, PairFlags, PairReports, Props};
 pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::engine::EngineState;
@@ -103,8 +103,8 @@ pub struct CpuEngine<T: Real> {
     load: Vec<Load<T>>,
     /// Each grain's position at the last neighbour build, in f32 ([`built_at`]).
     built_at: Vec<Vec3<f32>>,
-    /// Periods each grain has been wrapped by (empty without periodic axes).
-    image: Vec<[i32; 3]>,
+    /// Periods each grain has been wrapped by, along the wrapping axes.
+    image: Images,
     orientation: Option<Vec<[T; 4]>>,
     // Walls.
     walls: Vec<WallState<T>>,
@@ -137,6 +137,9 @@ pub struct CpuEngine<T: Real> {
     // Clocks.
     /// Largest squared displacement of a grain since the last build (m^2), as of the last drift.
     max_moved2: T,
+    /// The largest distance between a grain's kept position at the last build and the one
+    /// recorded (m; [`built_at`]), added to every displacement found since.
+    built_margin: T,
     forces_valid: bool,
     step: u64,
     time: f64,
@@ -203,7 +206,7 @@ impl<T: Real> CpuEngine<T> {
             id: (0..n as u32).collect(),
             slot: (0..n as u32).collect(),
             built_at: body.iter().map(|b| built_at::record(b.pos)).collect(),
-            image: if scene.periodic.iter().any(Option::is_some) { vec![[0; 3]; n] } else { Vec::new() },
+            image: Images::new([0, 1, 2].map(|a| scene.periodic[a].is_some()), n),
             body,
             residual,
             prop,
@@ -226,6 +229,7 @@ impl<T: Real> CpuEngine<T> {
             report: PairReports::default(),
             force_i: Vec::new(),
             max_moved2: T::ZERO,
+            built_margin: T::ZERO,
             forces_valid: false,
             step: 0,
             time: 0.0,
@@ -245,16 +249,18 @@ impl<T: Real> CpuEngine<T> {
         let t = self.clock.start();
         if self.periodic.any() {
             let p = self.periodic;
-            let wrap = |b: &mut Body<T>, r: &mut Vec3<T>, image: &mut [i32; 3]| {
+            let (counts, axes) = self.image.parts_mut();
+            let wrap = |b: &mut Body<T>, r: &mut Vec3<T>, image: &mut [i32]| {
                 let moved = position::wrap(&p, &mut b.pos, r);
-                for a in 0..3 {
-                    image[a] += moved[a];
+                for (c, &a) in image.iter_mut().zip(axes) {
+                    *c += moved[a];
                 }
             };
+            let width = axes.len();
             if T::COMPENSATED {
-                self.body.par_iter_mut().zip(self.residual.par_iter_mut()).zip(self.image.par_iter_mut()).with_min_len(PAR_MIN_ITEMS).for_each(|((b, r), image)| wrap(b, r, image));
+                self.body.par_iter_mut().zip(self.residual.par_iter_mut()).zip(counts.par_chunks_mut(width)).with_min_len(PAR_MIN_ITEMS).for_each(|((b, r), image)| wrap(b, r, image));
             } else {
-                self.body.par_iter_mut().zip(self.image.par_iter_mut()).with_min_len(PAR_MIN_ITEMS).for_each(|(b, image)| wrap(b, &mut Vec3::default(), image));
+                self.body.par_iter_mut().zip(counts.par_chunks_mut(width)).with_min_len(PAR_MIN_ITEMS).for_each(|(b, image)| wrap(b, &mut Vec3::default(), image));
             }
         }
         // The grid lives for the rebuild alone (6 bytes a grain at the bed's density).
@@ -278,9 +284,12 @@ impl<T: Real> CpuEngine<T> {
         renew(&mut self.share, n_pairs);
         self.report.renew(n_pairs, self.slots.layout.bridge);
         renew(&mut self.force_i, if self.model.keeps_both_forces() { n_pairs } else { 0 });
+        let mut margin = T::ZERO;
         for (b, at) in self.body.iter().zip(self.built_at.iter_mut()) {
             *at = built_at::record(b.pos);
+            margin = margin.max((b.pos - built_at::widen(*at)).norm());
         }
+        self.built_margin = margin;
         self.choose_wall_springs();
         self.rebuilds += 1;
         self.max_moved2 = T::ZERO;
@@ -302,7 +311,8 @@ impl<T: Real> CpuEngine<T> {
         r.apply(&mut self.material);
         r.apply(&mut self.load);
         r.apply(&mut self.built_at);
-        r.apply(&mut self.image);
+        let width = self.image.width();
+        r.apply_blocks(self.image.parts_mut().0, width);
         r.apply(&mut self.liquid);
         self.wall_springs = self.wall_springs.renumbered(&r.from, self.walls.len() * self.slots.stride);
         if let Some(q) = &mut self.orientation {
@@ -543,7 +553,7 @@ impl<T: Real> CpuEngine<T> {
             self.external_work -= (p.pressure * p.area * dz).f64();
         }
         self.servo_drift(tau);
-        self.max_moved2 = moved.into_iter().fold(T::ZERO, T::max);
+        self.max_moved2 = built_at::with_margin(moved.into_iter().fold(T::ZERO, T::max), self.built_margin);
         self.clock.stop(Phase::Integrate, t);
     }
 
@@ -1027,7 +1037,7 @@ impl<T: Real> Engine for CpuEngine<T> {
 
     fn memory_bytes(&self) -> u64 {
         let l = &self.pairs;
-        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.material) + allocated(&self.load) + allocated(&self.built_at) + allocated(&self.image);
+        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.material) + allocated(&self.load) + allocated(&self.built_at) + allocated(self.image.counts());
         let ws = &self.wall_springs;
         let walls = allocated(&ws.candidate) + allocated(&ws.run_start) + allocated(&ws.springs) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
         let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);

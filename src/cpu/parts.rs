@@ -17,7 +17,7 @@ const PAIR_ARRAYS: [(&str, bool); 6] = [("hist", false), ("share", false), ("f_n
 pub(crate) const BRIDGE_ROW: usize = 6;
 
 /// The arrays that hold one value for the whole engine, not one per grain or pair.
-const GLOBAL_ARRAYS: [&str; 8] = ["wall_touch_ids", "wall_touches", "wall_reaction", "wall_count", "piston", "servo", "clock", "counters"];
+const GLOBAL_ARRAYS: [&str; 9] = ["wall_touch_ids", "wall_touches", "wall_reaction", "wall_count", "piston", "servo", "clock", "built_margin", "counters"];
 
 /// Values per grain and per pair of each array of [`GRAIN_ARRAYS`] and [`PAIR_ARRAYS`] (0
 /// where the scene keeps none).
@@ -222,7 +222,7 @@ impl<T: Real> CpuEngine<T> {
     pub(crate) fn row_widths(&self) -> RowWidths {
         let stride = self.slots.stride;
         RowWidths {
-            grain: [9, 6, 3 * T::COMPENSATED as usize, 3, 3 * !self.image.is_empty() as usize, 4 * self.orientation.is_some() as usize, self.walls.len() * stride, self.slots.layout.bridge as usize],
+            grain: [9, 6, 3 * T::COMPENSATED as usize, 3, 3 * (self.image.width() > 0) as usize, 4 * self.orientation.is_some() as usize, self.walls.len() * stride, self.slots.layout.bridge as usize],
             pair: [stride, 6, 1, self.slots.layout.bridge as usize, 1, 3 * self.model.keeps_both_forces() as usize],
         }
     }
@@ -268,14 +268,15 @@ impl<T: Real> CpuEngine<T> {
     }
 
     /// The largest squared displacement since the last build of the grains `ids` (m^2), as a
-    /// drift computes it.
+    /// drift computes it (with this engine's margin, [`super::built_at`]).
     pub(crate) fn moved2_of(&self, ids: impl Iterator<Item = u32>) -> f64 {
-        ids.map(|i| {
-            let s = self.slot[i as usize] as usize;
-            super::built_at::moved2(self.body[s].pos, self.built_at[s])
-        })
-        .fold(T::ZERO, T::max)
-        .f64()
+        let moved2 = ids
+            .map(|i| {
+                let s = self.slot[i as usize] as usize;
+                super::built_at::moved2(self.body[s].pos, self.built_at[s])
+            })
+            .fold(T::ZERO, T::max);
+        super::built_at::with_margin(moved2, self.built_margin).f64()
     }
 
     /// Sets the largest displacement since the last build (m^2) that the rebuild check reads.

@@ -62,7 +62,10 @@ impl<T: Real> CpuEngine<T> {
             s.put_reals("residual", self.residual.iter().flat_map(v3));
         }
         s.put_reals("built_at", self.built_at.iter().flat_map(|v| v.f64()));
-        s.put_ints("image", self.image.iter().flat_map(|i| i.map(|x| x as i64 as u64)));
+        s.put_reals("built_margin", [self.built_margin.f64()]);
+        // Three counts a grain where any axis wraps, as before they were kept for those alone.
+        let with_images = if self.image.width() > 0 { self.body.len() } else { 0 };
+        s.put_ints("image", (0..with_images).flat_map(|i| self.image.get(i).map(|x| x as i64 as u64)));
         if let Some(q) = &self.orientation {
             s.put_reals("orientation", q.iter().flat_map(|q| q.map(T::f64)));
         }
@@ -139,9 +142,15 @@ impl<T: Real> CpuEngine<T> {
         for (b, c) in self.built_at.iter_mut().zip(s.reals("built_at", 3 * n)?.chunks_exact(3)) {
             *b = Vec3::of([c[0], c[1], c[2]]);
         }
-        let images = s.ints("image", Some(3 * self.image.len()))?;
-        for (i, c) in self.image.iter_mut().zip(images.chunks_exact(3)) {
-            *i = [c[0] as i64 as i32, c[1] as i64 as i32, c[2] as i64 as i32];
+        // Where the state does not say (written before there was a margin, or put together
+        // from several processes' rows), the margin from the kept positions alone.
+        self.built_margin = match s.reals("built_margin", 1) {
+            Ok(m) => T::of(m[0]),
+            Err(_) => self.built_at.iter().map(|&at| super::built_at::bound::<T>(at)).fold(T::ZERO, T::max),
+        };
+        let with_images = if self.image.width() > 0 { n } else { 0 };
+        for (i, c) in s.ints("image", Some(3 * with_images))?.chunks_exact(3).enumerate() {
+            self.image.set(i, [c[0] as i64 as i32, c[1] as i64 as i32, c[2] as i64 as i32]);
         }
         if let Some(q) = &mut self.orientation {
             for (q, c) in q.iter_mut().zip(s.reals("orientation", 4 * n)?.chunks_exact(4)) {

@@ -42,6 +42,53 @@ pub fn material_at(material: &[u32], i: usize) -> usize {
     material.get(i).map_or(0, |&m| m as usize)
 }
 
+/// Each grain's periodic image counts (the periods it has crossed along each axis, positive
+/// upward), kept for the wrapping axes alone: a scene periodic in x and y keeps two integers a
+/// grain, one without periods none.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Images {
+    /// The wrapping axes.
+    axes: Vec<usize>,
+    /// `axes.len()` counts per grain.
+    counts: Vec<i32>,
+}
+
+impl Images {
+    /// Zero counts for `n` grains along the axes `on`.
+    pub fn new(on: [bool; 3], n: usize) -> Self {
+        let axes: Vec<usize> = (0..3).filter(|&a| on[a]).collect();
+        Images { counts: vec![0; n * axes.len()], axes }
+    }
+    /// Counts per grain.
+    pub fn width(&self) -> usize {
+        self.axes.len()
+    }
+    /// Grain `i`'s counts along the three axes (0 along the others).
+    #[inline]
+    pub fn get(&self, i: usize) -> [i32; 3] {
+        let mut out = [0; 3];
+        for (k, &a) in self.axes.iter().enumerate() {
+            out[a] = self.counts[i * self.axes.len() + k];
+        }
+        out
+    }
+    /// Sets grain `i`'s counts (those along the axes that do not wrap are dropped).
+    pub fn set(&mut self, i: usize, c: [i32; 3]) {
+        let w = self.axes.len();
+        for (k, &a) in self.axes.iter().enumerate() {
+            self.counts[i * w + k] = c[a];
+        }
+    }
+    /// The counts, [`Self::width`] per grain, and the axes they count along.
+    pub fn parts_mut(&mut self) -> (&mut Vec<i32>, &[usize]) {
+        (&mut self.counts, &self.axes)
+    }
+    /// The counts, [`Self::width`] per grain.
+    pub fn counts(&self) -> &Vec<i32> {
+        &self.counts
+    }
+}
+
 /// Force and torque on a grain (N, N m).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Load<T> {

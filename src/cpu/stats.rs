@@ -64,7 +64,7 @@ impl<T: Real> CpuEngine<T> {
                 let (b, p, l) = (&self.body[i], &self.prop[i], &self.load[i]);
                 let m = p.mass.f64();
                 let v = b.vel.f64();
-                let pos = if self.image.is_empty() { b.pos } else { self.periodic.unwrap(b.pos, self.image[i]) };
+                let pos = self.periodic.unwrap(b.pos, self.image.get(i));
                 let x = pos.f64();
                 s.ke_t += 0.5 * m * b.vel.norm2().f64();
                 s.ke_r += 0.5 * p.inertia().f64() * b.omega.norm2().f64();

@@ -85,7 +85,7 @@ impl<T: Real> WallSprings<T> {
         let mut b = Builder::new(built_at.len());
         for (s, (&at, p)) in built_at.iter().zip(prop).enumerate() {
             // The kept position's rounding ([`super::built_at`]) widens the reach.
-            let (x, rounding) = super::built_at::recorded::<T>(at);
+            let (x, rounding) = (super::built_at::widen::<T>(at), super::built_at::bound::<T>(at));
             let near = WallGeom::any_within(walls.iter().map(|w| &w.geom), x, p.radius + skin + rounding);
             b.push(s, near.then(|| old.springs_of(s, per_grain).unwrap_or(&zeros)));
         }
