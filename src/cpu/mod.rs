@@ -58,6 +58,7 @@ use pair_force::{owner_block, OwnerBlock, TaskScratch};
 use profile::{Phase, PhaseClock};
 use reorder::Renumbering;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use reduce::{chunked, CHUNK, PAR_MIN_ITEMS};
 use wall_contacts::{wall_block, WallTouch};
 use wall_springs::WallSprings;
@@ -91,7 +92,9 @@ pub struct CpuEngine<T: Real> {
     // Grains, indexed by slot (renumbered in cell order by `reorder`).
     /// The permanent id of each slot.
     id: Vec<u32>,
-    /// The slot of each permanent id.
+    /// The slot of each permanent id where a run over several processes keeps it
+    /// ([`Self::keep_slots`]: they look grains up by id every step); empty otherwise, and
+    /// [`Self::slots`] finds it from `id` when a pass wants it (4 bytes a grain saved).
     slot: Vec<u32>,
     body: Vec<Body<T>>,
     /// What rounding took off each `body[i].pos` ([`crate::position`]): the grain is at
@@ -204,7 +207,7 @@ impl<T: Real> CpuEngine<T> {
             periodic: Periodic::of(&scene.periodic),
             reorder_every: scene.reorder_every,
             id: (0..n as u32).collect(),
-            slot: (0..n as u32).collect(),
+            slot: Vec::new(),
             built_at: body.iter().map(|b| built_at::record(b.pos)).collect(),
             image: Images::new([0, 1, 2].map(|a| scene.periodic[a].is_some()), n),
             body,
@@ -279,7 +282,7 @@ impl<T: Real> CpuEngine<T> {
         if self.reorder_every > 0 && self.rebuilds.is_multiple_of(self.reorder_every) {
             self.reorder(&grid);
         }
-        self.pairs.build_reverse(&self.slot);
+        self.pairs.build_reverse(&kept_or_found(&self.slot, &self.id));
         let n_pairs = self.pairs.len();
         renew(&mut self.share, n_pairs);
         self.report.renew(n_pairs, self.slots.layout.bridge);
@@ -319,9 +322,7 @@ impl<T: Real> CpuEngine<T> {
             r.apply(q);
         }
         (self.pairs, self.hist) = r.apply_pairs(&self.pairs, &self.hist, self.slots.stride);
-        for (s, &id) in self.id.iter().enumerate() {
-            self.slot[id as usize] = s as u32;
-        }
+        self.refresh_slots();
         self.renumberings += 1;
     }
 
@@ -337,9 +338,21 @@ impl<T: Real> CpuEngine<T> {
         self.renumberings
     }
 
+    /// The slot of each permanent id: kept ([`Self::keep_slots`]) or found from `id`.
+    fn slots(&self) -> Cow<'_, [u32]> {
+        kept_or_found(&self.slot, &self.id)
+    }
+
+    /// Brings the kept slots of the ids, if kept, up to date with `id`.
+    fn refresh_slots(&mut self) {
+        if !self.slot.is_empty() {
+            self.slot = slots_of(&self.id);
+        }
+    }
+
     /// The lowest permanent id of a grain whose state is not finite.
     fn first_non_finite(&self) -> Option<u32> {
-        self.slot.iter().map(|&s| &self.body[s as usize]).position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|id| id as u32)
+        self.slots().iter().map(|&s| &self.body[s as usize]).position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|id| id as u32)
     }
 
     fn non_finite_error(&self) -> SimError {
@@ -360,7 +373,7 @@ impl<T: Real> CpuEngine<T> {
 
     /// `v`'s items (one per slot) in permanent-id order.
     fn by_id<X: Copy>(&self, v: &[X]) -> Vec<X> {
-        self.slot.iter().map(|&s| v[s as usize]).collect()
+        self.slots().iter().map(|&s| v[s as usize]).collect()
     }
 
     /// Grain states, in permanent-id order (positions to this precision: see [`Self::positions`]).
@@ -370,7 +383,7 @@ impl<T: Real> CpuEngine<T> {
 
     /// Grain positions in permanent-id order (m, f64): `pos + residual` where compensated.
     pub fn positions(&self) -> Vec<[f64; 3]> {
-        self.slot.iter().map(|&s| position::absolute(self.body[s as usize].pos, position::residual_at(&self.residual, s as usize))).collect()
+        self.slots().iter().map(|&s| position::absolute(self.body[s as usize].pos, position::residual_at(&self.residual, s as usize))).collect()
     }
 
     /// The separation `r_i - r_j` of slots `i` and `j` (m, minimum image, residuals included).
@@ -395,7 +408,7 @@ impl<T: Real> CpuEngine<T> {
         let l = &self.pairs;
         let mut starts = vec![0u32];
         let mut partners = Vec::with_capacity(l.len());
-        for &s in &self.slot {
+        for &s in self.slots().iter() {
             let (a, b) = (l.owner_start[s as usize] as usize, l.owner_start[s as usize + 1] as usize);
             partners.extend(l.partner[a..b].iter().map(|&j| self.id[j as usize]));
             starts.push(partners.len() as u32);
@@ -946,6 +959,24 @@ pub(crate) fn renew<X: Clone + Default>(v: &mut Vec<X>, n: usize) {
     v.resize(n, X::default());
 }
 
+/// `slot` where it is kept (as long as `id`), else the inverse of `id`.
+fn kept_or_found<'a>(slot: &'a [u32], id: &[u32]) -> Cow<'a, [u32]> {
+    if slot.len() == id.len() {
+        Cow::Borrowed(slot)
+    } else {
+        Cow::Owned(slots_of(id))
+    }
+}
+
+/// The inverse of a numbering: `slot[id[s]] = s`.
+fn slots_of(id: &[u32]) -> Vec<u32> {
+    let mut slot = vec![0; id.len()];
+    for (s, &i) in id.iter().enumerate() {
+        slot[i as usize] = s as u32;
+    }
+    slot
+}
+
 /// Bytes a vector holds allocated.
 #[allow(clippy::ptr_arg)] // the capacity lives on the Vec, not the slice
 pub(crate) fn allocated<X>(v: &Vec<X>) -> u64 {
@@ -996,7 +1027,7 @@ impl<T: Real> Engine for CpuEngine<T> {
         let CohesionLaw::Capillary { theta, .. } = self.model.cohesion else {
             anyhow::bail!("the scene wets the sample but has no capillary cohesion; fix: set model.cohesion = \"capillary\"");
         };
-        let order = self.pairs.in_id_order(&self.slot);
+        let order = self.pairs.in_id_order(&self.slots());
         let pairs: Vec<(f64, f64, f64)> = order
             .iter()
             .map(|&k| {

@@ -357,6 +357,12 @@ impl<T: Real> CpuEngine<T> {
         self.wall_regimes = sums.regimes;
     }
 
+    /// Keeps the slot of each permanent id from now on: the lookups by id below, which a
+    /// process makes every step, read it.
+    pub(crate) fn keep_slots(&mut self) {
+        self.slot = super::slots_of(&self.id);
+    }
+
     /// True when grain `id`'s position and velocities are finite.
     pub(crate) fn is_finite(&self, id: u32) -> bool {
         let b = &self.body[self.slot[id as usize] as usize];

@@ -17,7 +17,7 @@ impl<T: Real> CpuEngine<T> {
             orientation: self.orientation.as_ref().map(|q| self.by_id(q).iter().map(|q| [q[0].f64(), q[1].f64(), q[2].f64(), q[3].f64()]).collect()),
             contacts: contacts.then(|| {
                 self.pairs
-                    .in_id_order(&self.slot)
+                    .in_id_order(&self.slots())
                     .into_iter()
                     .filter_map(|k| {
                         let k = k as usize;
@@ -114,13 +114,12 @@ impl<T: Real> CpuEngine<T> {
             }
         }
         // The grains' constant properties follow the checkpoint's numbering.
-        let r = Renumbering::new(id.iter().map(|&i| self.slot[i as usize]).collect());
+        let slot = self.slots();
+        let r = Renumbering::new(id.iter().map(|&i| slot[i as usize]).collect());
         r.apply(&mut self.prop);
         r.apply(&mut self.material);
         self.id = id;
-        for (slot, &i) in self.id.iter().enumerate() {
-            self.slot[i as usize] = slot as u32;
-        }
+        self.refresh_slots();
         let v3 = |a: &[f64]| Vec3::new(T::of(a[0]), T::of(a[1]), T::of(a[2]));
         for (b, c) in self.body.iter_mut().zip(s.reals("body", 9 * n)?.chunks_exact(9)) {
             *b = Body { pos: v3(&c[0..3]), vel: v3(&c[3..6]), omega: v3(&c[6..9]) };

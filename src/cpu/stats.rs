@@ -58,9 +58,10 @@ impl<T: Real> CpuEngine<T> {
         self.ensure_loads().ok();
         let g = self.gravity;
         let wall_force = self.wall_force_by_chunk();
+        let slot = self.slots();
         let grain_sums = chunked(self.body.len(), |r| {
             let mut s = GrainSums { wall_force: wall_force[r.start / CHUNK], ..Default::default() };
-            for i in r.map(|id| self.slot[id] as usize) {
+            for i in r.map(|id| slot[id] as usize) {
                 let (b, p, l) = (&self.body[i], &self.prop[i], &self.load[i]);
                 let m = p.mass.f64();
                 let v = b.vel.f64();
@@ -103,7 +104,7 @@ impl<T: Real> CpuEngine<T> {
             }
             s
         });
-        let canonical = self.pairs.in_id_order(&self.slot);
+        let canonical = self.pairs.in_id_order(&self.slots());
         let pair_sums = chunked(canonical.len(), |r| {
             let mut s = PairSums::default();
             for k in r.map(|c| canonical[c] as usize) {
@@ -200,7 +201,7 @@ impl<T: Real> CpuEngine<T> {
             }
             CohesionLaw::None => (0, 0.0, 0.0),
         };
-        let liquid_on_grains: f64 = chunked(self.liquid.len(), |r| r.map(|id| self.liquid[self.slot[id] as usize].f64()).sum::<f64>()).into_iter().sum();
+        let liquid_on_grains: f64 = chunked(self.liquid.len(), |r| r.map(|id| self.liquid[slot[id] as usize].f64()).sum::<f64>()).into_iter().sum();
         Stats {
             step: self.step,
             time: self.time,

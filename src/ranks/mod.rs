@@ -123,6 +123,7 @@ impl<T: Real> Distributed<T> {
         let world = SimpleCommunicator::world();
         let grid = Grid::new(scene, world.size() as usize)?;
         let mut whole = CpuEngine::<T>::new(scene)?;
+        whole.keep_slots();
         let template = Scene { grains: Default::default(), ..scene.clone() };
         let mut net = Net {
             rank: world.rank() as usize,
@@ -222,6 +223,7 @@ impl<T: Real> Net<T> {
         }
         let scene = Scene { grains, ..self.template.clone() };
         let mut local = CpuEngine::<T>::new(&scene)?;
+        local.keep_slots();
         local.restore(&state)?;
         self.gid = gid;
         Ok(local)
@@ -229,7 +231,9 @@ impl<T: Real> Net<T> {
 
     /// An engine over every grain of the scene (its state to be restored).
     fn whole_engine(&self) -> anyhow::Result<CpuEngine<T>> {
-        Ok(CpuEngine::new(&Scene { grains: self.grains.clone(), ..self.template.clone() })?)
+        let mut whole = CpuEngine::new(&Scene { grains: self.grains.clone(), ..self.template.clone() })?;
+        whole.keep_slots();
+        Ok(whole)
     }
 
     /// Every process's `mine`, concatenated in rank order, on rank 0; None elsewhere.
