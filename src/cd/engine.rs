@@ -66,13 +66,13 @@ impl<T: Real> Engine for ContactDynamics<T> {
         for (b, p) in self.body.iter().zip(&self.prop) {
             let (m, v, w) = (p.mass.f64(), b.vel.f64(), b.omega.f64());
             s.ke_translational += 0.5 * m * b.vel.norm2().f64();
-            s.ke_rotational += 0.5 * p.inertia().f64() * b.omega.norm2().f64();
+            s.ke_rotational += 0.5 * p.inertia.f64() * b.omega.norm2().f64();
             s.gravity_energy -= m * (g[0] * b.pos.x.f64() + g[1] * b.pos.y.f64() + g[2] * b.pos.z.f64());
             let x = b.pos.f64();
             let mv = [m * v[0], m * v[1], m * v[2]];
             for a in 0..3 {
                 s.momentum[a] += mv[a];
-                s.angular_momentum[a] += x[(a + 1) % 3] * mv[(a + 2) % 3] - x[(a + 2) % 3] * mv[(a + 1) % 3] + p.inertia().f64() * w[a];
+                s.angular_momentum[a] += x[(a + 1) % 3] * mv[(a + 2) % 3] - x[(a + 2) % 3] * mv[(a + 1) % 3] + p.inertia.f64() * w[a];
             }
         }
         let mut touching = vec![0u64; n];

@@ -263,7 +263,7 @@ impl<T: Real> ContactDynamics<T> {
         let (pos, residual): (Vec<Vec3<T>>, Vec<Vec3<T>>) = g.position.iter().map(|&x| position::split(x)).unzip();
         let body = (0..n).map(|i| Body { pos: pos[i], vel: Vec3::of(g.velocity[i]), omega: Vec3::of(g.angular_velocity[i]) }).collect();
         let prop = (0..n)
-            .map(|i| Props { radius: T::of(g.radius[i]), mass: T::of(g.mass[i]) })
+            .map(|i| Props::sphere(g.radius[i], g.mass[i]))
             .collect();
         let servo = scene.servo.as_ref().map(|b| servo::ServoWalls {
             walls: b.walls,
@@ -358,7 +358,7 @@ impl<T: Real> ContactDynamics<T> {
             let d = position::separation_of(&periodic, |s| self.body[s].pos, &self.residual, b, a);
             let dist = d.norm();
             let (pa, pb) = (&self.prop[a], &self.prop[b]);
-            let (inv_mass_b, inv_inertia_b) = (T::ONE / pb.mass, T::ONE / pb.inertia());
+            let (inv_mass_b, inv_inertia_b) = (T::ONE / pb.mass, T::ONE / pb.inertia);
             contacts.push(self.contact(a, Partner::Grain(b as u32), d * (T::ONE / dist), dist - pa.radius - pb.radius, self.material[b], (pb.radius, inv_mass_b, inv_inertia_b)));
         }
         for i in 0..self.body.len() {
@@ -382,7 +382,7 @@ impl<T: Real> ContactDynamics<T> {
     fn contact(&self, a: usize, b: Partner, n: Vec3<T>, gap: T, material: u32, (radius_b, inv_mass_b, inv_inertia_b): (T, T, T)) -> Contact<T> {
         let pa = &self.prop[a];
         let (mu, e) = self.pair(self.material[a], material);
-        let (inv_mass_a, inv_inertia_a) = (T::ONE / pa.mass, T::ONE / pa.inertia());
+        let (inv_mass_a, inv_inertia_a) = (T::ONE / pa.mass, T::ONE / pa.inertia);
         let w_n = inv_mass_a + inv_mass_b;
         // A wall turns no more than it slides: only its normal motion yields.
         let w_t = inv_mass_a + pa.radius * pa.radius * inv_inertia_a + if matches!(b, Partner::Grain(_)) { inv_mass_b + radius_b * radius_b * inv_inertia_b } else { T::ZERO };

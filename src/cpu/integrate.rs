@@ -11,7 +11,7 @@ use crate::real::{Real, Vec3};
 #[inline(always)]
 pub fn kick<T: Real>(b: &mut Body<T>, l: &Load<T>, p: &Props<T>, tau: T) {
     b.vel += l.force * (tau / p.mass);
-    b.omega += l.torque * (tau / p.inertia());
+    b.omega += l.torque * (tau / p.inertia);
 }
 
 /// Drift: `x += v tau`, the sum's rounding kept in `residual` where positions are compensated

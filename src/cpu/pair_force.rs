@@ -95,7 +95,7 @@ pub fn pair_force<T: Real>(i: usize, k: usize, pairs: &PairList, body: &[Body<T>
     }
     let geo = Geometry::grain_grain(d, dist2.sqrt(), pi.radius, pj.radius, pi.mass, pj.mass);
     let kin = Kinematics { v_i: bi.vel, v_j: bj.vel, w_i: bi.omega, w_j: bj.omega };
-    let bodies = Bodies { m_i: pi.mass, inertia_i: pi.inertia(), m_j: pj.mass, inertia_j: pj.inertia(), j_is_wall: false };
+    let bodies = Bodies { m_i: pi.mass, inertia_i: pi.inertia, m_j: pj.mass, inertia_j: pj.inertia, j_is_wall: false };
     let c = ctx.pair_coeffs(i, j);
     let mut h = ctx.slots.load(hist);
     let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);

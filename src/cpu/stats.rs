@@ -68,10 +68,10 @@ impl<T: Real> CpuEngine<T> {
                 let pos = self.periodic.unwrap(b.pos, self.image.get(i));
                 let x = pos.f64();
                 s.ke_t += 0.5 * m * b.vel.norm2().f64();
-                s.ke_r += 0.5 * p.inertia().f64() * b.omega.norm2().f64();
+                s.ke_r += 0.5 * p.inertia.f64() * b.omega.norm2().f64();
                 s.pe_g -= m * g.dot(pos).f64();
                 let w = b.omega.f64();
-                let ii = p.inertia().f64();
+                let ii = p.inertia.f64();
                 let mv = [m * v[0], m * v[1], m * v[2]];
                 for (p, q) in s.momentum.iter_mut().zip(mv) {
                     *p += q;

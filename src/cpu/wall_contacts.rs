@@ -84,7 +84,7 @@ pub fn wall_contacts<T: Real>(
 fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, material: usize, wall: &WallState<T>, ctx: &ForceContext<'c, T>, h_slot: &mut [T]) -> (Geometry<T>, &'c PairCoeffs<T>, ContactForce<T>) {
     let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
     let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
-    let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia(), j_is_wall: true, ..Default::default() };
+    let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
     let c = ctx.wall_coeffs(wall.material, material);
     let mut h = ctx.slots.load(h_slot);
     let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);

@@ -57,7 +57,7 @@ impl GpuEngine {
         let gpu_hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
         let v3 = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
         let body: Vec<Body<f32>> = (0..self.n as usize).map(|i| Body { pos: v3(arrays[0][i]), vel: v3(arrays[1][i]), omega: v3(arrays[2][i]) }).collect();
-        let prop: Vec<Props<f32>> = (0..self.n as usize).map(|i| Props { radius: arrays[0][i][3], mass: arrays[1][i][3] }).collect();
+        let prop: Vec<Props<f32>> = (0..self.n as usize).map(|i| Props { radius: arrays[0][i][3], mass: arrays[1][i][3], inertia: arrays[2][i][3] }).collect();
         let material: &[u32] = bytemuck::cast_slice(&parts[0]);
         let residual: Vec<Vec3<f32>> = arrays[3].iter().map(|&r| v3(r)).collect();
         let states: Vec<WallState<f32>> = walls
