@@ -287,12 +287,13 @@ impl<T: Real> CpuEngine<T> {
         renew(&mut self.share, n_pairs);
         self.report.renew(n_pairs, self.slots.layout.bridge);
         renew(&mut self.force_i, if self.model.keeps_both_forces() { n_pairs } else { 0 });
-        let mut margin = T::ZERO;
+        let mut margin2 = T::ZERO;
         for (b, at) in self.body.iter().zip(self.built_at.iter_mut()) {
             *at = built_at::record(b.pos);
-            margin = margin.max((b.pos - built_at::widen(*at)).norm());
+            margin2 = margin2.max((b.pos - built_at::widen(*at)).norm2());
         }
-        self.built_margin = margin;
+        // One root for all (it is monotonic and correctly rounded: the same bits).
+        self.built_margin = margin2.sqrt();
         self.choose_wall_springs();
         self.rebuilds += 1;
         self.max_moved2 = T::ZERO;
