@@ -353,7 +353,8 @@ impl<T: Real> CpuEngine<T> {
 
     /// The lowest permanent id of a grain whose state is not finite.
     fn first_non_finite(&self) -> Option<u32> {
-        self.slots().iter().map(|&s| &self.body[s as usize]).position(|b| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|id| id as u32)
+        // In slot order, which streams, not id order, which jumps about the grains.
+        self.body.iter().zip(&self.id).filter(|(b, _)| !(b.pos.is_finite() && b.vel.is_finite() && b.omega.is_finite())).map(|(_, &id)| id).min()
     }
 
     fn non_finite_error(&self) -> SimError {
@@ -1031,16 +1032,15 @@ impl<T: Real> Engine for CpuEngine<T> {
         let order = self.pairs.in_id_order(&self.slots());
         let pairs: Vec<(f64, f64, f64)> = order
             .iter()
-            .map(|&k| {
-                let k = k as usize;
-                let (i, j) = self.pairs.grains_of(k);
+            .map(|&(i, k)| {
+                let (i, j) = (i as usize, self.pairs.partner[k as usize] as usize);
                 (self.prop[i].radius.f64(), self.prop[j].radius.f64(), self.gap(i, j).f64())
             })
             .collect();
         let (shares, rest) = share_liquid(volume, &pairs, self.bridge_cap.f64(), theta.f64());
         let (stride, b) = (self.slots.stride, self.slots.bridge);
         for (c, v) in shares {
-            self.hist[order[c] as usize * stride + b] += T::of(v);
+            self.hist[order[c].1 as usize * stride + b] += T::of(v);
         }
         // What the bridges could not hold waits on the grains.
         let rest = T::of(rest / self.liquid.len() as f64);

@@ -111,19 +111,23 @@ impl PairList {
         }
         let mut cursor = self.rev_start[..n].to_vec();
         self.rev_pair = vec![0; self.partner.len()];
-        for k in self.in_id_order(slot) {
-            let j = self.partner[k as usize] as usize;
-            self.rev_pair[cursor[j] as usize] = k;
-            cursor[j] += 1;
+        for &s in slot {
+            for k in self.owner_start[s as usize]..self.owner_start[s as usize + 1] {
+                let j = self.partner[k as usize] as usize;
+                self.rev_pair[cursor[j] as usize] = k;
+                cursor[j] += 1;
+            }
         }
     }
 
-    /// Pair indices in canonical order: owners by ascending permanent id, then the owner's
-    /// pairs in list order (ascending partner id). `slot[id]` is the slot of permanent id `id`.
-    pub fn in_id_order(&self, slot: &[u32]) -> Vec<u32> {
+    /// `(owner, pair)` for every pair in canonical order: owners by ascending permanent id,
+    /// then the owner's pairs in list order (ascending partner id). `slot[id]` is the slot of
+    /// permanent id `id`. The owner comes along so that no pass bisects for it (at 10^6 grains
+    /// a bisection per pair made the statistics cost as much as five steps).
+    pub fn in_id_order(&self, slot: &[u32]) -> Vec<(u32, u32)> {
         let mut order = Vec::with_capacity(self.len());
         for &s in slot {
-            order.extend(self.owner_start[s as usize]..self.owner_start[s as usize + 1]);
+            order.extend((self.owner_start[s as usize]..self.owner_start[s as usize + 1]).map(|k| (s, k)));
         }
         order
     }

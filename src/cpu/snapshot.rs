@@ -19,9 +19,9 @@ impl<T: Real> CpuEngine<T> {
                 self.pairs
                     .in_id_order(&self.slots())
                     .into_iter()
-                    .filter_map(|k| {
-                        let k = k as usize;
-                        let (i, j) = self.pairs.grains_of(k);
+                    .filter_map(|(i, k)| {
+                        let (i, k) = (i as usize, k as usize);
+                        let j = self.pairs.partner[k] as usize;
                         let (h, _) = self.pair_overlap(i, j);
                         (h > T::ZERO || self.report.f_c(k) != T::ZERO).then(|| {
                             let springs = self.slots.load(&self.hist[k * self.slots.stride..]);

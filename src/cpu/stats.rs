@@ -107,8 +107,9 @@ impl<T: Real> CpuEngine<T> {
         let canonical = self.pairs.in_id_order(&self.slots());
         let pair_sums = chunked(canonical.len(), |r| {
             let mut s = PairSums::default();
-            for k in r.map(|c| canonical[c] as usize) {
-                let (i, j) = self.pairs.grains_of(k);
+            for (i, k) in r.map(|c| canonical[c]) {
+                let (i, k) = (i as usize, k as usize);
+                let j = self.pairs.partner[k] as usize;
                 let (h, r_min) = self.pair_overlap(i, j);
                 if h <= T::ZERO {
                     continue;
@@ -190,12 +191,12 @@ impl<T: Real> CpuEngine<T> {
         let (bridges, liquid_in_bridges, capillary_energy) = match self.model.cohesion {
             CohesionLaw::Capillary { kappa, theta, c } => {
                 let (stride, b) = (self.slots.stride, self.slots.bridge);
-                let bridge = |k: usize| {
-                    let v = self.hist[k * stride + b];
-                    let (i, j) = self.pairs.grains_of(k);
+                let bridge = |(i, k): (u32, u32)| {
+                    let (i, k) = (i as usize, k as usize);
+                    let (v, j) = (self.hist[k * stride + b], self.pairs.partner[k] as usize);
                     (v, capillary_potential(kappa, theta, c, self.prop[i].radius, self.prop[j].radius, v, self.gap(i, j)))
                 };
-                chunked(canonical.len(), |r| r.map(|c| bridge(canonical[c] as usize)).filter(|(v, _)| *v > T::ZERO).fold((0u64, 0.0, 0.0), |(n, s, u), (v, e)| (n + 1, s + v.f64(), u + e.f64())))
+                chunked(canonical.len(), |r| r.map(|c| bridge(canonical[c])).filter(|(v, _)| *v > T::ZERO).fold((0u64, 0.0, 0.0), |(n, s, u), (v, e)| (n + 1, s + v.f64(), u + e.f64())))
                     .into_iter()
                     .fold((0, 0.0, 0.0), |(n, s, u), (m, t, e)| (n + m, s + t, u + e))
             }
