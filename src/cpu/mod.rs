@@ -39,7 +39,7 @@ pub(crate) use parts::{state_of_rows, touch_of_row, touches_state, RowWidths, Ro
 pub(crate) use wall_contacts::WallTouch as WallContact;
 pub use pair_force::ForceContext;
 pub use profile::PHASE_NAMES;
-pub use state::{Body, HistorySlots, Images, Load, PairFlags, PairReports, Props};
+pub use state::{Body, Counts, HistorySlots, ImageCount, Images, Load, PairFlags, PairReports, Props};
 pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::engine::EngineState;
@@ -251,19 +251,23 @@ impl<T: Real> CpuEngine<T> {
     pub fn rebuild(&mut self) -> Result<(), SimError> {
         let t = self.clock.start();
         if self.periodic.any() {
-            let p = self.periodic;
-            let (counts, axes) = self.image.parts_mut();
-            let wrap = |b: &mut Body<T>, r: &mut Vec3<T>, image: &mut [i32]| {
-                let moved = position::wrap(&p, &mut b.pos, r);
-                for (c, &a) in image.iter_mut().zip(axes) {
-                    *c += moved[a];
-                }
+            let (p, axes) = (self.periodic, self.image.axes().to_vec());
+            let wrapped = match self.image.counts_mut() {
+                Counts::Narrow(c) => wrap_grains(&p, &mut self.body, &mut self.residual, c, &axes),
+                Counts::Wide(c) => wrap_grains(&p, &mut self.body, &mut self.residual, c, &axes),
             };
-            let width = axes.len();
-            if T::COMPENSATED {
-                self.body.par_iter_mut().zip(self.residual.par_iter_mut()).zip(counts.par_chunks_mut(width)).with_min_len(PAR_MIN_ITEMS).for_each(|((b, r), image)| wrap(b, r, image));
-            } else {
-                self.body.par_iter_mut().zip(counts.par_chunks_mut(width)).with_min_len(PAR_MIN_ITEMS).for_each(|(b, image)| wrap(b, &mut Vec3::default(), image));
+            match wrapped {
+                Ok(largest) => self.image.widen_for(largest),
+                Err(slot) => {
+                    return Err(SimError::Unstable {
+                        step: self.step,
+                        time: self.time,
+                        what: format!("a grain crossed more than {} periods between two neighbour builds", Images::WIDEN_AT),
+                        grain: self.id[slot],
+                        suggested_dt: self.suggested_dt,
+                        also: "",
+                    })
+                }
             }
         }
         // The grid lives for the rebuild alone (6 bytes a grain at the bed's density).
@@ -316,7 +320,10 @@ impl<T: Real> CpuEngine<T> {
         r.apply(&mut self.load);
         r.apply(&mut self.built_at);
         let width = self.image.width();
-        r.apply_blocks(self.image.parts_mut().0, width);
+        match self.image.counts_mut() {
+            Counts::Narrow(c) => r.apply_blocks(c, width),
+            Counts::Wide(c) => r.apply_blocks(c, width),
+        }
         r.apply(&mut self.liquid);
         self.wall_springs = self.wall_springs.renumbered(&r.from, self.walls.len() * self.slots.stride);
         if let Some(q) = &mut self.orientation {
@@ -945,6 +952,28 @@ fn owner_blocks<'a, T: Real>(
     blocks
 }
 
+/// Wraps every grain's position into the periods and adds the periods it crossed along
+/// `axes` to its image counts (`axes.len()` per grain). Returns the largest count's magnitude,
+/// or, of the grains whose count no longer fits its width, the lowest slot.
+fn wrap_grains<T: Real, C: ImageCount>(p: &Periodic<T>, body: &mut [Body<T>], residual: &mut [Vec3<T>], counts: &mut [C], axes: &[usize]) -> Result<u32, usize> {
+    let wrap = |(s, b, r, image): (usize, &mut Body<T>, &mut Vec3<T>, &mut [C])| {
+        let moved = position::wrap(p, &mut b.pos, r);
+        image.iter_mut().zip(axes).try_fold(0, |m, (c, &a)| c.add(moved[a]).map(|v| m.max(v.unsigned_abs())).ok_or(s))
+    };
+    // Of two results the error, and of two errors the lower slot: the same on any split.
+    let first = |a: Result<u32, usize>, b: Result<u32, usize>| match (a, b) {
+        (Ok(x), Ok(y)) => Ok(x.max(y)),
+        (Err(x), Err(y)) => Err(x.min(y)),
+        (Err(x), _) | (_, Err(x)) => Err(x),
+    };
+    let width = axes.len();
+    if T::COMPENSATED {
+        body.par_iter_mut().zip(residual.par_iter_mut()).zip(counts.par_chunks_mut(width)).with_min_len(PAR_MIN_ITEMS).enumerate().map(|(s, ((b, r), c))| wrap((s, b, r, c))).reduce(|| Ok(0), first)
+    } else {
+        body.par_iter_mut().zip(counts.par_chunks_mut(width)).with_min_len(PAR_MIN_ITEMS).enumerate().map(|(s, (b, c))| wrap((s, b, &mut Vec3::default(), c))).reduce(|| Ok(0), first)
+    }
+}
+
 /// Splits the first `n` items off `s`, leaving it the rest.
 fn take_front<'a, X>(s: &mut &'a mut [X], n: usize) -> &'a mut [X] {
     let (front, rest) = std::mem::take(s).split_at_mut(n);
@@ -1069,7 +1098,7 @@ impl<T: Real> Engine for CpuEngine<T> {
 
     fn memory_bytes(&self) -> u64 {
         let l = &self.pairs;
-        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.material) + allocated(&self.load) + allocated(&self.built_at) + allocated(self.image.counts());
+        let grains = allocated(&self.liquid) + allocated(&self.id) + allocated(&self.slot) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.material) + allocated(&self.load) + allocated(&self.built_at) + self.image.bytes();
         let ws = &self.wall_springs;
         let walls = allocated(&ws.candidate) + allocated(&ws.run_start) + allocated(&ws.springs) + allocated(&self.wall_touches) + self.orientation.as_ref().map_or(0, allocated);
         let pairs = allocated(&self.hist) + allocated(&self.share) + allocated(&self.report.f_n) + allocated(&self.report.f_c) + allocated(&self.report.flags) + allocated(&self.force_i) + allocated(&l.owner_start) + allocated(&l.partner) + allocated(&l.rev_start) + allocated(&l.rev_pair);
@@ -1093,5 +1122,47 @@ impl<T: Real> Engine for CpuEngine<T> {
             self.walls[p.wall].geom = WallGeom::Piston { z: T::of(z) };
             self.walls[p.wall].velocity = Vec3::ZERO;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two grains in a box periodic in x and y, each one period past its upper end along x
+    /// (and the second also one below along y), with counts one short of the widening.
+    fn crossing<C: ImageCount + From<i16>>() -> (Periodic<f64>, Vec<Body<f64>>, Vec<C>) {
+        let p = Periodic::of(&[Some([0.0, 1.0]), Some([0.0, 1.0]), None]);
+        let at = |x: f64, y: f64| Body { pos: Vec3::new(x, y, 0.5), ..Default::default() };
+        let start = C::from(Images::WIDEN_AT as i16 - 1);
+        (p, vec![at(1.25, 0.5), at(1.5, -0.5)], vec![start, C::from(0), start, start])
+    }
+
+    /// The wrap adds the periods crossed to the two-byte counts and reports the largest, which
+    /// widens them; a count two bytes cannot hold names its grain and changes nothing.
+    #[test]
+    fn image_counts_widen_before_two_bytes_overflow() {
+        let (p, mut body, mut counts) = crossing::<i16>();
+        let largest = wrap_grains(&p, &mut body, &mut [], &mut counts, &[0, 1]);
+        assert_eq!(largest, Ok(Images::WIDEN_AT as u32));
+        assert_eq!(counts, vec![Images::WIDEN_AT as i16, 0, Images::WIDEN_AT as i16, Images::WIDEN_AT as i16 - 2]);
+        assert_eq!((body[0].pos.x, body[1].pos.x, body[1].pos.y), (0.25, 0.5, 0.5));
+        let mut images = Images::new([true, true, false], 2);
+        for (i, c) in counts.chunks(2).enumerate() {
+            images.set(i, [c[0] as i32, c[1] as i32, 0]);
+        }
+        assert!(matches!(images.counts_mut(), Counts::Wide(_)), "a count of WIDEN_AT widens them");
+        assert_eq!(images.get(1), [Images::WIDEN_AT, Images::WIDEN_AT - 2, 0]);
+        images.widen_for(0);
+        assert_eq!(images.bytes(), 4 * 4, "two grains, two wrapping axes, four bytes a count");
+        // One past what two bytes hold: an error naming the lowest such slot.
+        let (p, mut body, _) = crossing::<i16>();
+        let mut full = vec![i16::MAX, 0, i16::MAX, 0];
+        assert_eq!(wrap_grains(&p, &mut body, &mut [], &mut full, &[0, 1]), Err(0));
+        assert_eq!(full[0], i16::MAX);
+        // Four bytes take it.
+        let (p, mut body, mut wide) = crossing::<i32>();
+        wide[0] = i16::MAX as i32;
+        assert_eq!(wrap_grains(&p, &mut body, &mut [], &mut wide, &[0, 1]), Ok(i16::MAX as u32 + 1));
     }
 }

@@ -45,49 +45,120 @@ pub fn material_at(material: &[u32], i: usize) -> usize {
 }
 
 /// Each grain's periodic image counts (the periods it has crossed along each axis, positive
-/// upward), kept for the wrapping axes alone: a scene periodic in x and y keeps two integers a
-/// grain, one without periods none.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// upward), kept for the wrapping axes alone: a scene periodic in x and y keeps two counts a
+/// grain, one without periods none. Counts take two bytes each until one reaches
+/// [`Images::WIDEN_AT`] periods, four from then on (LAMMPS packs its three into one 32-bit
+/// integer, ten bits each, and lets them wrap around).
+#[derive(Clone, Debug, PartialEq)]
 pub struct Images {
     /// The wrapping axes.
     axes: Vec<usize>,
     /// `axes.len()` counts per grain.
-    counts: Vec<i32>,
+    counts: Counts,
+}
+
+/// Image counts, two or four bytes each.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Counts {
+    /// Two bytes each, while every count is below [`Images::WIDEN_AT`].
+    Narrow(Vec<i16>),
+    /// Four bytes each, once one has reached it.
+    Wide(Vec<i32>),
+}
+
+impl Default for Images {
+    fn default() -> Self {
+        Images { axes: Vec::new(), counts: Counts::Narrow(Vec::new()) }
+    }
+}
+
+/// One image count, of either width.
+pub trait ImageCount: Copy + Send + Sync {
+    /// Adds `d` periods; returns the sum, or `None` where it does not fit this width (the
+    /// count is then left as it was).
+    fn add(&mut self, d: i32) -> Option<i32>;
+}
+
+impl ImageCount for i16 {
+    #[inline]
+    fn add(&mut self, d: i32) -> Option<i32> {
+        let v = i16::try_from(*self as i32 + d).ok()?;
+        *self = v;
+        Some(v as i32)
+    }
+}
+
+impl ImageCount for i32 {
+    #[inline]
+    fn add(&mut self, d: i32) -> Option<i32> {
+        *self = self.checked_add(d)?;
+        Some(*self)
+    }
 }
 
 impl Images {
+    /// The magnitude from which counts take four bytes: half of what two hold, so that a
+    /// build that finds a count past it widens them while every step since could only have
+    /// added a few periods.
+    pub const WIDEN_AT: i32 = 1 << 14;
+
     /// Zero counts for `n` grains along the axes `on`.
     pub fn new(on: [bool; 3], n: usize) -> Self {
         let axes: Vec<usize> = (0..3).filter(|&a| on[a]).collect();
-        Images { counts: vec![0; n * axes.len()], axes }
+        Images { counts: Counts::Narrow(vec![0; n * axes.len()]), axes }
     }
     /// Counts per grain.
     pub fn width(&self) -> usize {
         self.axes.len()
     }
+    /// The wrapping axes.
+    pub fn axes(&self) -> &[usize] {
+        &self.axes
+    }
     /// Grain `i`'s counts along the three axes (0 along the others).
     #[inline]
     pub fn get(&self, i: usize) -> [i32; 3] {
+        let w = self.axes.len();
         let mut out = [0; 3];
         for (k, &a) in self.axes.iter().enumerate() {
-            out[a] = self.counts[i * self.axes.len() + k];
+            out[a] = match &self.counts {
+                Counts::Narrow(v) => v[i * w + k] as i32,
+                Counts::Wide(v) => v[i * w + k],
+            };
         }
         out
     }
-    /// Sets grain `i`'s counts (those along the axes that do not wrap are dropped).
+    /// Sets grain `i`'s counts (those along the axes that do not wrap are dropped), widening
+    /// every count first where one of these reaches [`Self::WIDEN_AT`].
     pub fn set(&mut self, i: usize, c: [i32; 3]) {
+        self.widen_for(self.axes.iter().map(|&a| c[a].unsigned_abs()).max().unwrap_or(0));
         let w = self.axes.len();
         for (k, &a) in self.axes.iter().enumerate() {
-            self.counts[i * w + k] = c[a];
+            match &mut self.counts {
+                Counts::Narrow(v) => v[i * w + k] = c[a] as i16,
+                Counts::Wide(v) => v[i * w + k] = c[a],
+            }
         }
     }
-    /// The counts, [`Self::width`] per grain, and the axes they count along.
-    pub fn parts_mut(&mut self) -> (&mut Vec<i32>, &[usize]) {
-        (&mut self.counts, &self.axes)
+    /// Widens the counts to four bytes when `largest` (the largest count's magnitude) has
+    /// reached [`Self::WIDEN_AT`].
+    pub fn widen_for(&mut self, largest: u32) {
+        if let Counts::Narrow(v) = &self.counts {
+            if largest >= Self::WIDEN_AT as u32 {
+                self.counts = Counts::Wide(v.iter().map(|&c| c as i32).collect());
+            }
+        }
     }
     /// The counts, [`Self::width`] per grain.
-    pub fn counts(&self) -> &Vec<i32> {
-        &self.counts
+    pub fn counts_mut(&mut self) -> &mut Counts {
+        &mut self.counts
+    }
+    /// Bytes allocated.
+    pub fn bytes(&self) -> u64 {
+        match &self.counts {
+            Counts::Narrow(v) => super::allocated(v),
+            Counts::Wide(v) => super::allocated(v),
+        }
     }
 }
 

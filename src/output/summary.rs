@@ -229,11 +229,11 @@ pub(crate) fn engine_bytes(scene: &Scene, real: usize, pairs_per_grain: f64) -> 
     // 4, the liquid 1. The position at the last build, 3 f32. Then the id, the pair and
     // reverse list starts (u32 each; the slot of each id is found when wanted, kept only by
     // the processes of a run over MPI), the material index where there are several, the
-    // periodic image counts (one per wrapping axis), the wall springs' candidate bit and run
-    // start where there are walls (`cpu::wall_springs`). The cell list lives for a rebuild
-    // alone.
+    // periodic image counts (one per wrapping axis, two bytes each until one reaches 2^14),
+    // the wall springs' candidate bit and run start where there are walls
+    // (`cpu::wall_springs`). The cell list lives for a rebuild alone.
     let walls = !scene.walls.is_empty();
-    let per_grain = ((18 + some(real == 4, 3) + some(scene.track_orientation, 4) + some(capillary, 1)) * real + 3 * 4 + 3 * 4 + some(scene.materials.len() > 1, 4) + 4 * scene.periodic.iter().filter(|p| p.is_some()).count()) as f64 + if walls { (1.0 + 4.0) / 64.0 } else { 0.0 };
+    let per_grain = ((18 + some(real == 4, 3) + some(scene.track_orientation, 4) + some(capillary, 1)) * real + 3 * 4 + 3 * 4 + some(scene.materials.len() > 1, 4) + 2 * scene.periodic.iter().filter(|p| p.is_some()).count()) as f64 + if walls { (1.0 + 4.0) / 64.0 } else { 0.0 };
     // The partner and the reverse index (u32), the history, the partner's share 6 and the
     // normal force 1 reals, the capillary force, the owner's force (seed 000's law), the flags.
     let per_pair = 8 + (stride + 7 + some(capillary, 1) + some(owner_force, 3)) * real + 1;
