@@ -143,10 +143,8 @@ impl Images {
     /// Widens the counts to four bytes when `largest` (the largest count's magnitude) has
     /// reached [`Self::WIDEN_AT`].
     pub fn widen_for(&mut self, largest: u32) {
-        if let Counts::Narrow(v) = &self.counts {
-            if largest >= Self::WIDEN_AT as u32 {
-                self.counts = Counts::Wide(v.iter().map(|&c| c as i32).collect());
-            }
+        if let (Counts::Narrow(v), true) = (&self.counts, largest >= Self::WIDEN_AT as u32) {
+            self.counts = Counts::Wide(v.iter().map(|&c| c as i32).collect());
         }
     }
     /// The counts, [`Self::width`] per grain.
