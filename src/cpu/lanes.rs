@@ -469,7 +469,7 @@ duration = 1.0e-3
         let mut touches = Vec::new();
         let wall: Vec<Load<T>> = (0..e.body.len()).map(|i| wall_contacts(e.id[i], &e.body[i], crate::position::residual_at(&e.residual, i), &e.prop[i], ctx.material(i), &e.walls, &ctx, &mut wall_hist[i * per_grain..(i + 1) * per_grain], &mut touches)).collect();
         assert!(!touches.is_empty(), "grains must touch the floor");
-        e.evaluate_forces(elapsed, None);
+        e.evaluate_forces(elapsed, None, None);
         let p = &e.pairs;
         let first = (0..e.body.len()).find(|&i| {
             let (mut force, mut torque) = (e.gravity * e.prop[i].mass, Vec3::ZERO);

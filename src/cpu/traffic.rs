@@ -46,7 +46,13 @@ impl<T: Real> CpuEngine<T> {
             None => out.push((name, b)),
         };
         let merged_kick = bytes(&self.load) + prop;
-        for &sweep in self.schedule.sweeps(1) {
+        // Inside a run of steps a step's first sweep, a kick and a drift, rides in the step
+        // before's gather sweep ([`CpuEngine::step_in_run`]), which has the bodies, loads
+        // and properties in hand: the residuals, the build positions and the orientations
+        // are what it adds.
+        let sweeps = self.schedule.sweeps(1);
+        let carried = matches!((sweeps.first(), sweeps.last()), (Some(Sweep::KickDrift { .. }), Some(Sweep::ForcesKick { .. })));
+        for &sweep in sweeps {
             match sweep {
                 Sweep::Op(Op::Kick { .. }) => add("kick", kick),
                 Sweep::Op(Op::Drift { .. }) => add("drift", drift),
@@ -56,6 +62,7 @@ impl<T: Real> CpuEngine<T> {
                     add("gather", gather);
                     add("walls", walls);
                 }
+                Sweep::KickDrift { .. } if carried => add("drift", 2 * residual + bytes(&self.built_at) + 2 * orientation),
                 Sweep::KickDrift { .. } => {
                     add("kick", merged_kick);
                     add("drift", drift);

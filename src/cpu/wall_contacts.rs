@@ -94,26 +94,26 @@ fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, mat
 
 super::simd::dispatch! {
     /// `wall_contacts` for the candidates among slots `first..first + loads.len()` (at most
-    /// one part of [`split::split`](super::split::split); `id`, `body` and `prop` are theirs
-    /// alone, `candidate` the candidate bits from `first`, a multiple of
+    /// one part of [`split::split`](super::split::split); `id`, `body`, `residual` (empty
+    /// unless positions are compensated) and `prop` are theirs alone, `candidate` the candidate bits from `first`, a multiple of
     /// [`ALIGN`](super::split::ALIGN), on): each one's wall load (zero without a contact) is
     /// added to its load; `springs` holds their entries' history blocks in slot order (empty
     /// when the model keeps none); the contacts are appended to `touches`. A grain that is not
     /// a candidate can touch no wall ([`super::wall_springs`]).
-    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], candidate: &[u64], springs: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) => wall_block_portable
+    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], candidate: &[u64], springs: &mut [T], id: &[u32], body: &[Body<T>], residual: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) => wall_block_portable
 }
 
 /// [`wall_block`] for whatever instruction set the caller is compiled for.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], candidate: &[u64], springs: &mut [T], id: &[u32], body: &[Body<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) {
+fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], candidate: &[u64], springs: &mut [T], id: &[u32], body: &[Body<T>], residual: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) {
     let per_grain = walls.len() * ctx.slots.stride;
     let mut e = 0;
     for (m, l) in loads.iter_mut().enumerate() {
         if !is_candidate(candidate, m) {
             continue;
         }
-        let w = wall_contacts(id[m], &body[m], crate::position::residual_at(ctx.residual, first + m), &prop[m], ctx.material(first + m), walls, ctx, &mut springs[e * per_grain..(e + 1) * per_grain], touches);
+        let w = wall_contacts(id[m], &body[m], crate::position::residual_at(residual, m), &prop[m], ctx.material(first + m), walls, ctx, &mut springs[e * per_grain..(e + 1) * per_grain], touches);
         l.force += w.force;
         l.torque += w.torque;
         e += 1;

@@ -41,6 +41,12 @@ pub fn is_candidate(words: &[u64], m: usize) -> bool {
     words[m / ALIGN] >> (m % ALIGN) & 1 != 0
 }
 
+/// [`WallSprings::first_entry`] from the runs' first entries `run_start`.
+#[inline]
+pub fn first_entry(run_start: &[u32], slot: usize) -> u32 {
+    if run_start.is_empty() { 0 } else { run_start[slot.div_ceil(ALIGN)] }
+}
+
 /// Candidates in slot order with their springs: what [`WallSprings::choose`] and
 /// [`WallSprings::renumbered`] fill.
 struct Builder<T> {
@@ -150,7 +156,7 @@ impl<T: Real> WallSprings<T> {
     /// The first entry at or after `slot`, a multiple of [`ALIGN`] or the number of grains
     /// (0 without walls, where there are no entries).
     pub fn first_entry(&self, slot: usize) -> u32 {
-        if self.run_start.is_empty() { 0 } else { self.run_start[slot.div_ceil(ALIGN)] }
+        first_entry(&self.run_start, slot)
     }
 
     /// Number of candidates.

@@ -476,7 +476,9 @@ impl<T: Real> Engine for Distributed<T> {
     }
     fn advance(&mut self, n: u64) -> Result<(), SimError> {
         for _ in 0..n {
-            self.local.step_with(&mut self.net)?;
+            // Processes exchange ghosts after each drift and sum the walls after each
+            // evaluation: no step carries the next one's first sweep.
+            self.local.step_with(&mut self.net, false)?;
         }
         self.gather_whole(false)
     }
