@@ -134,7 +134,7 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, reorder_ev
     for _ in 0..repeats.max(1) {
         // `advance` returns when its steps are done: the GPU's ends on the rebuild check's
         // read-back. The statistics, a pass in permanent-id order that a run makes once per
-        // `stats_interval`, are not timed: at 10^6 grains one took as long as three steps.
+        // `stats_interval`, are not timed: at 10^6 grains one took as long as five steps.
         let started = Instant::now();
         engine.advance(steps)?;
         seconds_each.push(started.elapsed().as_secs_f64());

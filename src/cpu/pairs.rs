@@ -123,7 +123,7 @@ impl PairList {
     /// `(owner, pair)` for every pair in canonical order: owners by ascending permanent id,
     /// then the owner's pairs in list order (ascending partner id). `slot[id]` is the slot of
     /// permanent id `id`. The owner comes along so that no pass bisects for it (at 10^6 grains
-    /// a bisection per pair made the statistics cost as much as five steps).
+    /// the bisections took 0.36 s of a statistics read's 0.84, two steps' worth).
     pub fn in_id_order(&self, slot: &[u32]) -> Vec<(u32, u32)> {
         let mut order = Vec::with_capacity(self.len());
         for &s in slot {
