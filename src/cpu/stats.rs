@@ -104,7 +104,7 @@ impl<T: Real> CpuEngine<T> {
             }
             s
         });
-        let canonical = self.pairs.in_id_order(&self.slots());
+        let canonical = self.pairs.in_id_order(&slot);
         let pair_sums = chunked(canonical.len(), |r| {
             let mut s = PairSums::default();
             for (i, k) in r.map(|c| canonical[c]) {
