@@ -25,7 +25,7 @@ use crate::real::{Real, Vec3};
 /// about 5% slower (the bed, f64, one thread: mean of ten runs side by side, 1.05x for 16).
 const LANES: usize = 16;
 // A lane array of the narrowest real fills whole cache lines (see [`Inputs`]).
-const _: () = assert!(LANES * std::mem::size_of::<f32>() % 64 == 0);
+const _: () = assert!((LANES * std::mem::size_of::<f32>()).is_multiple_of(64));
 
 /// `model` rebuilt with its laws as compile-time constants when it is the standard
 /// Hertz-Mindlin model (with any cohesion), so that the composed `contact_force` folds to
