@@ -52,7 +52,6 @@ use crate::schedule::{Op, Schedule, Sweep, Trace};
 use crate::scene::{Scene, WallShape};
 use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
-use std::sync::atomic::AtomicUsize;
 use gather::gather_block;
 pub(crate) use grid::{hash_cells, CellGrid};
 use pair_force::{owner_block, OwnerBlock, TaskScratch};
@@ -511,13 +510,13 @@ impl<T: Real> CpuEngine<T> {
         let mut blocks = owner_blocks(pairs, self.slots.stride, &mut self.load, &mut self.share, &mut self.report, &mut self.force_i, &mut self.hist).into_iter();
         // Each part's owner blocks (parts start at block boundaries).
         let parts: Vec<Vec<OwnerBlock<T>>> = bounds.windows(2).map(|w| blocks.by_ref().take(w[1].div_ceil(pair_force::OWNERS) - w[0].div_ceil(pair_force::OWNERS)).collect()).collect();
-        let (tasks, done) = (parts.len(), AtomicUsize::new(0));
+        let together = warm::Together::new(parts.len());
         parts.into_par_iter().for_each(|part| {
             let mut scratch = TaskScratch::default();
             for b in part {
                 owner_block(b, &mut scratch, pairs, body, prop, &ctx, gravity);
             }
-            warm::finish_together(&done, tasks);
+            together.finish();
         });
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
@@ -572,12 +571,12 @@ impl<T: Real> CpuEngine<T> {
                 (take_front(&mut body, grains.len()), r, &self.built_at[grains.clone()], &self.load[grains.clone()], &self.prop[grains])
             })
             .collect();
-        let (tasks, done) = (parts.len(), AtomicUsize::new(0));
+        let together = warm::Together::new(parts.len());
         let moved: Vec<T> = parts
             .into_par_iter()
             .map(|(b, r, at, l, p)| {
                 let moved = integrate::kick_drift(b, r, at, l, p, kick, tau);
-                warm::finish_together(&done, tasks);
+                together.finish();
                 moved
             })
             .collect();
@@ -979,7 +978,7 @@ fn complete_loads<T: Real>(
             (w[0], take_front(&mut loads, n), take_front(&mut bodies, n), take_front(&mut residuals, if compensated { n } else { 0 }), take_front(&mut springs, (e[1] - e[0]) as usize * per_grain))
         })
         .collect();
-    let (tasks, finished) = (parts.len(), AtomicUsize::new(0));
+    let together = warm::Together::new(parts.len());
     let done: Vec<(Vec<WallTouch<T>>, T)> = parts
         .into_par_iter()
         .map(|(first, mut loads, mut bodies, mut residuals, mut springs)| {
@@ -1009,7 +1008,7 @@ fn complete_loads<T: Real>(
                 }
                 at = stop;
             }
-            warm::finish_together(&finished, tasks);
+            together.finish();
             (touches, moved)
         })
         .collect();

@@ -49,28 +49,41 @@ fn keep_warm(stop: &AtomicBool, leader: Option<usize>) {
     }
 }
 
-/// The end of one of a parallel loop's `tasks` tasks, which `done` counts: waits until the
-/// others are done too, running the pool's pending work meanwhile, for at most
-/// [`TOGETHER_LIMIT`]. The thread that called the loop runs one task and, finishing it
-/// before the others, waits in the loop's join, where rayon lets it sleep; waking it when the
-/// last task ends cost 20 us on the 2-core KVM guest (the pair pass at 10^4 grains, f64, two
-/// threads: 494 us from the loop's start to its return, the caller's task done after 457 us,
-/// the helper's after 471). Kept awake here, it returns as the last task ends (the pair pass
-/// then 471 us; the bench, interleaved runs, f64, two threads: 10^4 grains 1.611e7 ->
-/// 1.647e7 particle-steps/s, means of five; 10^6 1.20e7 -> 1.25e7; three threads on the two
-/// cores 1.03e7-1.28e7 -> 1.49e7-1.51e7). The limit keeps a wait for a task that this thread
-/// itself must run (more tasks than threads) short.
-pub fn finish_together(done: &AtomicUsize, tasks: usize) {
-    done.fetch_add(1, Ordering::AcqRel);
-    let start = Instant::now();
-    while done.load(Ordering::Acquire) < tasks && start.elapsed() < TOGETHER_LIMIT {
-        if rayon::yield_now() != Some(rayon::Yield::Executed) {
-            std::hint::spin_loop();
+/// Where the tasks of one parallel loop end together. The thread that calls the loop runs one
+/// task and, finishing it before the others, waits in the loop's join, where rayon lets it
+/// sleep; waking it when the last task ended cost 20 us on the 2-core KVM guest (the pair pass
+/// at 10^4 grains, f64, two threads: 494 us from the loop's start to its return, the caller's
+/// task done after 457 us, the helper's after 471). Each task that ends here waits for the
+/// others, running the pool's pending work meanwhile, for at most [`TOGETHER_LIMIT`], so the
+/// caller is awake when the last ends (the pair pass then 471 us; the bench, interleaved runs,
+/// f64, two threads: 10^4 grains 1.611e7 -> 1.647e7 particle-steps/s, means of five; 10^6
+/// 1.20e7 -> 1.25e7; three threads on the two cores 1.03e7-1.28e7 -> 1.49e7-1.51e7). The
+/// limit keeps a wait for a task that this thread itself must run (more tasks than threads)
+/// short.
+pub struct Together {
+    done: AtomicUsize,
+    tasks: usize,
+}
+
+impl Together {
+    /// For a loop of `tasks` tasks.
+    pub fn new(tasks: usize) -> Self {
+        Together { done: AtomicUsize::new(0), tasks }
+    }
+
+    /// The end of one task: waits for the others (see [`Together`]).
+    pub fn finish(&self) {
+        self.done.fetch_add(1, Ordering::AcqRel);
+        let start = Instant::now();
+        while self.done.load(Ordering::Acquire) < self.tasks && start.elapsed() < TOGETHER_LIMIT {
+            if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                std::hint::spin_loop();
+            }
         }
     }
 }
 
-/// The longest [`finish_together`] waits: a few wake-ups' worth.
+/// The longest [`Together::finish`] waits: a few wake-ups' worth.
 const TOGETHER_LIMIT: Duration = Duration::from_micros(100);
 
 /// Sets its flag when dropped.
@@ -97,6 +110,31 @@ mod tests {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             let runs: Vec<Vec<f64>> = pool.install(|| with_warm_pool(|| (0..50).map(|_| v.par_chunks(1000).map(|c| c.iter().sum()).collect()).collect()));
             assert!(runs.iter().all(|r| *r == serial), "{threads} threads");
+        }
+    }
+
+    /// Tasks that end together ([`Together`]), more of them than threads, in a warm run and
+    /// outside one: every loop returns, with the serial loop's results and every task counted.
+    #[test]
+    fn tasks_that_end_together_give_the_same_sums() {
+        let v: Vec<f64> = (0..100_000).map(|i| (i as f64).sqrt()).collect();
+        let serial: Vec<f64> = v.chunks(10_000).map(|c| c.iter().sum()).collect();
+        let sums = || {
+            let together = Together::new(serial.len());
+            let r: Vec<f64> = v
+                .par_chunks(10_000)
+                .map(|c| {
+                    let s = c.iter().sum();
+                    together.finish();
+                    s
+                })
+                .collect();
+            (r, together.done.load(Ordering::Acquire))
+        };
+        for threads in 1..=4 {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let runs: Vec<(Vec<f64>, usize)> = pool.install(|| (0..10).map(|_| sums()).chain(with_warm_pool(|| (0..10).map(|_| sums()).collect::<Vec<_>>())).collect());
+            assert!(runs.iter().all(|(r, done)| *r == serial && *done == serial.len()), "{threads} threads");
         }
     }
 }
