@@ -43,9 +43,7 @@ fn keep_warm(stop: &AtomicBool, leader: Option<usize>) {
         return;
     }
     while !stop.load(Ordering::Acquire) {
-        if rayon::yield_now() != Some(rayon::Yield::Executed) {
-            std::hint::spin_loop();
-        }
+        run_pending_or_spin();
     }
 }
 
@@ -76,15 +74,21 @@ impl Together {
         self.done.fetch_add(1, Ordering::AcqRel);
         let start = Instant::now();
         while self.done.load(Ordering::Acquire) < self.tasks && start.elapsed() < TOGETHER_LIMIT {
-            if rayon::yield_now() != Some(rayon::Yield::Executed) {
-                std::hint::spin_loop();
-            }
+            run_pending_or_spin();
         }
     }
 }
 
 /// The longest [`Together::finish`] waits: a few wake-ups' worth.
 const TOGETHER_LIMIT: Duration = Duration::from_micros(100);
+
+/// One turn of a wait that stays awake: a unit of the pool's pending work if there is one
+/// ([`rayon::yield_now`]), else a spin.
+fn run_pending_or_spin() {
+    if rayon::yield_now() != Some(rayon::Yield::Executed) {
+        std::hint::spin_loop();
+    }
+}
 
 /// Sets its flag when dropped.
 struct StopOnDrop<'a>(&'a AtomicBool);
