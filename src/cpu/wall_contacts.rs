@@ -95,11 +95,12 @@ fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, mat
 super::simd::dispatch! {
     /// `wall_contacts` for the candidates among slots `first..first + loads.len()` (at most
     /// one part of [`split::split`](super::split::split); `id`, `body`, `residual` (empty
-    /// unless positions are compensated) and `prop` are theirs alone, `candidate` the candidate bits from `first`, a multiple of
-    /// [`ALIGN`](super::split::ALIGN), on): each one's wall load (zero without a contact) is
-    /// added to its load; `springs` holds their entries' history blocks in slot order (empty
-    /// when the model keeps none); the contacts are appended to `touches`. A grain that is not
-    /// a candidate can touch no wall ([`super::wall_springs`]).
+    /// unless positions are compensated) and `prop` are theirs alone, `candidate` the
+    /// candidate bits from `first`, a multiple of [`ALIGN`](super::split::ALIGN), on): each
+    /// one's wall load (zero without a contact) is added to its load; `springs` holds their
+    /// entries' history blocks in slot order (empty when the model keeps none); the contacts
+    /// are appended to `touches`. A grain that is not a candidate can touch no wall
+    /// ([`super::wall_springs`]).
     pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], candidate: &[u64], springs: &mut [T], id: &[u32], body: &[Body<T>], residual: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) => wall_block_portable
 }
 
