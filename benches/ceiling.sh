@@ -12,8 +12,9 @@
 #
 #   benches/ceiling.sh [SIZES] [THREADS] [ROUNDS]    defaults: 10000 1 3
 #
-# Builds the patched tree in a git worktree (committed HEAD only) with the project's target
-# folder, whose dependencies it shares, and keeps its binary as target/ceiling/grains.
+# Builds the patched tree in a git worktree (committed HEAD only) into target/ceiling (a target
+# folder of its own: one shared with the project's build would leave the patched library in
+# place of the real one; the first run builds the dependencies there too, some minutes).
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 SIZES=${1:-10000}
@@ -27,14 +28,12 @@ if ! git -C "$TREE" apply "$ROOT/benches/ceiling.patch"; then
   echo "error: benches/ceiling.patch no longer applies to src/cpu/lanes.rs; fix: redo its one change (the call of contact_force in the lane loop replaced by inputs times zero) and regenerate it with git diff" >&2
   exit 1
 fi
-cargo build --release --quiet --manifest-path "$TREE/Cargo.toml" --target-dir "$ROOT/target"
-mkdir -p "$ROOT/target/ceiling"
-cp "$ROOT/target/release/grains" "$ROOT/target/ceiling/grains"
 cargo build --release --quiet --manifest-path "$ROOT/Cargo.toml"
+cargo build --release --quiet --manifest-path "$TREE/Cargo.toml" --target-dir "$ROOT/target/ceiling"
 run() {
   "$1" bench --part throughput --sizes "$SIZES" --threads "$THREADS" --precision f64 --repeats 3 --work 1e7 2>/dev/null | grep -E '^cpu ' | awk -v who="$2" '{printf "%-8s %3s thr %8s grains %10s particle-steps/s %7s ns/p-step  Z = %s\n", who, $3, $5, $6, $8, $9}'
 }
 for _ in $(seq "$ROUNDS"); do
   run "$ROOT/target/release/grains" real
-  run "$ROOT/target/ceiling/grains" "no law"
+  run "$ROOT/target/ceiling/release/grains" "no law"
 done
