@@ -30,8 +30,17 @@ if ! git -C "$TREE" apply "$ROOT/benches/ceiling.patch"; then
 fi
 cargo build --release --quiet --manifest-path "$ROOT/Cargo.toml"
 cargo build --release --quiet --manifest-path "$TREE/Cargo.toml" --target-dir "$ROOT/target/ceiling"
+LOG=$(mktemp)
+trap 'cleanup; rm -f "$LOG"' EXIT
+# The bench's table rows of binary $1, labelled $2; its progress goes to $LOG, shown if it fails.
 run() {
-  "$1" bench --part throughput --sizes "$SIZES" --threads "$THREADS" --precision f64 --repeats 3 --work 1e7 2>/dev/null | grep -E '^cpu ' | awk -v who="$2" '{printf "%-8s %3s thr %8s grains %10s particle-steps/s %7s ns/p-step  Z = %s\n", who, $3, $5, $6, $8, $9}'
+  local table
+  if ! table=$("$1" bench --part throughput --sizes "$SIZES" --threads "$THREADS" --precision f64 --repeats 3 --work 1e7 2>"$LOG"); then
+    echo "error: the $2 build's bench failed:" >&2
+    tail -n 3 "$LOG" >&2
+    exit 1
+  fi
+  grep -E '^cpu ' <<<"$table" | awk -v who="$2" '{printf "%-8s %3s thr %8s grains %10s particle-steps/s %7s ns/p-step  Z = %s\n", who, $3, $5, $6, $8, $9}'
 }
 for _ in $(seq "$ROUNDS"); do
   run "$ROOT/target/release/grains" real
