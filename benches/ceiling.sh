@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The ceiling of the step as built: `grains bench` on the dense bed, interleaved, for HEAD and
-# for HEAD with `benches/ceiling.patch`, whose lane kernel computes no contact law (each
+# The ceiling of the step as built: `grains bench` on the dense bed, interleaved, for the build
+# and for HEAD with `benches/ceiling.patch`, whose lane kernel computes no contact law (each
 # touching pair's forces, torques and spring are its loaded inputs times zero) while the touch
 # test, the lane fill, the owner sums, the partners' shares, the reports, the springs written
 # back, the gather, the walls, the kicks and the drifts run as they are. The difference is what
@@ -12,9 +12,10 @@
 #
 #   benches/ceiling.sh [SIZES] [THREADS] [ROUNDS]    defaults: 10000 1 3
 #
-# Builds the patched tree in a git worktree (committed HEAD only) into target/ceiling (a target
-# folder of its own: one shared with the project's build would leave the patched library in
-# place of the real one; the first run builds the dependencies there too, some minutes).
+# The real build is the working tree's (target/release); the patched one is committed HEAD's,
+# built in a git worktree into target/ceiling (a target folder of its own: one shared with the
+# project's build would leave the patched library in place of the real one; the first run
+# builds the dependencies there too, some minutes). Commit first for a like-for-like pair.
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 SIZES=${1:-10000}
