@@ -122,7 +122,7 @@ pub fn characteristic_times(materials: &[Material], grains: &Grains, walls: &[Wa
         }
     }
     let collision = |a: usize, b: Option<usize>, (ra, ma): (f64, f64), other: Option<(f64, f64)>| -> f64 {
-        let c: PairCoeffs<f64> = PairCoeffs::mix(&materials[a].constants, &materials[b.unwrap_or(a)].constants);
+        let c: PairCoeffs<f64> = PairCoeffs::mix(&materials[a].constants, &materials[b.unwrap_or(a)].constants, model);
         let (r_eff, m_eff) = match other {
             Some((rb, mb)) => (ra * rb / (ra + rb), ma * mb / (ma + mb)),
             None => (ra, ma),

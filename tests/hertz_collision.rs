@@ -128,53 +128,22 @@ fn restitution_falls_with_the_papers_damping_coefficient() {
     assert!(table.last().unwrap().1 < 0.9, "the largest damping should dissipate visibly: {table:?}");
 }
 
-/// Reference for a damped head-on collision: the same overlap equation
-/// `m_eff h'' = -(F_el(h) + eta(h) h')`, clamped at zero force, integrated by classical
-/// Runge-Kutta with a step 1e-4 of the contact time. Returns (restitution, contact time).
-fn damped_reference(restitution: f64) -> (f64, f64) {
-    let m = 4.0 / 3.0 * std::f64::consts::PI * R.powi(3) * RHO;
-    let (me, re, ve) = (m / 2.0, R / 2.0, E / (1.0 - NU * NU) / 2.0);
-    let beta = grains::model::restitution_beta(restitution);
-    let acc = |h: f64, hd: f64| {
-        if h <= 0.0 {
-            return 0.0;
-        }
-        let f_el = 4.0 / 3.0 * ve * re.sqrt() * h.powf(1.5);
-        let eta = 2.0 * (5.0f64 / 6.0).sqrt() * beta * (2.0 * ve * (re * h).sqrt() * me).sqrt();
-        -(f_el + eta * hd).max(0.0) / me
-    };
-    let (mut h, mut hd, mut t) = (0.0, V_REL, 0.0);
-    let dt = theory().0 * 1e-4;
-    loop {
-        let (k1x, k1v) = (hd, acc(h, hd));
-        let (k2x, k2v) = (hd + 0.5 * dt * k1v, acc(h + 0.5 * dt * k1x, hd + 0.5 * dt * k1v));
-        let (k3x, k3v) = (hd + 0.5 * dt * k2v, acc(h + 0.5 * dt * k2x, hd + 0.5 * dt * k2v));
-        let (k4x, k4v) = (hd + dt * k3v, acc(h + dt * k3x, hd + dt * k3v));
-        let h_new = h + dt / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
-        let hd_new = hd + dt / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
-        if h_new <= 0.0 && t > 0.0 {
-            return (-hd_new / V_REL, t + dt * h / (h - h_new));
-        }
-        (h, hd, t) = (h_new, hd_new, t + dt);
-    }
-}
-
-/// The restitution law (LIGGGHTS' `coefficientRestitution`) with the no-pull clamp, against an
-/// accurate integration of the same contact equation. The clamp removes the tensile tail of
-/// the damping force (which the peers keep), so e = 0.5 in gives about 0.55 out; without the
-/// clamp the reference gives 0.5000. Velocity Verlet lags the damping velocity by half a
-/// step, an error of first order in dt.
+/// The restitution law with the no-pull clamp on the shipped two-sphere pair: its dashpot is
+/// sized for the clamped Hertz contact ([`grains::model::restitution`]), so e = 0.5 in gives
+/// 0.5 out within the velocity-Verlet step's first-order error (the dashpot sees the velocity
+/// of half a step before), which falls with dt; LIGGGHTS' closed-form ratio under the same
+/// clamp gives 0.550 (`tests/impacts.rs` covers every law, clamp and e).
 #[test]
-fn restitution_law_matches_an_accurate_integration_of_the_same_contact() {
+fn restitution_law_gives_the_restitution_asked_for() {
     const DAMPED_TOLERANCE: f64 = 0.01;
     let (t_c, _) = theory();
-    let (e_ref, tc_ref) = damped_reference(0.5);
     let coarse = collide(t_c / 50.0, "damping = \"restitution\" # restitution = 0.5");
     let fine = collide(t_c / 200.0, "damping = \"restitution\" # restitution = 0.5");
-    println!("reference: e = {e_ref:.5}, contact {tc_ref:.5e} s; t_c/50: e = {:.5}, {:.5e} s; t_c/200: e = {:.5}, {:.5e} s", coarse.restitution, coarse.contact_time, fine.restitution, fine.contact_time);
-    assert!((coarse.restitution / e_ref - 1.0).abs() < DAMPED_TOLERANCE);
-    assert!((coarse.contact_time / tc_ref - 1.0).abs() < DAMPED_TOLERANCE);
-    assert!((fine.restitution - e_ref).abs() < (coarse.restitution - e_ref).abs(), "the error must fall with dt");
+    println!("e = 0.5 asked: t_c/50: e = {:.5}, contact {:.5e} s; t_c/200: e = {:.5}, {:.5e} s", coarse.restitution, coarse.contact_time, fine.restitution, fine.contact_time);
+    assert!((coarse.restitution / 0.5 - 1.0).abs() < DAMPED_TOLERANCE);
+    assert!((fine.restitution - 0.5).abs() < (coarse.restitution - 0.5).abs(), "the error must fall with dt");
+    let liggghts = grains::model::restitution::restitution_of(grains::model::restitution::Spring::Hertz, true, grains::model::restitution::oscillator_beta(0.5));
+    assert!((liggghts - 0.550).abs() < 0.001, "LIGGGHTS' ratio under the clamp: {liggghts}");
 }
 
 /// The linear spring (k_n) as the alternative normal law: an undamped contact lasts half a

@@ -29,6 +29,8 @@ override TWISTING_LAW: u32 = TWISTING_NONE;
 override COHESION_LAW: u32 = COHESION_NONE;    // capillary: a bridge volume per pair
 override HAS_TANGENTIAL_HISTORY: bool = false;
 override HAS_ROLLING_HISTORY: bool = false;
+// The no-pull clamp (src/model/mod.rs ContactModel::limit_damping).
+override LIMIT_DAMPING: bool = true;
 
 struct Geometry {
     n: vec3<f32>,
@@ -238,19 +240,34 @@ fn rolling_regime(fr: vec3<f32>, m: f32, inertia: f32, rp: f32, n: vec3<f32>, ou
     *out_t = cross(fr, n) * (rp / (1.0 + mr2 / inertia));
 }
 
-fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr<function, History>, elapsed: f32) -> ContactForce {
+// The time the springs advance by (src/model/mod.rs since_touch): `elapsed`, or on the
+// evaluation that finds a contact new, the time since its surfaces met.
+fn since_touch(hist: History, h: f32, v_n: f32, elapsed: f32) -> f32 {
+    let approach = -v_n;
+    let is_new = all(hist.tangential == vec3<f32>(0.0)) && all(hist.rolling == vec3<f32>(0.0));
+    if (is_new && approach * elapsed > h) {
+        return h / approach;
+    }
+    return elapsed;
+}
+
+fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr<function, History>, elapsed_step: f32) -> ContactForce {
     var out: ContactForce;
     let v_n = dot(k.v_i - k.v_j, g.n);
     let el = normal_elastic(c, g);
     let eta_n = normal_damping(c, g);
-    var f_n = el.x - eta_n * v_n;
-    out.clamped = f_n < 0.0;
+    let f_total = el.x - eta_n * v_n;
+    out.clamped = LIMIT_DAMPING && f_total < 0.0;
+    var f_signed = f_total;
     if (out.clamped) {
-        f_n = 0.0;
+        f_signed = 0.0;
     }
-    out.f_n = f_n;
-    out.f_i = g.n * f_n;
+    out.f_n = f_signed;
+    out.f_i = g.n * f_signed;
     out.f_j = -out.f_i;
+    // The friction limits take the normal force's magnitude: unclamped, the dashpot can pull.
+    let f_n = abs(f_signed);
+    let elapsed = since_touch(*hist, g.h, v_n, elapsed_step);
     out.t_i = vec3<f32>(0.0);
     out.t_j = vec3<f32>(0.0);
 

@@ -40,6 +40,7 @@ pub fn hertz_mindlin<T: Real>(model: &ContactModel<T>) -> Option<ContactModel<T>
         rolling: RollingLaw::None,
         twisting: TwistingLaw::None,
         cohesion: model.cohesion,
+        limit_damping: model.limit_damping,
     };
     (*model == fixed).then_some(ContactModel { cohesion: CohesionLaw::None, ..fixed })
 }

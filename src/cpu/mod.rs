@@ -164,7 +164,7 @@ impl<T: Real> CpuEngine<T> {
         let mut coeffs = Vec::with_capacity(n_materials * n_materials);
         for a in &scene.materials {
             for b in &scene.materials {
-                coeffs.push(PairCoeffs::mix(&a.constants, &b.constants));
+                coeffs.push(PairCoeffs::mix(&a.constants, &b.constants, &scene.model));
             }
         }
         let g = &scene.grains;

@@ -306,7 +306,7 @@ impl GpuEngine {
             .iter()
             .flat_map(|a| scene.materials.iter().map(move |b| (a, b)))
             .map(|(a, b)| {
-                let c: PairCoeffs<f32> = PairCoeffs::mix(&a.constants, &b.constants);
+                let c: PairCoeffs<f32> = PairCoeffs::mix(&a.constants, &b.constants, &scene.model);
                 layout::PairCoeffs { v_eff: c.v_eff, g_eff: c.g_eff, mu_s: c.mu_s, mu_k: c.mu_k, tan_roll: c.tan_roll, gamma_n: c.gamma_n, gamma_nt: c.gamma_nt, beta: c.beta }
             })
             .collect();
@@ -434,7 +434,7 @@ impl GpuEngine {
             servo: scene.servo.map(|s| s.walls),
             periodic: crate::periodic::Periodic::of(&scene.periodic),
             model: scene.model.cast::<f32>(),
-            coeffs: scene.materials.iter().flat_map(|a| scene.materials.iter().map(move |b| PairCoeffs::mix(&a.constants, &b.constants))).collect(),
+            coeffs: scene.materials.iter().flat_map(|a| scene.materials.iter().map(move |b| PairCoeffs::mix(&a.constants, &b.constants, &scene.model))).collect(),
             n_materials: scene.materials.len(),
             step: 0,
             time: 0.0,
@@ -522,6 +522,7 @@ impl GpuEngine {
             ("COHESION_LAW", m.cohesion.code() as f64),
             ("HAS_TANGENTIAL_HISTORY", self.history.tangential as u8 as f64),
             ("HAS_ROLLING_HISTORY", self.history.rolling as u8 as f64),
+            ("LIMIT_DAMPING", m.limit_damping as u8 as f64),
         ];
         let orientation = ("TRACK_ORIENTATION", self.track_orientation as u8 as f64);
         let wall_response = ("WALL_RESPONSE", self.servo.is_some() as u8 as f64);

@@ -12,13 +12,14 @@
 mod capillary;
 mod geometry;
 mod normal;
+pub mod restitution;
 mod rolling;
 mod tangential;
 mod twisting;
 
 pub use capillary::{capillary_force, capillary_potential, decay_length, rupture_distance, share_liquid, within_rupture};
 pub use geometry::{Bodies, Geometry, Kinematics};
-pub use normal::{normal_damping, normal_elastic, normal_force, normal_stiffness, restitution_beta};
+pub use normal::{normal_damping, normal_elastic, normal_force, normal_stiffness};
 pub use rolling::rolling_sds;
 pub use tangential::{contact_tangential_velocity, mindlin_tangential, oquendo_tangential, rotate_into_plane, TangentialOut};
 pub use twisting::twisting_torque;
@@ -178,10 +179,11 @@ pub enum DampingLaw<T> {
     /// The papers' nonlinear damping `-m_eff gamma_n sqrt(h) v_n` (seed 000 eq. 1),
     /// `gamma_n` (s^-1 m^-1/2) from the materials.
     Papers,
-    /// Viscous damping tuned to a restitution coefficient `e` from the materials, as LIGGGHTS'
-    /// `coefficientRestitution` (Hertz: `eta = 2 sqrt(5/6) |beta| sqrt(S_n m_eff)`,
-    /// `S_n = 2 V_eff sqrt(R_eff h)`; linear: `eta = 2 |beta| sqrt(k_n m_eff)`,
-    /// `beta = ln e / sqrt(ln^2 e + pi^2)`).
+    /// Viscous damping that gives a binary impact the restitution coefficient `e` of the
+    /// materials, shaped as LIGGGHTS' `coefficientRestitution` (Hertz:
+    /// `eta = 2 sqrt(5/6) beta sqrt(S_n m_eff)`, `S_n = 2 V_eff sqrt(R_eff h)`; linear:
+    /// `eta = 2 beta sqrt(k_n m_eff)`), its ratio `beta` found for the law as it runs, with or
+    /// without the clamp ([`restitution::dashpot_ratio`]).
     Restitution,
     /// Constant viscous coefficient `c_n` (N s/m): `-c_n v_n`.
     Viscous {
@@ -310,6 +312,11 @@ pub struct ContactModel<T> {
     pub twisting: TwistingLaw,
     /// Cohesion.
     pub cohesion: CohesionLaw<T>,
+    /// The no-pull clamp: the elastic and damping normal force together is held at zero
+    /// where the dashpot would pull (PHYSICS.md ruling; LAMMPS' `limit_damping`). Off, the
+    /// dashpot pulls at the end of a contact (as in LIGGGHTS, EDEM and MercuryDPM) and the
+    /// friction limits take the force's magnitude.
+    pub limit_damping: bool,
 }
 
 impl<T: Real> ContactModel<T> {
@@ -384,7 +391,8 @@ pub struct PairCoeffs<T> {
     pub gamma_n: T,
     /// Twisting damping `gamma_nt` (s^-1).
     pub gamma_nt: T,
-    /// `|beta|` of the restitution coefficient (see [`restitution_beta`]).
+    /// Dashpot ratio `beta` (-) of `damping = "restitution"`, found for the mean restitution
+    /// of the two materials ([`restitution::dashpot_ratio`]); 0 under other damping laws.
     pub beta: T,
 }
 
@@ -424,8 +432,9 @@ impl<T: Real> PairCoeffs<T> {
     /// Coefficients for a contact between materials `a` and `b`. Elastic constants combine
     /// as PHYSICS.md rules; friction coefficients and the rolling angle take the smaller of
     /// the two (as YADE does: a frictionless wall makes frictionless contacts); damping and
-    /// restitution take the arithmetic mean. Equal materials give their own values.
-    pub fn mix(a: &MaterialConstants, b: &MaterialConstants) -> Self {
+    /// restitution take the arithmetic mean. Equal materials give their own values. The
+    /// dashpot ratio is sized for `model`'s normal law and clamp.
+    pub fn mix(a: &MaterialConstants, b: &MaterialConstants, model: &ContactModel<f64>) -> Self {
         let (va, vb) = (a.stiffness(), b.stiffness());
         let g_inv = (2.0 - a.poisson_ratio) / a.shear_modulus() + (2.0 - b.poisson_ratio) / b.shear_modulus();
         let mean = |x: f64, y: f64| 0.5 * (x + y);
@@ -437,7 +446,16 @@ impl<T: Real> PairCoeffs<T> {
             tan_roll: T::of(a.rolling_angle.min(b.rolling_angle).tan()),
             gamma_n: T::of(mean(a.gamma_n, b.gamma_n)),
             gamma_nt: T::of(mean(a.gamma_nt, b.gamma_nt)),
-            beta: T::of(restitution_beta(mean(a.restitution, b.restitution))),
+            beta: T::of(match model.damping {
+                DampingLaw::Restitution => {
+                    let spring = match model.normal {
+                        NormalLaw::Hertz => restitution::Spring::Hertz,
+                        NormalLaw::Linear { .. } => restitution::Spring::Linear,
+                    };
+                    restitution::dashpot_ratio(mean(a.restitution, b.restitution), spring, model.limit_damping)
+                }
+                _ => 0.0,
+            }),
         }
     }
 }
@@ -490,7 +508,8 @@ impl Regime {
 /// Composes the sub-models for one touching contact (`geo.h > 0`), updating its history.
 ///
 /// `elapsed` is the time (s) since the previous force evaluation: the tangential and rolling
-/// springs grow by the relative velocity times `elapsed`.
+/// springs grow by the relative velocity times `elapsed`, or, on the evaluation that finds the
+/// contact new, times the time since the surfaces met ([`since_touch`]).
 #[inline(always)]
 pub fn contact_force<T: Real>(
     model: &ContactModel<T>,
@@ -505,8 +524,11 @@ pub fn contact_force<T: Real>(
     let v_n = v_rel.dot(geo.n);
     let (f_el, k_secant) = normal_elastic(&model.normal, c, geo);
     let eta_n = normal_damping(&model.damping, &model.normal, c, geo);
-    let (f_n, clamped) = normal_force(f_el, eta_n, v_n);
+    let (f_n, clamped) = normal_force(f_el, eta_n, v_n, model.limit_damping);
     let mut out = ContactForce { f_i: geo.n * f_n, f_j: geo.n * (-f_n), f_n, clamped, ..Default::default() };
+    // The friction limits take the normal force's magnitude: unclamped, the dashpot can pull.
+    let f_n = f_n.abs();
+    let elapsed = since_touch(hist, geo.h, v_n, elapsed);
 
     match model.tangential {
         TangentialLaw::None => {}
@@ -547,6 +569,20 @@ pub fn contact_force<T: Real>(
         out.f_j -= geo.n * f_c;
     }
     out
+}
+
+/// The time (s) the springs of a contact advance by at this evaluation: `elapsed`, the time
+/// since the previous one, unless the contact is new (its springs all zero, as a contact that
+/// was open at the previous evaluation has them) and its surfaces met within `elapsed`: then
+/// the time since they met, the overlap `h` over the approach speed `-v_n` (m/s, `v_n < 0`
+/// approaching), so that a contact that starts late in a step does not count a whole step of
+/// slip (LAMMPS does). A contact whose springs are zero for another reason (no tangential
+/// motion yet) has an overlap of more than a step's approach, and keeps `elapsed`.
+#[inline(always)]
+pub fn since_touch<T: Real>(hist: &History<T>, h: T, v_n: T, elapsed: T) -> T {
+    let approach = -v_n;
+    let new = hist.tangential == Vec3::ZERO && hist.rolling == Vec3::ZERO;
+    if new && approach * elapsed > h { h / approach } else { elapsed }
 }
 
 /// `k_t` (N/m) for the current overlap.
@@ -601,6 +637,7 @@ impl ContactModel<f64> {
                 CohesionLaw::None => CohesionLaw::None,
                 CohesionLaw::Capillary { kappa, theta, c } => CohesionLaw::Capillary { kappa: u(kappa), theta: u(theta), c: u(c) },
             },
+            limit_damping: self.limit_damping,
         }
     }
 
@@ -637,7 +674,8 @@ impl ContactModel<f64> {
             CohesionLaw::None => "none".to_string(),
             CohesionLaw::Capillary { kappa, theta, c } => format!("capillary(kappa={kappa:e} N/m, theta={:.1} deg, c={c})", theta.to_degrees()),
         };
-        format!("normal={normal} damping={damping} tangential={tangential} rolling={rolling} twisting={twisting} cohesion={cohesion}")
+        let clamp = if self.limit_damping { "on" } else { "off" };
+        format!("normal={normal} damping={damping} no-pull clamp={clamp} tangential={tangential} rolling={rolling} twisting={twisting} cohesion={cohesion}")
     }
 }
 
@@ -657,9 +695,15 @@ mod tests {
         MaterialConstants { youngs_modulus: 7.0e7, poisson_ratio: 0.3, mu_s: 0.5, mu_k: 0.4, rolling_angle: 0.1, gamma_n: 1.0e5, gamma_nt: 20.0, restitution: 0.5 }
     }
 
+    /// The standard Hertz-Mindlin model with restitution damping, clamped or not.
+    fn restitution_model(normal: NormalLaw<f64>, limit_damping: bool) -> ContactModel<f64> {
+        let tangential = TangentialLaw::Mindlin { damping_ratio: 0.0, stiffness: TangentialStiffness::Mindlin };
+        ContactModel { normal, damping: DampingLaw::Restitution, tangential, rolling: RollingLaw::None, twisting: TwistingLaw::None, cohesion: CohesionLaw::None, limit_damping }
+    }
+
     /// Two 0.5 mm grains of 1.3875e-6 kg along x, overlapping by 1 um.
     fn pair() -> (PairCoeffs<f64>, Geometry<f64>) {
-        let c = PairCoeffs::mix(&sand(), &sand());
+        let c = PairCoeffs::mix(&sand(), &sand(), &restitution_model(NormalLaw::Hertz, true));
         let g = Geometry::grain_grain(Vec3::new(0.999e-3, 0.0, 0.0), 0.999e-3, 5.0e-4, 5.0e-4, 1.3875e-6, 1.3875e-6);
         (c, g)
     }
@@ -671,9 +715,14 @@ mod tests {
         assert!(close(c.v_eff, 7.0e7 / 0.91 / 2.0));
         assert!(close(c.g_eff, 7.0e7 / 2.6 / 3.4));
         assert!(close(c.tan_roll, 0.1f64.tan()));
-        // beta(0.5) = ln 2 / sqrt(ln^2 2 + pi^2)
+        // The dashpot ratio is the law's own: the clamped Hertz inversion; the linear spring
+        // that may pull has the oscillator's ln 2 / sqrt(ln^2 2 + pi^2).
+        assert!(close(c.beta, restitution::dashpot_ratio(0.5, restitution::Spring::Hertz, true)));
         let (ln2, pi) = (std::f64::consts::LN_2, std::f64::consts::PI);
-        assert!(close(c.beta, ln2 / (ln2 * ln2 + pi * pi).sqrt()));
+        let linear: PairCoeffs<f64> = PairCoeffs::mix(&sand(), &sand(), &restitution_model(NormalLaw::Linear { k_n: 1.0e3 }, false));
+        assert!(close(linear.beta, ln2 / (ln2 * ln2 + pi * pi).sqrt()));
+        let papers = ContactModel { damping: DampingLaw::Papers, ..restitution_model(NormalLaw::Hertz, true) };
+        assert_eq!(PairCoeffs::<f64>::mix(&sand(), &sand(), &papers).beta, 0.0, "no dashpot ratio without restitution damping");
     }
 
     #[test]
@@ -697,8 +746,9 @@ mod tests {
         assert!(close(f, hand) && close(k, hand / 1.0e-6));
         // m_eff gamma_n sqrt(h) = 6.9375e-7 * 1e5 * 1e-3
         assert!(close(normal_damping(&DampingLaw::Papers, &NormalLaw::Hertz, &c, &g), 6.9375e-7 * 1.0e5 * 1.0e-3));
-        assert_eq!(normal_force(1.0, 2.0, -0.25), (1.5, false));
-        assert_eq!(normal_force(1.0, 2.0, 1.0), (0.0, true));
+        assert_eq!(normal_force(1.0, 2.0, -0.25, true), (1.5, false));
+        assert_eq!(normal_force(1.0, 2.0, 1.0, true), (0.0, true));
+        assert_eq!(normal_force(1.0, 2.0, 1.0, false), (-1.0, false), "unclamped, the dashpot pulls");
         assert!(close(normal_potential(&NormalLaw::Hertz, &c, g.r_eff, g.h), 0.4 * hand * 1.0e-6));
     }
 

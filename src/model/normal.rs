@@ -34,22 +34,13 @@ pub fn normal_damping<T: Real>(law: &DampingLaw<T>, normal: &NormalLaw<T>, c: &P
     }
 }
 
-/// Total normal force magnitude `F_el - eta v_n` clamped at zero so that damping never pulls
-/// (PHYSICS.md ruling). Returns the clamped magnitude (N) and whether the clamp acted.
+/// Total normal force magnitude `F_el - eta v_n` (N, compressive positive), with the no-pull
+/// clamp when `limit_damping`: then held at zero where the dashpot would pull (PHYSICS.md
+/// ruling; LAMMPS' `limit_damping`). Returns the force and whether the clamp acted.
 #[inline(always)]
-pub fn normal_force<T: Real>(f_elastic: T, eta: T, v_n: T) -> (T, bool) {
+pub fn normal_force<T: Real>(f_elastic: T, eta: T, v_n: T, limit_damping: bool) -> (T, bool) {
     let f = f_elastic - eta * v_n;
-    if f < T::ZERO { (T::ZERO, true) } else { (f, false) }
-}
-
-/// `|beta| = |ln e| / sqrt(ln^2 e + pi^2)` for a restitution coefficient `e` in (0, 1];
-/// 0 for `e >= 1` (no dissipation).
-pub fn restitution_beta(e: f64) -> f64 {
-    if e >= 1.0 || e <= 0.0 {
-        return 0.0;
-    }
-    let l = e.ln();
-    l.abs() / (l * l + std::f64::consts::PI * std::f64::consts::PI).sqrt()
+    if limit_damping && f < T::ZERO { (T::ZERO, true) } else { (f, false) }
 }
 
 /// Tangent stiffness `dF/dh` (N/m) of the elastic normal law: Hertz `2 V_eff sqrt(R_eff h)`

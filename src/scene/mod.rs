@@ -10,6 +10,7 @@ pub mod types;
 pub use error::SceneError;
 pub use types::*;
 
+use crate::model::restitution::MIN_RESTITUTION;
 use crate::model::{
     CohesionLaw, ContactModel, DampingLaw, MaterialConstants, NormalLaw, OquendoLaw, RollingFriction, RollingLaw, TangentialLaw,
     TangentialStiffness, TwistingLaw,
@@ -233,7 +234,8 @@ fn validate_materials(c: &Complainer, f: &SceneFile) -> Result<Vec<Material>, Sc
         let gamma_n = non_negative(c, &key("gamma_n"), m.gamma_n, "give gamma_n in s^-1 m^-1/2, or 0")?;
         let gamma_nt = non_negative(c, &key("gamma_nt"), m.gamma_nt, "give gamma_nt in s^-1, or 0")?;
         if let Some(e) = m.restitution.filter(|e| !(*e > 0.0 && *e <= 1.0)) {
-            return Err(c.invalid(key("restitution"), e, "must lie in (0, 1]", "give a restitution coefficient such as 0.5"));
+            let why = if e == 0.0 { "must lie in (0, 1]: no dashpot of finite strength stops an impact dead without holding the grains together" } else { "must lie in (0, 1]" };
+            return Err(c.invalid(key("restitution"), e, why, "give a restitution coefficient such as 0.5"));
         }
         out.push(Material {
             name: m.name.clone(),
@@ -566,6 +568,14 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
             if let Some((i, _)) = materials.iter().enumerate().find(|(i, mat)| used.contains(&(*i as u16)) && mat.restitution.is_none()) {
                 return Err(c.invalid(format!("material[{i}].restitution"), "(missing)", "damping = \"restitution\" needs it", "add `restitution` in (0, 1] to the material"));
             }
+            if let Some((i, e)) = materials.iter().enumerate().filter(|(i, _)| used.contains(&(*i as u16))).find_map(|(i, mat)| mat.restitution.filter(|&e| e < MIN_RESTITUTION).map(|e| (i, e))) {
+                return Err(c.invalid(
+                    format!("material[{i}].restitution"),
+                    e,
+                    format!("is below {MIN_RESTITUTION}, where the dashpot would set the contact's time scale and the time step, picked from the elastic contact time, would not resolve it"),
+                    format!("give a restitution of at least {MIN_RESTITUTION}"),
+                ));
+            }
             DampingLaw::Restitution
         }
         "viscous" => DampingLaw::Viscous { c_n: need("c_n", m.c_n, "give the dashpot coefficient c_n in N s/m")? },
@@ -573,6 +583,9 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
     };
     if !matches!(damping, DampingLaw::Viscous { .. }) {
         unused("c_n", m.c_n.is_some(), &format!("damping = \"{damping_name}\""))?;
+    }
+    if matches!(damping, DampingLaw::None) {
+        unused("limit_damping", m.limit_damping.is_some(), "damping = \"none\" (an elastic force never pulls)")?;
     }
     if matches!(damping, DampingLaw::Papers) && materials.iter().all(|x| x.constants.gamma_n == 0.0) {
         return Err(c.invalid("model.damping", "\"papers\"", "no material sets gamma_n, so it would not damp", "set `gamma_n` (s^-1 m^-1/2) in the [[material]] tables or use damping = \"none\""));
@@ -667,7 +680,7 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
         }
         other => return Err(c.invalid("model.cohesion", format!("\"{other}\""), "unknown cohesion law", "use \"none\" or \"capillary\"")),
     };
-    Ok(ContactModel { normal, damping, tangential, rolling, twisting, cohesion })
+    Ok(ContactModel { normal, damping, tangential, rolling, twisting, cohesion, limit_damping: m.limit_damping.unwrap_or(true) })
 }
 
 /// `simulation.method` and, for contact dynamics, its `[contact_dynamics]` settings.

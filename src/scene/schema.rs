@@ -297,6 +297,10 @@ pub struct ModelSpec {
     pub k_n: Option<f64>,
     /// Viscous coefficient c_n (N s/m), `damping = "viscous"`.
     pub c_n: Option<f64>,
+    /// The no-pull clamp (LAMMPS' `limit_damping`): true (default, PHYSICS.md's ruling) holds
+    /// the elastic and damping normal force at zero where the dashpot would pull; false lets it
+    /// pull at the end of a contact, as LIGGGHTS, EDEM and MercuryDPM do.
+    pub limit_damping: Option<bool>,
     /// No longer used (seed 000's contacts slide on their spring's Coulomb test); read only to
     /// say so.
     pub v_slip: Option<f64>,
