@@ -251,6 +251,61 @@ fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
     }
 }
 
+/// A dense colliding gas under the restitution dashpot with Hertz-Mindlin friction, clamped
+/// and pulling (`limit_damping`), GPU against the CPU f32 twin for 300 steps: the clamp's
+/// override, the friction limit's magnitude and the springs counted from the touch, contact
+/// by contact (the clamped counts equal, none unclamped).
+#[test]
+fn the_no_pull_clamp_and_its_absence_run_on_the_gpu_as_on_the_cpu() {
+    for clamp in [true, false] {
+        let scene = common::parse(&format!(
+            r#"
+seed = 4
+[[material]]
+name = "sand"
+density = 2650.0
+youngs_modulus = 7.0e7
+poisson_ratio = 0.3
+mu_s = 0.5
+restitution = 0.3
+[[generate]]
+material = "sand"
+count = 1500
+diameter = {{ min = 0.8e-3, max = 1.2e-3 }}
+region = {{ shape = "box", min = [0.0, 0.0, 0.0], max = [16.0e-3, 16.0e-3, 16.0e-3] }}
+random_speed = 0.5
+[[wall]]
+type = "box"
+material = "sand"
+min = [0.0, 0.0, 0.0]
+max = [16.0e-3, 16.0e-3, 16.0e-3]
+[model]
+damping = "restitution"
+limit_damping = {clamp}
+tangential = "mindlin"
+tangential_damping_ratio = 0.9
+[simulation]
+skin = 3.0e-4
+[[stage]]
+kind = "run"
+duration = 1.0e-3
+"#
+        ));
+        let Some(mut g) = common::gpu_engine(&scene) else { return };
+        let mut c: CpuEngine<f32> = common::engine(&scene);
+        g.advance(300).unwrap();
+        c.advance(300).unwrap();
+        let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
+        let worst = fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+        let (sg, sc) = (g.stats().unwrap(), c.stats().unwrap());
+        println!("clamp {clamp}: positions differ by {:.2e} of a diameter; contacts {} / {}, clamped {} / {}, sliding {} / {}", worst / 1.0e-3, sg.contacts, sc.contacts, sg.clamped, sc.clamped, sg.sliding, sc.sliding);
+        assert!(worst / 1.0e-3 < F32_POSITION_TOLERANCE, "clamp {clamp}");
+        assert!(sc.contacts > 0 && sc.sliding > 0, "the gas collides and slides");
+        assert_eq!((sg.contacts, sg.clamped, sg.sliding), (sc.contacts, sc.clamped, sc.sliding), "clamp {clamp}");
+        assert_eq!(sc.clamped == 0, !clamp, "clamped contacts exist with the clamp only");
+    }
+}
+
 /// The oedometer's piston under a target pressure, GPU against the CPU f32 twin: it is kicked
 /// and drifted in the dispatches after the grains' (its kicks wait for the walls' sums, and a
 /// run of steps carries each step's first kick and drift into the step before's), with the
