@@ -23,6 +23,12 @@ const F32_MOMENTUM_ROUNDOFF: f64 = 1e-5;
 
 /// A dense, frictional, colliding gas with walls and orientation: every kernel has work.
 fn gas(periodic: bool) -> Scene {
+    gas_with(periodic, "mu_k = 0.4\nrolling_angle = 3.0\ngamma_n = 1.0e5\ngamma_nt = 10.0", "damping = \"papers\"\ntangential = \"oquendo\"\ntwisting = \"oquendo\"")
+}
+
+/// The gas of [`gas`] with `material` added to its sand's keys (after `mu_s = 0.5`) and `model`
+/// as its `[model]` table.
+fn gas_with(periodic: bool, material: &str, model: &str) -> Scene {
     let walls = if periodic {
         "[periodic]\nx = [0.0, 16.0e-3]\ny = [0.0, 16.0e-3]\n[[wall]]\ntype = \"plane\"\nmaterial = \"sand\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n"
     } else {
@@ -37,10 +43,7 @@ density = 2650.0
 youngs_modulus = 7.0e7
 poisson_ratio = 0.3
 mu_s = 0.5
-mu_k = 0.4
-rolling_angle = 3.0
-gamma_n = 1.0e5
-gamma_nt = 10.0
+{material}
 [[generate]]
 material = "sand"
 count = 1500
@@ -49,9 +52,7 @@ region = {{ shape = "box", min = [0.0, 0.0, 0.0], max = [16.0e-3, 16.0e-3, 16.0e
 random_speed = 0.5
 {walls}
 [model]
-damping = "papers"
-tangential = "oquendo"
-twisting = "oquendo"
+{model}
 [simulation]
 track_orientation = true
 skin = 3.0e-4
@@ -258,39 +259,7 @@ fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
 #[test]
 fn the_no_pull_clamp_and_its_absence_run_on_the_gpu_as_on_the_cpu() {
     for clamp in [true, false] {
-        let scene = common::parse(&format!(
-            r#"
-seed = 4
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
-restitution = 0.3
-[[generate]]
-material = "sand"
-count = 1500
-diameter = {{ min = 0.8e-3, max = 1.2e-3 }}
-region = {{ shape = "box", min = [0.0, 0.0, 0.0], max = [16.0e-3, 16.0e-3, 16.0e-3] }}
-random_speed = 0.5
-[[wall]]
-type = "box"
-material = "sand"
-min = [0.0, 0.0, 0.0]
-max = [16.0e-3, 16.0e-3, 16.0e-3]
-[model]
-damping = "restitution"
-limit_damping = {clamp}
-tangential = "mindlin"
-tangential_damping_ratio = 0.9
-[simulation]
-skin = 3.0e-4
-[[stage]]
-kind = "run"
-duration = 1.0e-3
-"#
-        ));
+        let scene = gas_with(false, "restitution = 0.3", &format!("damping = \"restitution\"\nlimit_damping = {clamp}\ntangential = \"mindlin\"\ntangential_damping_ratio = 0.9"));
         let Some(mut g) = common::gpu_engine(&scene) else { return };
         let mut c: CpuEngine<f32> = common::engine(&scene);
         g.advance(300).unwrap();
