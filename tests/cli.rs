@@ -163,6 +163,13 @@ fn malformed_scenes_get_one_line_naming_the_key_and_the_fix() {
         ("speed_threshold.toml", base.replace("[model]", "[model]\nv_slip = 1.0e-3"), "model.v_slip = 0.001: is no longer used"),
         ("seating_above_p0.toml", oedometer().replace("seating_pressure = 1.0e3", "seating_pressure = 2.0e4"), "seating_pressure = 20000: is not below p0"),
         ("two_ke_criteria.toml", oedometer().replace("ke_ratio = 1.0e-3", "ke_ratio = 1.0e-3\nke_per_grain = 1.0e-12"), "ke_ratio"),
+        ("plastic_impact.toml", base.replace("poisson_ratio = 0.3", "poisson_ratio = 0.3\nrestitution = 0.0"), "material[0].restitution = 0: must lie in (0, 1]: no dashpot"),
+        (
+            "tiny_restitution.toml",
+            base.replace("poisson_ratio = 0.3", "poisson_ratio = 0.3\nrestitution = 0.0005").replace("damping = \"none\"", "damping = \"restitution\""),
+            "material[0].restitution = 0.0005: is below 0.001",
+        ),
+        ("clamp_without_damping.toml", base.replace("damping = \"none\"", "damping = \"none\"\nlimit_damping = false"), "model.limit_damping"),
     ];
     for (name, text, key) in cases {
         let err = refused(name, &text);

@@ -568,7 +568,8 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
             if let Some((i, _)) = materials.iter().enumerate().find(|(i, mat)| used.contains(&(*i as u16)) && mat.restitution.is_none()) {
                 return Err(c.invalid(format!("material[{i}].restitution"), "(missing)", "damping = \"restitution\" needs it", "add `restitution` in (0, 1] to the material"));
             }
-            if let Some((i, e)) = materials.iter().enumerate().filter(|(i, _)| used.contains(&(*i as u16))).find_map(|(i, mat)| mat.restitution.filter(|&e| e < MIN_RESTITUTION).map(|e| (i, e))) {
+            // Every material, used or not: the dashpot is sized for each pair of them.
+            if let Some((i, e)) = materials.iter().enumerate().find_map(|(i, mat)| mat.restitution.filter(|&e| e < MIN_RESTITUTION).map(|e| (i, e))) {
                 return Err(c.invalid(
                     format!("material[{i}].restitution"),
                     e,
