@@ -64,7 +64,7 @@ fn contact_time(i: &Impact) -> f64 {
 
 /// The scene of one impact with restitution `e`: grains placed so that their surfaces meet
 /// `phase` of the way through the second step's drift.
-fn scene(i: &Impact, e: f64) -> (grains::scene::Scene, f64) {
+fn scene(i: &Impact, e: f64) -> grains::scene::Scene {
     let dt = contact_time(i) / i.steps;
     let gap = i.speed * dt * (1.0 + i.phase);
     let normal = if i.linear { format!("normal = \"linear\"\nk_n = {K_N:e}") } else { "normal = \"hertz\"".to_string() };
@@ -93,13 +93,13 @@ fn scene(i: &Impact, e: f64) -> (grains::scene::Scene, f64) {
         i.clamp,
         20.0 * dt * i.steps
     );
-    (common::parse(&text), dt)
+    common::parse(&text)
 }
 
 /// The normal restitution the engine gives the impact: the approach speed out over in, once
 /// the surfaces have parted.
 fn measured(i: &Impact, e: f64) -> f64 {
-    let (scene, _) = scene(i, e);
+    let scene = scene(i, e);
     let mut eng: CpuEngine<f64> = common::engine(&scene);
     // The approach speed along the normal and the overlap, read off the engine.
     type Reading = fn(&CpuEngine<f64>) -> f64;

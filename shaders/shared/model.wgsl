@@ -240,7 +240,7 @@ fn rolling_regime(fr: vec3<f32>, m: f32, inertia: f32, rp: f32, n: vec3<f32>, ou
     *out_t = cross(fr, n) * (rp / (1.0 + mr2 / inertia));
 }
 
-// The time the springs advance by (src/model/mod.rs since_touch): `elapsed`, or on the
+// The time the springs advance by (src/model/tangential.rs since_touch): `elapsed`, or on the
 // evaluation that finds a contact new, the time since its surfaces met.
 fn since_touch(hist: History, h: f32, v_n: f32, elapsed: f32) -> f32 {
     let approach = -v_n;

@@ -21,7 +21,7 @@ pub use capillary::{capillary_force, capillary_potential, decay_length, rupture_
 pub use geometry::{Bodies, Geometry, Kinematics};
 pub use normal::{normal_damping, normal_elastic, normal_force, normal_stiffness};
 pub use rolling::rolling_sds;
-pub use tangential::{contact_tangential_velocity, mindlin_tangential, oquendo_tangential, rotate_into_plane, TangentialOut};
+pub use tangential::{contact_tangential_velocity, mindlin_tangential, oquendo_tangential, rotate_into_plane, since_touch, TangentialOut};
 pub use twisting::twisting_torque;
 
 use crate::real::{Real, Vec3};
@@ -569,20 +569,6 @@ pub fn contact_force<T: Real>(
         out.f_j -= geo.n * f_c;
     }
     out
-}
-
-/// The time (s) the springs of a contact advance by at this evaluation: `elapsed`, the time
-/// since the previous one, unless the contact is new (its springs all zero, as a contact that
-/// was open at the previous evaluation has them) and its surfaces met within `elapsed`: then
-/// the time since they met, the overlap `h` over the approach speed `-v_n` (m/s, `v_n < 0`
-/// approaching), so that a contact that starts late in a step does not count a whole step of
-/// slip (LAMMPS does). A contact whose springs are zero for another reason (no tangential
-/// motion yet) has an overlap of more than a step's approach, and keeps `elapsed`.
-#[inline(always)]
-pub fn since_touch<T: Real>(hist: &History<T>, h: T, v_n: T, elapsed: T) -> T {
-    let approach = -v_n;
-    let new = hist.tangential == Vec3::ZERO && hist.rolling == Vec3::ZERO;
-    if new && approach * elapsed > h { h / approach } else { elapsed }
 }
 
 /// `k_t` (N/m) for the current overlap.

@@ -32,6 +32,20 @@ pub fn rotate_into_plane<T: Real>(s: Vec3<T>, n: Vec3<T>) -> Vec3<T> {
     if p2 == T::ZERO { Vec3::ZERO } else { p * (len2 / p2).sqrt() }
 }
 
+/// The time (s) the springs of a contact advance by at this evaluation: `elapsed`, the time
+/// since the previous one, unless the contact is new (its springs all zero, as a contact that
+/// was open at the previous evaluation has them) and its surfaces met within `elapsed`: then
+/// the time since they met, the overlap `h` over the approach speed `-v_n` (m/s, `v_n < 0`
+/// approaching), so that a contact that starts late in a step does not count a whole step of
+/// slip (LAMMPS does). A contact whose springs are zero for another reason (no tangential
+/// motion yet) has an overlap of more than a step's approach, and keeps `elapsed`.
+#[inline(always)]
+pub fn since_touch<T: Real>(hist: &History<T>, h: T, v_n: T, elapsed: T) -> T {
+    let approach = -v_n;
+    let new = hist.tangential == Vec3::ZERO && hist.rolling == Vec3::ZERO;
+    if new && approach * elapsed > h { h / approach } else { elapsed }
+}
+
 /// Tangential velocity of the contact points, `v_t = v_p - (v_p.n) n` with seed 000 eq. 4
 /// `v_p = v_i - v_j - (R'_i w_i + R'_j w_j) x n`.
 #[inline(always)]
