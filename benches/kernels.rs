@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
-use grains::model::{contact_force, Bodies, ContactForce, Geometry, History, Kinematics, PairCoeffs};
+use grains::model::{contact_force, Bodies, ContactForce, Geometry, History, KickWindow, Kinematics, PairCoeffs};
 use grains::real::{Real, Vec3};
 use grains::scene::{self, Scene};
 use std::hint::black_box;
@@ -29,7 +29,7 @@ fn pair_maths<T: Real>(c: &mut Criterion, label: &str) {
     group.throughput(Throughput::Elements(1));
     group.bench_function(label, |b| {
         let mut h = History::<T>::default();
-        b.iter(|| -> ContactForce<T> { contact_force(&model, &coeffs, black_box(&geo), black_box(&kin), &bodies, &mut h, T::of(2e-6)) })
+        b.iter(|| -> ContactForce<T> { contact_force(&model, &coeffs, black_box(&geo), black_box(&kin), &bodies, &mut h, T::of(2e-6), KickWindow::centred(T::of(2e-6))) })
     });
     group.finish();
 }

@@ -121,6 +121,18 @@ fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
             let frame = wall_frame(wall, p.xyz, residual[i]);
             if (frame.w >= p.w) {
                 for (var b = 0u; b < params.hist_blocks; b++) { wall_hist[base + b] = vec4<f32>(0.0); }
+                // A contact that parted within the window may still pull: its force counts in
+                // the wall's reaction, not in its contacts.
+                let window = kick_window(phase.elapsed);
+                if (ends_pull(window)) {
+                    let g = geometry_grain_wall(frame.xyz, frame.w, p.w, v.w);
+                    let f_n = parted_normal_force(coeffs[wall.material * params.n_materials + material[i]], g, dot(v.xyz - wall.velocity.xyz, g.n), window);
+                    if (f_n != 0.0) {
+                        let f_w = g.n * f_n;
+                        out.force += f_w;
+                        reaction[lid * MAX_WALLS + w] = vec4<f32>(-f_w, bitcast<f32>(0u));
+                    }
+                }
                 continue;
             }
             let g = geometry_grain_wall(frame.xyz, frame.w, p.w, v.w);
@@ -128,14 +140,12 @@ fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
             let bodies = Bodies(v.w, om.w, 0.0, 0.0, true);
             let c = coeffs[wall.material * params.n_materials + material[i]];
             // Walls are not wetted: their contacts keep springs only.
-            var h = empty_history();
-            var b = base;
-            if (HAS_TANGENTIAL_HISTORY) { h.tangential = wall_hist[b].xyz; h.sliding = wall_hist[b].w != 0.0; b += 1u; }
-            if (HAS_ROLLING_HISTORY) { h.rolling = wall_hist[b].xyz; }
+            var blocks: array<vec4<f32>, MAX_HISTORY_BLOCKS>;
+            for (var b = 0u; b < params.hist_blocks; b++) { blocks[b] = wall_hist[base + b]; }
+            var h = history_of_blocks(blocks);
             let f = contact_force(c, g, kin, bodies, &h, phase.elapsed);
-            b = base;
-            if (HAS_TANGENTIAL_HISTORY) { wall_hist[b] = vec4<f32>(h.tangential, select(0.0, 1.0, h.sliding)); b += 1u; }
-            if (HAS_ROLLING_HISTORY) { wall_hist[b] = vec4<f32>(h.rolling, 0.0); }
+            blocks = blocks_of_history(h);
+            for (var b = 0u; b < params.hist_blocks; b++) { wall_hist[base + b] = blocks[b]; }
             out.force += f.f_i;
             out.torque += f.t_i;
             reaction[lid * MAX_WALLS + w] = vec4<f32>(-f.f_i, bitcast<f32>(1u));

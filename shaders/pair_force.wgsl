@@ -1,12 +1,13 @@
 // One invocation computes the force of one listed pair, once, in canonical order (owner =
-// lower id = i), reading and writing its history (the tangential block's w is the sliding
-// flag, the bridge block's x the liquid volume). Its record: out_fi the force on i and the
+// lower id = i), reading and writing its history (history_of_blocks: the tangential block's w
+// is the sliding flag, the bridge block's x the liquid volume, and the normal velocity at the
+// previous evaluation takes a spare component). Its record: out_fi the force on i and the
 // normal force, out_ti the torque on i and its tangential regime (plus CLAMPED_FLAG when the
 // normal force was clamped), out_tj the torque on j and its capillary force, and out_fj the
 // force on j only where the law's force on j is not the force on i reversed
 // (PARTNER_FORCE_STORED; the gather subtracts out_fi otherwise). A pair that does not touch
 // forgets its springs and exerts only the capillary force of its bridge, if it has one within
-// reach.
+// reach, and the end of a contact that parted within the window (parted_normal_force).
 override PARTNER_FORCE_STORED: bool;
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
@@ -26,19 +27,14 @@ override PARTNER_FORCE_STORED: bool;
 @group(0) @binding(15) var<storage, read> control: Control;
 
 fn load_history(k: u32) -> History {
-    var h = empty_history();
-    var b = k * params.hist_blocks;
-    if (HAS_TANGENTIAL_HISTORY) { h.tangential = hist[b].xyz; h.sliding = hist[b].w != 0.0; b += 1u; }
-    if (HAS_ROLLING_HISTORY) { h.rolling = hist[b].xyz; b += 1u; }
-    if (COHESION_LAW == COHESION_CAPILLARY) { h.bridge = hist[b].x; }
-    return h;
+    var blocks: array<vec4<f32>, MAX_HISTORY_BLOCKS>;
+    for (var b = 0u; b < params.hist_blocks; b++) { blocks[b] = hist[k * params.hist_blocks + b]; }
+    return history_of_blocks(blocks);
 }
 
 fn store_history(k: u32, h: History) {
-    var b = k * params.hist_blocks;
-    if (HAS_TANGENTIAL_HISTORY) { hist[b] = vec4<f32>(h.tangential, select(0.0, 1.0, h.sliding)); b += 1u; }
-    if (HAS_ROLLING_HISTORY) { hist[b] = vec4<f32>(h.rolling, 0.0); b += 1u; }
-    if (COHESION_LAW == COHESION_CAPILLARY) { hist[b] = vec4<f32>(h.bridge, 0.0, 0.0, 0.0); }
+    let blocks = blocks_of_history(h);
+    for (var b = 0u; b < params.hist_blocks; b++) { hist[k * params.hist_blocks + b] = blocks[b]; }
 }
 
 @compute @workgroup_size(64)
@@ -66,9 +62,19 @@ fn pair_force(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
             n = d * (1.0 / dist);
         }
         store_history(k, open);
-        out_fi[k] = vec4<f32>(n * f_c, 0.0);
+        var f_i = n * f_c;
+        var f_j = n * (-f_c);
+        var f_n = 0.0;
+        let window = kick_window(phase.elapsed);
+        if (ends_pull(window)) {
+            let g = geometry_grain_grain(d, sqrt(dist2), pi.w, pj.w, vel[i].w, vel[j].w);
+            f_n = parted_normal_force(coeffs[material[i] * params.n_materials + material[j]], g, dot(vel[i].xyz - vel[j].xyz, g.n), window);
+            f_i += g.n * f_n;
+            f_j -= g.n * f_n;
+        }
+        out_fi[k] = vec4<f32>(f_i, f_n);
         if (PARTNER_FORCE_STORED) {
-            out_fj[k] = vec4<f32>(n * (-f_c), 0.0);
+            out_fj[k] = vec4<f32>(f_j, 0.0);
         }
         out_ti[k] = vec4<f32>(0.0);
         out_tj[k] = vec4<f32>(0.0, 0.0, 0.0, f_c);

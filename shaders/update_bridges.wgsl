@@ -27,7 +27,7 @@ fn update_bridges() {
             let v = hist[at].x;
             liquid[i] += v * 0.5;
             liquid[j] += v * 0.5;
-            hist[at] = vec4<f32>(0.0);
+            hist[at].x = 0.0;
         } else if (liquid[i] > 0.0 || liquid[j] > 0.0) {
             var a = liquid[i] * 0.5;
             var c = liquid[j] * 0.5;
@@ -38,7 +38,8 @@ fn update_bridges() {
             }
             liquid[i] -= a;
             liquid[j] -= c;
-            hist[at] = vec4<f32>(a + c, 0.0, 0.0, 0.0);
+            // (Its y may hold the normal velocity: src/gpu/layout.rs normal_slot.)
+            hist[at].x = a + c;
         }
     }
 }

@@ -39,6 +39,10 @@ pub struct Schedule {
     pub prologue: Vec<Op>,
     /// Whether a step needs valid loads before its first operation (it starts with a kick).
     pub needs_loads: bool,
+    /// Whether each evaluation's forces stand for the kicks half a step either side of it
+    /// (velocity Verlet): the contact laws then take their mean over that window of one step
+    /// ([`crate::model::window`]), whose length is the evaluation's elapsed time.
+    pub centred_kicks: bool,
     /// The first step: its first evaluation counts the springs' time from the start.
     pub first: Vec<Op>,
     /// Every later step.
@@ -76,7 +80,14 @@ impl Schedule {
         let first = with_elapsed(&step, 0.0);
         let step = with_elapsed(&step, drifts_after_last);
         let (first_sweeps, step_sweeps) = (sweeps(&first), sweeps(&step));
-        Schedule { prologue: vec![Op::RebuildIfNeeded, Op::Forces { elapsed: 0.0 }], needs_loads: matches!(step[0], Kick { .. }), first, step, first_sweeps, step_sweeps }
+        let centred_kicks = matches!(integrator, Integrator::VelocityVerlet);
+        Schedule { prologue: vec![Op::RebuildIfNeeded, Op::Forces { elapsed: 0.0 }], needs_loads: matches!(step[0], Kick { .. }), centred_kicks, first, step, first_sweeps, step_sweeps }
+    }
+
+    /// The window (s) of kicks an evaluation `elapsed` (s) after the previous one stands for
+    /// ([`Self::centred_kicks`]; 0 where the kicks are not centred on it).
+    pub fn window(&self, elapsed: f64) -> f64 {
+        if self.centred_kicks { elapsed } else { 0.0 }
     }
 
     /// The kick and drift (s) of a later step's first sweep where a run of steps may run it in

@@ -378,14 +378,15 @@ fn liquid_bridges_on_the_gpu_form_and_break_as_on_the_cpu() {
     bridges_follow_the_cpu(&common::wet_gas());
 }
 
-/// The same with rolling springs too, so that each pair holds three history blocks (tangential,
-/// rolling, bridge) and every one of them, the bridge's last, must survive the rebuilds (the
-/// replaced list's blocks sit in three different record buffers meanwhile).
+/// The same with rolling springs too, so that each pair holds three history blocks (tangential
+/// with the normal velocity in w, rolling, bridge) and every one of them, the bridge's last,
+/// must survive the rebuilds (the replaced list's blocks sit in three different record buffers
+/// meanwhile).
 #[test]
 fn three_history_blocks_survive_rebuilds_on_the_gpu() {
     let mut scene = common::wet_gas();
     scene.model.rolling = grains::model::RollingLaw::Sds { k_r: 50.0, gamma_r: 0.0, mu_r: 0.05 };
-    assert_eq!(scene.model.history_layout(), grains::model::HistoryLayout { tangential: true, sliding: false, rolling: true, bridge: true });
+    assert_eq!(scene.model.history_layout(), grains::model::HistoryLayout { tangential: true, normal: true, sliding: false, rolling: true, bridge: true });
     bridges_follow_the_cpu(&scene);
 }
 
@@ -430,8 +431,11 @@ fn bridges_follow_the_cpu(scene: &grains::scene::Scene) {
 #[test]
 fn the_wet_protocol_runs_on_the_gpu_as_on_the_cpu() {
     /// Wall positions after 3000 steps of servo control and capillary forces whose pow and exp
-    /// differ by ulps between the backends, over the mean diameter.
-    const WET_WALL_TOLERANCE: f64 = 1e-4;
+    /// differ by ulps between the backends, over the mean diameter. The difference grows as a
+    /// packing's chaos does, fastest in the last stage of the loose preparation: from 1.8e-6 to
+    /// 9.2e-5 before the damped forces were taken over their windows (whose start and end tests
+    /// are switches too), from 5.8e-5 to 1.0e-4 after, on lavapipe.
+    const WET_WALL_TOLERANCE: f64 = 2e-4;
     for name in ["wet_iso_100pa.toml", "wet_iso_100pa_wetted_loose.toml"] {
         let scene = common::parse(&common::edit(
             &std::fs::read_to_string(common::scene_path(name)).unwrap(),

@@ -179,6 +179,10 @@ fn rust_mirrors_match_the_wgsl_structures() {
     assert_eq!(constant("STAT_ROW") as usize, layout::STAT_ROW);
     assert_eq!(constant("RATTLER_CONTACTS") as u64, grains::engine::RATTLER_CONTACTS);
     assert_eq!(constant("SCAN_BLOCK") as u64, layout::SCAN_BLOCK);
+    use layout::normal_slot;
+    for (name, slot) in [("NORMAL_SLOT_NONE", normal_slot::NONE), ("NORMAL_SLOT_TANGENTIAL_W", normal_slot::TANGENTIAL_W), ("NORMAL_SLOT_ROLLING_W", normal_slot::ROLLING_W), ("NORMAL_SLOT_BRIDGE_Y", normal_slot::BRIDGE_Y), ("NORMAL_SLOT_OWN", normal_slot::OWN)] {
+        assert_eq!(constant(name), slot, "{name}");
+    }
     for (name, kind) in [("WALL_PLANE", layout::wall_kind::PLANE), ("WALL_CYLINDER", layout::wall_kind::CYLINDER), ("WALL_PISTON", layout::wall_kind::PISTON)] {
         assert_eq!(constant(name), kind, "{name}");
     }

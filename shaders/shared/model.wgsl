@@ -31,6 +31,12 @@ override HAS_TANGENTIAL_HISTORY: bool = false;
 override HAS_ROLLING_HISTORY: bool = false;
 // The no-pull clamp (src/model/mod.rs ContactModel::limit_damping).
 override LIMIT_DAMPING: bool = true;
+// Where damped laws keep the normal velocity of the previous evaluation (src/model/mod.rs
+// HistoryLayout::normal) in a contact's history blocks: NORMAL_SLOT_*.
+override NORMAL_SLOT: u32 = NORMAL_SLOT_NONE;
+// Each evaluation's forces stand for the kicks half a step either side of it (velocity
+// Verlet; src/schedule.rs Schedule::centred_kicks): the window the normal force is a mean over.
+override CENTRED_KICKS: bool = false;
 
 struct Geometry {
     n: vec3<f32>,
@@ -76,6 +82,7 @@ const CLAMPED_FLAG: u32 = 4u;
 
 struct History {
     tangential: vec3<f32>,
+    v_n: f32,             // driven normal velocity at the previous evaluation (m/s)
     sliding: bool,
     rolling: vec3<f32>,
     bridge: f32,          // liquid bridge volume (m^3)
@@ -85,10 +92,66 @@ struct History {
 fn empty_history() -> History {
     var h: History;
     h.tangential = vec3<f32>(0.0);
+    h.v_n = 0.0;
     h.sliding = false;
     h.rolling = vec3<f32>(0.0);
     h.bridge = 0.0;
     return h;
+}
+
+// History blocks a contact keeps at most (src/gpu/layout.rs history_blocks).
+const MAX_HISTORY_BLOCKS: u32 = 3u;
+
+// A contact's history from its params.hist_blocks blocks: the tangential spring with the
+// sliding flag in w, the rolling spring, the bridge volume in x, and the normal velocity where
+// NORMAL_SLOT puts it (src/gpu/layout.rs history_blocks).
+fn history_of_blocks(blocks: array<vec4<f32>, MAX_HISTORY_BLOCKS>) -> History {
+    var at = blocks;
+    var h = empty_history();
+    var b = 0u;
+    if (HAS_TANGENTIAL_HISTORY) {
+        h.tangential = at[b].xyz;
+        if (NORMAL_SLOT == NORMAL_SLOT_TANGENTIAL_W) { h.v_n = at[b].w; } else { h.sliding = at[b].w != 0.0; }
+        b += 1u;
+    }
+    if (HAS_ROLLING_HISTORY) {
+        h.rolling = at[b].xyz;
+        if (NORMAL_SLOT == NORMAL_SLOT_ROLLING_W) { h.v_n = at[b].w; }
+        b += 1u;
+    }
+    if (COHESION_LAW == COHESION_CAPILLARY) {
+        h.bridge = at[b].x;
+        if (NORMAL_SLOT == NORMAL_SLOT_BRIDGE_Y) { h.v_n = at[b].y; }
+        b += 1u;
+    }
+    if (NORMAL_SLOT == NORMAL_SLOT_OWN) { h.v_n = at[b].x; }
+    return h;
+}
+
+// history_of_blocks undone.
+fn blocks_of_history(h: History) -> array<vec4<f32>, MAX_HISTORY_BLOCKS> {
+    var out: array<vec4<f32>, MAX_HISTORY_BLOCKS>;
+    var b = 0u;
+    if (HAS_TANGENTIAL_HISTORY) {
+        var w = select(0.0, 1.0, h.sliding);
+        if (NORMAL_SLOT == NORMAL_SLOT_TANGENTIAL_W) { w = h.v_n; }
+        out[b] = vec4<f32>(h.tangential, w);
+        b += 1u;
+    }
+    if (HAS_ROLLING_HISTORY) {
+        var w = 0.0;
+        if (NORMAL_SLOT == NORMAL_SLOT_ROLLING_W) { w = h.v_n; }
+        out[b] = vec4<f32>(h.rolling, w);
+        b += 1u;
+    }
+    if (COHESION_LAW == COHESION_CAPILLARY) {
+        var y = 0.0;
+        if (NORMAL_SLOT == NORMAL_SLOT_BRIDGE_Y) { y = h.v_n; }
+        out[b] = vec4<f32>(h.bridge, y, 0.0, 0.0);
+        b += 1u;
+    }
+    if (NORMAL_SLOT == NORMAL_SLOT_OWN) { out[b] = vec4<f32>(h.v_n, 0.0, 0.0, 0.0); }
+    return out;
 }
 
 // What update_bridges does at a pair (find_bridge_events marks it): its bridge ruptures, or
@@ -184,6 +247,79 @@ fn normal_damping(c: PairCoeffs, g: Geometry) -> f32 {
     return 0.0;
 }
 
+// The window (s) of kicks an evaluation `elapsed` (s) after the previous one stands for.
+fn kick_window(elapsed: f32) -> f32 {
+    return select(0.0, elapsed, CENTRED_KICKS);
+}
+
+// Exponents (p, q) of the overlap in F_el ~ h^p and eta ~ h^q (src/model/window.rs).
+fn overlap_exponents() -> vec2<f32> {
+    var p = 1.5;
+    if (NORMAL_LAW == NORMAL_LINEAR) { p = 1.0; }
+    var q = 0.0;
+    if (DAMPING_LAW == DAMPING_PAPERS) { q = 0.5; }
+    if (DAMPING_LAW == DAMPING_RESTITUTION && NORMAL_LAW == NORMAL_HERTZ) { q = 0.25; }
+    return vec2<f32>(p, q);
+}
+
+// The mean over a window of `window` (s) of the normal force of a contact lasting `span` (s)
+// of it, its overlap falling linearly to zero from h_far (m), dashpot velocity u (m/s).
+fn mean_over(c: PairCoeffs, g: Geometry, h_far: f32, span: f32, u: f32, window: f32) -> f32 {
+    var far = g;
+    far.h = h_far;
+    let f_el = normal_elastic(c, far).x;
+    let eta = normal_damping(c, far);
+    let pq = overlap_exponents();
+    return span / window * (f_el / (pq.x + 1.0) - eta * u / (pq.y + 1.0));
+}
+
+// The normal force (N) of a touching contact over the window centred on this evaluation,
+// before the clamp (src/model/window.rs windowed_normal_force): dv is the change of the
+// driven normal velocity since the previous evaluation.
+fn windowed_normal_force(c: PairCoeffs, g: Geometry, f_el: f32, eta: f32, v_n: f32, dv: f32, window: f32) -> f32 {
+    if (DAMPING_LAW == DAMPING_NONE || window == 0.0) {
+        return f_el - eta * v_n;
+    }
+    let half = 0.5 * window;
+    let approach = -v_n;
+    if (approach * window > g.h) {
+        let span = g.h / approach + half;
+        return mean_over(c, g, approach * span, span, v_n, window);
+    }
+    let u = v_n + 0.5 * dv;
+    let w = v_n + dv;
+    if (w * half > g.h) {
+        let span = g.h / w + half;
+        return mean_over(c, g, w * span, span, u, window);
+    }
+    return f_el - eta * u;
+}
+
+// The normal velocity the contact forces drive (src/model/window.rs driven_normal_velocity).
+fn driven_normal_velocity(k: Kinematics, n: vec3<f32>, j_is_wall: bool) -> f32 {
+    if (j_is_wall) {
+        return dot(k.v_i, n);
+    }
+    return dot(k.v_i - k.v_j, n);
+}
+
+// Whether a contact that has parted can still pull within the window (src/cpu/pair_force.rs
+// ForceContext::ends_pull).
+fn ends_pull(window: f32) -> bool {
+    return !LIMIT_DAMPING && DAMPING_LAW != DAMPING_NONE && window > 0.0;
+}
+
+// The normal force (N) of a contact without the clamp on the evaluation after it parted, g.h
+// <= 0 (src/model/window.rs parted_normal_force).
+fn parted_normal_force(c: PairCoeffs, g: Geometry, v_n: f32, window: f32) -> f32 {
+    let half = 0.5 * window;
+    if (!ends_pull(window) || !(v_n * half > -g.h)) {
+        return 0.0;
+    }
+    let span = g.h / v_n + half;
+    return mean_over(c, g, v_n * span, span, v_n, window);
+}
+
 fn rotate_into_plane(s: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let len2 = dot(s, s);
     if (len2 == 0.0) {
@@ -256,7 +392,9 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
     let v_n = dot(k.v_i - k.v_j, g.n);
     let el = normal_elastic(c, g);
     let eta_n = normal_damping(c, g);
-    let f_total = el.x - eta_n * v_n;
+    let driven = driven_normal_velocity(k, g.n, b.j_is_wall);
+    let f_total = windowed_normal_force(c, g, el.x, eta_n, v_n, driven - (*hist).v_n, kick_window(elapsed_step));
+    (*hist).v_n = driven;
     out.clamped = LIMIT_DAMPING && f_total < 0.0;
     var f_signed = f_total;
     if (out.clamped) {

@@ -59,6 +59,13 @@ const WALL_PLANE: u32 = 0u;
 const WALL_CYLINDER: u32 = 1u;
 const WALL_PISTON: u32 = 2u;
 
+// Where a contact's normal velocity sits in its history blocks (src/gpu/layout.rs normal_slot).
+const NORMAL_SLOT_NONE: u32 = 0u;
+const NORMAL_SLOT_TANGENTIAL_W: u32 = 1u;
+const NORMAL_SLOT_ROLLING_W: u32 = 2u;
+const NORMAL_SLOT_BRIDGE_Y: u32 = 3u;
+const NORMAL_SLOT_OWN: u32 = 4u;
+
 // Sum of two per-wall rows: xyz as f32; w a u32 count (its bits; 0 in the stiffness rows).
 fn add_wall_row(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(a.xyz + b.xyz, bitcast<f32>(bitcast<u32>(a.w) + bitcast<u32>(b.w)));

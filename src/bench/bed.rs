@@ -20,8 +20,9 @@ const BED_PATH: &str = "scenes/bench_bed.toml";
 /// The revision of the pour's physics, part of the cache file's name with the scene's text, so
 /// that a bed poured under an older contact law is poured again rather than read: raised
 /// whenever a change moves the pour (2: the restitution dashpot sized for the clamped law, and
-/// springs counted from the instant of touch).
-const POUR_REVISION: u32 = 2;
+/// springs counted from the instant of touch; 3: the damped normal force taken over each
+/// evaluation's window).
+const POUR_REVISION: u32 = 3;
 
 /// What the cache file's header records about the pour.
 #[derive(Clone, Debug, Serialize, Deserialize)]

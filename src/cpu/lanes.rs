@@ -16,7 +16,7 @@
 use super::pair_force::ForceContext;
 use super::pairs::PairList;
 use super::state::{Body, Props};
-use crate::model::{contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, Regime, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+use crate::model::{at_edge, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, Regime, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw, KickWindow};
 use crate::position::{complete, residual_at};
 use crate::real::{Real, Vec3};
 
@@ -92,6 +92,8 @@ struct Inputs<T> {
     mu_s: [T; LANES],
     beta: [T; LANES],
     xi: V3s<T>,
+    /// Normal velocity at the previous evaluation (m/s).
+    v_n: [T; LANES],
     /// Bridge volume (m^3), zero without cohesion.
     v_b: [T; LANES],
 }
@@ -106,7 +108,10 @@ struct Outputs<T> {
     f_n: [T; LANES],
     f_c: [T; LANES],
     xi: V3s<T>,
+    v_n: [T; LANES],
     clamped: [bool; LANES],
+    /// The contact starts or ends inside the window ([`at_edge`]).
+    edge: [bool; LANES],
     sliding: [bool; LANES],
 }
 
@@ -167,8 +172,46 @@ impl<T: Real> Inputs<T> {
             mu_s: [T::ZERO; LANES],
             beta: [T::ZERO; LANES],
             xi: V3s::ZERO,
+            v_n: [T::ZERO; LANES],
             v_b: [T::ZERO; LANES],
         }
+    }
+}
+
+impl<T: Real> Inputs<T> {
+    /// Lane `l`'s contact: its geometry, kinematics, coefficients and history.
+    #[inline(always)]
+    fn lane(&self, l: usize) -> (Geometry<T>, Kinematics<T>, PairCoeffs<T>, History<T>) {
+        let d = self.d.get(l);
+        let geo = Geometry::grain_grain(d, d.norm2().sqrt(), self.r_i[l], self.r_j[l], self.m_i[l], self.m_j[l]);
+        let kin = Kinematics { v_i: self.v_i.get(l), v_j: self.v_j.get(l), w_i: self.w_i.get(l), w_j: self.w_j.get(l) };
+        let c = PairCoeffs { v_eff: self.v_eff[l], g_eff: self.g_eff[l], mu_s: self.mu_s[l], beta: self.beta[l], ..Default::default() };
+        (geo, kin, c, History { tangential: self.xi.get(l), v_n: self.v_n[l], ..Default::default() })
+    }
+}
+
+impl<T: Real> Outputs<T> {
+    /// Lane `l`'s results: the contact force `f` and history `h` of the contact of geometry
+    /// `geo`, with a touching bridge's pull f0 = -kappa sqrt(R_i R_j) added after the contact
+    /// force as `contact_force` adds it, where bridges pull (`kappa`, N/m).
+    #[inline(always)]
+    fn set(&mut self, l: usize, f: &mut ContactForce<T>, h: &History<T>, geo: &Geometry<T>, kappa: Option<T>, inp: &Inputs<T>) {
+        if let Some(kappa) = kappa {
+            let f_c = if inp.v_b[l] > T::ZERO { -kappa * (inp.r_i[l] * inp.r_j[l]).sqrt() } else { T::ZERO };
+            f.f_c = f_c;
+            f.f_i += geo.n * f_c;
+            f.f_j -= geo.n * f_c;
+        }
+        self.f_i.set(l, f.f_i);
+        self.f_j.set(l, f.f_j);
+        self.t_i.set(l, f.t_i);
+        self.t_j.set(l, f.t_j);
+        self.f_n[l] = f.f_n;
+        self.f_c[l] = f.f_c;
+        self.clamped[l] = f.clamped;
+        self.sliding[l] = f.regime == Regime::Sliding;
+        self.xi.set(l, h.tangential);
+        self.v_n[l] = h.v_n;
     }
 }
 
@@ -200,24 +243,26 @@ impl<T: Copy + Default> PairSink<T> for [ContactForce<T>] {
 }
 
 /// The pair pass for pairs `first..first + n` under `model` (from [`hertz_mindlin`]), handed to
-/// `sink`; `hist` holds their tangential springs (three reals per pair) and, in capillary
-/// scenes, their bridge volumes (a fourth).
+/// `sink`; `hist` holds their tangential springs (three reals per pair), their normal
+/// velocities at the previous evaluation (a fourth) and, in capillary scenes, their bridge
+/// volumes (a fifth).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub fn hertz_mindlin_block<T: Real, S: PairSink<T> + ?Sized>(model: &ContactModel<T>, scratch: &mut Scratch<T>, first: usize, n: usize, sink: &mut S, hist: &mut [T], pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>) {
-    debug_assert!(ctx.slots.tangential == 0 && (!ctx.slots.layout.bridge || ctx.slots.bridge == 3), "the spring first, the bridge after it");
+    debug_assert!(ctx.slots.tangential == 0 && ctx.slots.normal == 3 && (!ctx.slots.layout.bridge || ctx.slots.bridge == 4), "the spring first, the normal velocity, the bridge after them");
     match ctx.model.cohesion {
-        CohesionLaw::Capillary { kappa, .. } => lanes::<T, S, 4>(model, scratch, Some(kappa), first, n, sink, hist, pairs, body, prop, ctx),
-        CohesionLaw::None => lanes::<T, S, 3>(model, scratch, None, first, n, sink, hist, pairs, body, prop, ctx),
+        CohesionLaw::Capillary { kappa, .. } => lanes::<T, S, 5>(model, scratch, Some(kappa), first, n, sink, hist, pairs, body, prop, ctx),
+        CohesionLaw::None => lanes::<T, S, 4>(model, scratch, None, first, n, sink, hist, pairs, body, prop, ctx),
     }
 }
 
 /// [`hertz_mindlin_block`] with `STRIDE` reals of history per pair (the bridge volume last
-/// when 4) and `kappa` (N/m) when bridges pull. Each window of pairs is first tested for
+/// when 5) and `kappa` (N/m) when bridges pull. Each window of pairs is first tested for
 /// touch, with no branch: the positions' scattered reads and the radii, then the fold and the
-/// test in vector lanes over the window. The open pairs are done at once: dry, a zero force
-/// and forgotten springs; wet, `pair_force`'s short way (springs forgotten, a bridge's pull
-/// across the gap). Only the touching ones, packed, load the rest of their grains and fill the
+/// test in vector lanes over the window. The open pairs are done at once: dry and clamped, a
+/// zero force and forgotten springs; wet, or where a parted contact may still pull
+/// ([`ForceContext::ends_pull`]), `pair_force`'s short way (springs forgotten, a bridge's pull
+/// across the gap, a contact's end). Only the touching ones, packed, load the rest of their grains and fill the
 /// lanes (a third of a dense packing's listed pairs are open, most of a capillary scene's).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
@@ -230,7 +275,7 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
         let c = &ctx.coeffs[0];
         (inp.v_eff, inp.g_eff, inp.mu_s, inp.beta) = ([c.v_eff; LANES], [c.g_eff; LANES], [c.mu_s; LANES], [c.beta; LANES]);
     }
-    let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], f_c: [T::ZERO; LANES], clamped: [false; LANES], sliding: [false; LANES], xi: V3s::ZERO };
+    let mut res = Outputs { f_i: V3s::ZERO, f_j: V3s::ZERO, t_i: V3s::ZERO, t_j: V3s::ZERO, f_n: [T::ZERO; LANES], f_c: [T::ZERO; LANES], clamped: [false; LANES], edge: [false; LANES], sliding: [false; LANES], xi: V3s::ZERO, v_n: [T::ZERO; LANES] };
     for (w, hist) in hist[..STRIDE * n].chunks_mut(STRIDE * WINDOW).enumerate() {
         let (base, len) = (first + w * WINDOW, hist.len() / STRIDE);
         window_owners(pairs, base, &mut win.owner[..len]);
@@ -269,18 +314,14 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
             n_touching += t as usize;
             n_open += !t as usize;
         }
+        let open_way = kappa.is_some() || ctx.ends_pull();
         for &m in &open[..n_open] {
             let m = m as usize;
-            match kappa {
-                Some(_) => {
-                    let i = win.owner[m] as usize;
-                    sink.put(w * WINDOW + m, i, &super::pair_force::pair_force(i, base + m, pairs, body, prop, ctx, &mut hist[STRIDE * m..STRIDE * (m + 1)]));
-                }
-                None => {
-                    if sink.skip(w * WINDOW + m) {
-                        hist[STRIDE * m..STRIDE * m + 3].fill(T::ZERO);
-                    }
-                }
+            if open_way {
+                let i = win.owner[m] as usize;
+                sink.put(w * WINDOW + m, i, &super::pair_force::pair_force(i, base + m, pairs, body, prop, ctx, &mut hist[STRIDE * m..STRIDE * (m + 1)]));
+            } else if sink.skip(w * WINDOW + m) {
+                hist[STRIDE * m..STRIDE * m + 4].fill(T::ZERO);
             }
         }
         for group in touching[..n_touching].chunks(LANES) {
@@ -302,41 +343,32 @@ fn lanes<T: Real, S: PairSink<T> + ?Sized, const STRIDE: usize>(model: &ContactM
                 }
                 let h = &hist[STRIDE * m..STRIDE * (m + 1)];
                 inp.xi.set(l, Vec3::new(h[0], h[1], h[2]));
-                inp.v_b[l] = if STRIDE == 4 { h[STRIDE - 1] } else { T::ZERO };
+                inp.v_n[l] = h[3];
+                inp.v_b[l] = if STRIDE == 5 { h[STRIDE - 1] } else { T::ZERO };
             }
             // Compute: every lane, with no branch the compiler cannot turn into a select
-            // (lanes past the end of a short group recompute stale inputs, unstored).
+            // (lanes past the end of a short group recompute stale inputs, unstored), the
+            // window's edges left out: each lane notes whether its contact starts or ends in
+            // the window, and those few are done again one at a time with them.
             for l in 0..LANES {
-                let d = inp.d.get(l);
-                let geo = Geometry::grain_grain(d, d.norm2().sqrt(), inp.r_i[l], inp.r_j[l], inp.m_i[l], inp.m_j[l]);
-                let kin = Kinematics { v_i: inp.v_i.get(l), v_j: inp.v_j.get(l), w_i: inp.w_i.get(l), w_j: inp.w_j.get(l) };
-                let c = PairCoeffs { v_eff: inp.v_eff[l], g_eff: inp.g_eff[l], mu_s: inp.mu_s[l], beta: inp.beta[l], ..Default::default() };
-                let mut h = History { tangential: inp.xi.get(l), ..Default::default() };
-                let mut f = contact_force(model, &c, &geo, &kin, &Bodies::default(), &mut h, ctx.elapsed);
-                // A touching bridge pulls with f0 = -kappa sqrt(R_i R_j), added after the
-                // contact force as `contact_force` adds it.
-                if let Some(kappa) = kappa {
-                    let f_c = if inp.v_b[l] > T::ZERO { -kappa * (inp.r_i[l] * inp.r_j[l]).sqrt() } else { T::ZERO };
-                    f.f_c = f_c;
-                    f.f_i += geo.n * f_c;
-                    f.f_j -= geo.n * f_c;
+                let (geo, kin, c, mut h) = inp.lane(l);
+                let mut f = contact_force(model, &c, &geo, &kin, &Bodies::default(), &mut h, ctx.elapsed, KickWindow { span: ctx.window, edges: false });
+                res.edge[l] = at_edge(model, geo.h, (kin.v_i - kin.v_j).dot(geo.n), h.v_n - inp.v_n[l], ctx.window);
+                res.set(l, &mut f, &h, &geo, kappa, &inp);
+            }
+            for l in 0..group.len() {
+                if res.edge[l] {
+                    let (geo, kin, c, mut h) = inp.lane(l);
+                    let mut f = contact_force(model, &c, &geo, &kin, &Bodies::default(), &mut h, ctx.elapsed, KickWindow::centred(ctx.window));
+                    res.set(l, &mut f, &h, &geo, kappa, &inp);
                 }
-                res.f_i.set(l, f.f_i);
-                res.f_j.set(l, f.f_j);
-                res.t_i.set(l, f.t_i);
-                res.t_j.set(l, f.t_j);
-                res.f_n[l] = f.f_n;
-                res.f_c[l] = f.f_c;
-                res.clamped[l] = f.clamped;
-                res.sliding[l] = f.regime == Regime::Sliding;
-                res.xi.set(l, h.tangential);
             }
             // Store.
             for (l, &m) in group.iter().enumerate() {
                 let m = m as usize;
                 sink.put(w * WINDOW + m, win.owner[m] as usize, &ContactForce { f_i: res.f_i.get(l), f_j: res.f_j.get(l), t_i: res.t_i.get(l), t_j: res.t_j.get(l), f_n: res.f_n[l], f_c: res.f_c[l], clamped: res.clamped[l], regime: if res.sliding[l] { Regime::Sliding } else { Regime::Static } });
                 let xi = res.xi.get(l);
-                hist[STRIDE * m..STRIDE * m + 3].copy_from_slice(&[xi.x, xi.y, xi.z]);
+                hist[STRIDE * m..STRIDE * m + 4].copy_from_slice(&[xi.x, xi.y, xi.z, res.v_n[l]]);
             }
         }
     }
@@ -427,7 +459,7 @@ duration = 1.0e-3
         }
         e.advance(400).unwrap();
         let model = hertz_mindlin(&e.model).expect("the scene's model is Hertz-Mindlin");
-        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), periodic: e.periodic, residual: &e.residual, material: &e.material };
+        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), window: T::of(1.0e-7), periodic: e.periodic, residual: &e.residual, material: &e.material };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let (mut hist_one, mut hist_lanes) = (e.hist.clone(), e.hist.clone());
         let one: Vec<ContactForce<T>> = e.pairs.owners_of(0..n).enumerate().map(|(k, i)| pair_force(i, k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[stride * k..stride * (k + 1)])).collect();
@@ -470,7 +502,7 @@ duration = 1.0e-3
         let mut e = CpuEngine::<T>::new(&scene).unwrap();
         e.advance(400).unwrap();
         let elapsed = T::of(1.0e-7);
-        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed, periodic: e.periodic, residual: &e.residual, material: &e.material };
+        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed, window: elapsed, periodic: e.periodic, residual: &e.residual, material: &e.material };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let mut hist = e.hist.clone();
         let one: Vec<ContactForce<T>> = e.pairs.owners_of(0..n).enumerate().map(|(k, i)| pair_force(i, k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist[stride * k..stride * (k + 1)])).collect();

@@ -44,7 +44,7 @@ pub use wall_contacts::{wall_contact_records, WallState};
 
 use crate::engine::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
-use crate::model::{capillary_potential, normal_potential, share_liquid, within_rupture, CohesionLaw, ContactModel, PairCoeffs, Regime};
+use crate::model::{capillary_potential, normal_potential, share_liquid, within_rupture, CohesionLaw, ContactModel, PairCoeffs};
 use crate::periodic::Periodic;
 use crate::position;
 use crate::real::{Real, Vec3};
@@ -500,6 +500,7 @@ impl<T: Real> CpuEngine<T> {
             n_materials: self.n_materials,
             slots: self.slots,
             elapsed,
+            window: T::of(self.schedule.window(elapsed.f64())),
             periodic: self.periodic,
             residual: &[],
             material: &self.material,
@@ -845,7 +846,7 @@ impl<T: Real> WallRow<T> {
     const ZERO: Self = WallRow { reaction: Vec3::ZERO, count: 0, response: (T::ZERO, T::ZERO) };
 
     fn of(t: &WallTouch<T>) -> Self {
-        WallRow { reaction: -t.force, count: 1, response: (t.stiffness, t.damping) }
+        WallRow { reaction: -t.force, count: t.touching as u64, response: (t.stiffness, t.damping) }
     }
 
     fn add(self, o: Self) -> Self {
@@ -860,7 +861,7 @@ impl<T: Real> WallSums<T> {
     fn of(n_walls: usize, n_grains: usize, touches: &[WallTouch<T>]) -> Self {
         let totals = if T::GPU_TWIN { WallRow::in_gpu_order(n_walls, n_grains, touches) } else { WallRow::in_chunks(n_walls, touches) };
         let mut regimes = RegimeCounts::default();
-        for t in touches {
+        for t in touches.iter().filter(|t| t.touching) {
             regimes.count(t.regime);
         }
         WallSums { reaction: totals.iter().map(|r| r.reaction).collect(), count: totals.iter().map(|r| r.count).collect(), response: totals.iter().map(|r| r.response).collect(), regimes }
@@ -908,7 +909,7 @@ impl<T: Real> WallRow<T> {
             }
             let p = &mut part[t.wall as usize];
             p.reaction -= t.force;
-            p.count += 1;
+            p.count += t.touching as u64;
             p.response = (p.response.0 + t.stiffness, p.response.1 + t.damping);
         }
         absorb(&mut total, &mut part);

@@ -13,7 +13,7 @@
 use super::pairs::PairList;
 use super::state::{Body, HistorySlots, Load, PairFlags, Props};
 use super::lanes::PairSink;
-use crate::model::{capillary_force, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, Geometry, Kinematics, PairCoeffs};
+use crate::model::{capillary_force, contact_force, parted_normal_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, KickWindow, Kinematics, PairCoeffs};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 
@@ -30,6 +30,9 @@ pub struct ForceContext<'a, T> {
     pub slots: HistorySlots,
     /// Time since the previous force evaluation (s).
     pub elapsed: T,
+    /// The span of kicks (s) the evaluation's forces stand for, centred on it: the step
+    /// under velocity Verlet, 0 otherwise ([`crate::model::window`]).
+    pub window: T,
     /// Wrapping axes.
     pub periodic: Periodic<T>,
     /// The positions' residuals by slot ([`crate::position`]; empty in f64).
@@ -57,6 +60,13 @@ impl<'a, T: Real> ForceContext<'a, T> {
         coeffs_of(self.coeffs, self.n_materials, wall as usize, grain)
     }
 
+    /// Whether a contact that has parted can still pull ([`parted_normal_force`]): a damped
+    /// law without the no-pull clamp, inside a window.
+    #[inline(always)]
+    pub fn ends_pull(&self) -> bool {
+        !self.model.limit_damping && !matches!(self.model.damping, DampingLaw::None) && self.window > T::ZERO
+    }
+
     /// The separation `r_i - r_j` of slots `i` and `j` (m, minimum image, residuals included).
     #[inline(always)]
     pub fn separation(&self, body: &[Body<T>], i: usize, j: usize) -> Vec3<T> {
@@ -73,7 +83,7 @@ pub fn coeffs_of<T>(coeffs: &[PairCoeffs<T>], n_materials: usize, a: usize, b: u
 
 /// `pair_force` for pair `k`, owned by grain `i`. A listed pair that does not touch forgets
 /// its springs and exerts only the capillary force of its liquid bridge, if it has one within
-/// reach.
+/// reach, and the end of a contact that parted within the window ([`parted_normal_force`]).
 #[inline(always)]
 pub fn pair_force<T: Real>(i: usize, k: usize, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, hist: &mut [T]) -> ContactForce<T> {
     let j = pairs.partner[k] as usize;
@@ -83,7 +93,7 @@ pub fn pair_force<T: Real>(i: usize, k: usize, pairs: &PairList, body: &[Body<T>
     let reach = pi.radius + pj.radius;
     if dist2 >= reach * reach {
         ctx.slots.clear_springs(hist);
-        return match ctx.model.cohesion {
+        let mut f = match ctx.model.cohesion {
             CohesionLaw::Capillary { kappa, theta, c } if ctx.slots.layout.bridge && hist[ctx.slots.bridge] > T::ZERO => {
                 let dist = dist2.sqrt();
                 let f_c = capillary_force(kappa, theta, c, pi.radius, pj.radius, hist[ctx.slots.bridge], dist - reach);
@@ -92,13 +102,21 @@ pub fn pair_force<T: Real>(i: usize, k: usize, pairs: &PairList, body: &[Body<T>
             }
             _ => ContactForce::default(),
         };
+        if ctx.ends_pull() {
+            let geo = Geometry::grain_grain(d, dist2.sqrt(), pi.radius, pj.radius, pi.mass, pj.mass);
+            let f_n = parted_normal_force(ctx.model, ctx.pair_coeffs(i, j), &geo, (bi.vel - bj.vel).dot(geo.n), ctx.window);
+            f.f_n = f_n;
+            f.f_i += geo.n * f_n;
+            f.f_j -= geo.n * f_n;
+        }
+        return f;
     }
     let geo = Geometry::grain_grain(d, dist2.sqrt(), pi.radius, pj.radius, pi.mass, pj.mass);
     let kin = Kinematics { v_i: bi.vel, v_j: bj.vel, w_i: bi.omega, w_j: bj.omega };
     let bodies = Bodies { m_i: pi.mass, inertia_i: pi.inertia, m_j: pj.mass, inertia_j: pj.inertia, j_is_wall: false };
     let c = ctx.pair_coeffs(i, j);
     let mut h = ctx.slots.load(hist);
-    let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
+    let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed, KickWindow::centred(ctx.window));
     ctx.slots.store(&h, hist);
     f
 }

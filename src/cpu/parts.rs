@@ -197,7 +197,7 @@ pub(crate) fn state_of_rows(rows: &Rows, widths: &RowWidths, template: &EngineSt
 pub(crate) fn touches_state<T: Real>(touches: &[WallTouch<T>]) -> EngineState {
     let mut s = EngineState::default();
     let v3 = |v: &Vec3<T>| [v.x.f64(), v.y.f64(), v.z.f64()];
-    s.put_ints("wall_touch_ids", touches.iter().flat_map(|t| [t.grain as u64, t.wall as u64, t.regime as u64]));
+    s.put_ints("wall_touch_ids", touches.iter().flat_map(|t| [t.grain as u64, t.wall as u64, t.code() as u64]));
     s.put_reals("wall_touches", touches.iter().flat_map(|t| [v3(&t.force).as_slice(), &[t.stiffness.f64(), t.damping.f64()]].concat()));
     s
 }
@@ -205,16 +205,17 @@ pub(crate) fn touches_state<T: Real>(touches: &[WallTouch<T>]) -> EngineState {
 /// Values of a wall contact in [`touch_row`].
 pub(crate) const TOUCH_ROW: usize = 8;
 
-/// A wall contact as `[grain, wall, regime, force x, y, z, stiffness, damping]`, with the grain
-/// given by `id`.
+/// A wall contact as `[grain, wall, code, force x, y, z, stiffness, damping]`, with the grain
+/// given by `id` ([`WallTouch::code`]).
 pub(crate) fn touch_row<T: Real>(t: &WallTouch<T>, id: u32) -> [f64; TOUCH_ROW] {
     let f = t.force.f64();
-    [id as f64, t.wall as f64, t.regime as u8 as f64, f[0], f[1], f[2], t.stiffness.f64(), t.damping.f64()]
+    [id as f64, t.wall as f64, t.code() as f64, f[0], f[1], f[2], t.stiffness.f64(), t.damping.f64()]
 }
 
 /// [`touch_row`] undone.
 pub(crate) fn touch_of_row<T: Real>(r: &[f64]) -> WallTouch<T> {
-    WallTouch { grain: r[0] as u32, wall: r[1] as u32, regime: Regime::from_code(r[2] as u8), force: Vec3::new(T::of(r[3]), T::of(r[4]), T::of(r[5])), stiffness: T::of(r[6]), damping: T::of(r[7]) }
+    let (regime, touching) = WallTouch::<T>::of_code(r[2] as u8);
+    WallTouch { grain: r[0] as u32, wall: r[1] as u32, regime, touching, force: Vec3::new(T::of(r[3]), T::of(r[4]), T::of(r[5])), stiffness: T::of(r[6]), damping: T::of(r[7]) }
 }
 
 impl<T: Real> CpuEngine<T> {

@@ -41,7 +41,7 @@ impl<T: Real> CpuEngine<T> {
                     .collect()
             }),
             wall_contacts: contacts.then(|| {
-                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, periodic: self.periodic, residual: &self.residual, material: &self.material };
+                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, window: T::ZERO, periodic: self.periodic, residual: &self.residual, material: &self.material };
                 wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_springs.dense(self.body.len(), self.walls.len() * self.slots.stride))
             }),
             walls: self.walls.iter().map(|w| w.geom.f64()).collect(),
@@ -56,7 +56,7 @@ impl<T: Real> CpuEngine<T> {
         s.put_ints("id", self.id.iter().map(|&x| x as u64));
         s.put_reals("body", self.body.iter().flat_map(|b| [v3(&b.pos), v3(&b.vel), v3(&b.omega)].concat()));
         s.put_reals("load", self.load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
-        s.put_ints("wall_touch_ids", self.wall_touches.iter().flat_map(|t| [t.grain as u64, t.wall as u64, t.regime as u64]));
+        s.put_ints("wall_touch_ids", self.wall_touches.iter().flat_map(|t| [t.grain as u64, t.wall as u64, t.code() as u64]));
         s.put_reals("wall_touches", self.wall_touches.iter().flat_map(|t| [v3(&t.force).as_slice(), &[t.stiffness.f64(), t.damping.f64()]].concat()));
         if T::COMPENSATED {
             s.put_reals("residual", self.residual.iter().flat_map(v3));
@@ -132,7 +132,10 @@ impl<T: Real> CpuEngine<T> {
         self.wall_touches = ids
             .chunks_exact(3)
             .zip(values.chunks_exact(5))
-            .map(|(i, v)| WallTouch { grain: i[0] as u32, wall: i[1] as u32, regime: Regime::from_code(i[2] as u8), force: v3(&v[0..3]), stiffness: T::of(v[3]), damping: T::of(v[4]) })
+            .map(|(i, v)| {
+                let (regime, touching) = WallTouch::<T>::of_code(i[2] as u8);
+                WallTouch { grain: i[0] as u32, wall: i[1] as u32, regime, touching, force: v3(&v[0..3]), stiffness: T::of(v[3]), damping: T::of(v[4]) }
+            })
             .collect();
         // f64 keeps no residuals (and a checkpoint written before there were any still resumes).
         if T::COMPENSATED {

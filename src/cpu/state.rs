@@ -243,6 +243,8 @@ pub struct HistorySlots {
     pub layout: HistoryLayout,
     /// Offset of the tangential spring.
     pub tangential: usize,
+    /// Offset of the normal velocity.
+    pub normal: usize,
     /// Offset of the sliding flag.
     pub sliding: usize,
     /// Offset of the rolling spring.
@@ -254,22 +256,28 @@ pub struct HistorySlots {
 }
 
 impl HistorySlots {
-    /// Packs the blocks a layout uses, in slot order (tangential, sliding, rolling, bridge).
+    /// Packs the blocks a layout uses, in slot order (tangential, normal, sliding, rolling,
+    /// bridge).
     pub fn new(layout: HistoryLayout) -> Self {
         let tangential = 0;
-        let sliding = if layout.tangential { 3 } else { 0 };
+        let normal = if layout.tangential { 3 } else { 0 };
+        let sliding = normal + layout.normal as usize;
         let rolling = sliding + if layout.sliding { 1 } else { 0 };
         let bridge = rolling + if layout.rolling { 3 } else { 0 };
         let stride = layout.reals();
-        HistorySlots { layout, tangential, sliding, rolling, bridge, stride }
+        HistorySlots { layout, tangential, normal, sliding, rolling, bridge, stride }
     }
 
-    /// Forgets the springs of a contact that has opened, keeping its liquid bridge.
+    /// Forgets the springs and the normal velocity of a contact that has opened, keeping its
+    /// liquid bridge.
     #[inline(always)]
     pub fn clear_springs<T: Real>(&self, s: &mut [T]) {
         // Fixed-size stores per block: a `fill` of run-time length becomes a call to memset.
         if self.layout.tangential {
             s[self.tangential..self.tangential + 3].copy_from_slice(&[T::ZERO; 3]);
+        }
+        if self.layout.normal {
+            s[self.normal] = T::ZERO;
         }
         if self.layout.sliding {
             s[self.sliding] = T::ZERO;
@@ -285,6 +293,7 @@ impl HistorySlots {
         let v = |o: usize| Vec3::new(s[o], s[o + 1], s[o + 2]);
         History {
             tangential: if self.layout.tangential { v(self.tangential) } else { Vec3::ZERO },
+            v_n: if self.layout.normal { s[self.normal] } else { T::ZERO },
             sliding: self.layout.sliding && s[self.sliding] != T::ZERO,
             rolling: if self.layout.rolling { v(self.rolling) } else { Vec3::ZERO },
             bridge: if self.layout.bridge { s[self.bridge] } else { T::ZERO },
@@ -296,6 +305,9 @@ impl HistorySlots {
     pub fn store<T: Real>(&self, h: &History<T>, s: &mut [T]) {
         if self.layout.sliding {
             s[self.sliding] = if h.sliding { T::ONE } else { T::ZERO };
+        }
+        if self.layout.normal {
+            s[self.normal] = h.v_n;
         }
         let mut put = |o: usize, v: Vec3<T>| {
             s[o] = v.x;

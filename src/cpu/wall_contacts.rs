@@ -4,7 +4,7 @@
 use super::pair_force::ForceContext;
 use super::wall_springs::is_candidate;
 use super::state::{Body, Load, Props};
-use crate::model::{contact_force, normal_damping, normal_stiffness, Bodies, ContactForce, Geometry, Kinematics, PairCoeffs, Regime};
+use crate::model::{contact_force, normal_damping, normal_stiffness, parted_normal_force, Bodies, ContactForce, Geometry, KickWindow, Kinematics, PairCoeffs, Regime};
 use crate::engine::WallContactRecord;
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
@@ -35,6 +35,26 @@ pub struct WallTouch<T> {
     pub damping: T,
     /// Tangential regime.
     pub regime: Regime,
+    /// False for a contact that parted within the window and still pulls
+    /// ([`parted_normal_force`]): its force counts in the wall's reaction, not in its
+    /// touching grains, stiffness, damping or regimes.
+    pub touching: bool,
+}
+
+impl<T> WallTouch<T> {
+    /// The regime's code, plus [`Self::PARTED`] where the contact no longer touches: how
+    /// checkpoints and the distributed engine's rows carry both.
+    pub fn code(&self) -> u8 {
+        self.regime as u8 | if self.touching { 0 } else { Self::PARTED }
+    }
+
+    /// The regime and whether the contact touches, from [`Self::code`].
+    pub fn of_code(code: u8) -> (Regime, bool) {
+        (Regime::from_code(code & !Self::PARTED), code & Self::PARTED == 0)
+    }
+
+    /// The code's mark of a contact that no longer touches.
+    const PARTED: u8 = 8;
 }
 
 /// `wall_contacts` for the grain of permanent id `id` and material `material`. `hist` holds
@@ -59,6 +79,14 @@ pub fn wall_contacts<T: Real>(
         let (n, dist) = wall.geom.frame(b.pos, residual);
         if dist >= p.radius {
             ctx.slots.clear_springs(h_slot);
+            if ctx.ends_pull() {
+                let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
+                let f_n = parted_normal_force(ctx.model, ctx.wall_coeffs(wall.material, material), &geo, (b.vel - wall.velocity).dot(n), ctx.window);
+                if f_n != T::ZERO {
+                    load.force += n * f_n;
+                    touches.push(WallTouch { grain: id, wall: w as u32, force: n * f_n, stiffness: T::ZERO, damping: T::ZERO, regime: Regime::Static, touching: false });
+                }
+            }
             continue;
         }
         let (geo, c, f) = wall_contact(n, dist, b, p, material, wall, ctx, h_slot);
@@ -71,6 +99,7 @@ pub fn wall_contacts<T: Real>(
             stiffness: normal_stiffness(&ctx.model.normal, c, &geo),
             damping: normal_damping(&ctx.model.damping, &ctx.model.normal, c, &geo),
             regime: f.regime,
+            touching: true,
         });
     }
     load
@@ -87,7 +116,7 @@ fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, mat
     let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
     let c = ctx.wall_coeffs(wall.material, material);
     let mut h = ctx.slots.load(h_slot);
-    let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed);
+    let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed, KickWindow::centred(ctx.window));
     ctx.slots.store(&h, h_slot);
     (geo, c, f)
 }

@@ -200,7 +200,7 @@ impl GpuEngine {
         let hash_size = (n.max(64)).next_power_of_two();
         limit("scan elements (hash buckets)", hash_size, MAX_SCAN, "use fewer grains per run (the two-level scan holds 4,194,304)")?;
         let layout_of_history = scene.model.history_layout();
-        let hist_blocks = [layout_of_history.tangential, layout_of_history.rolling, layout_of_history.bridge].into_iter().filter(|&b| b).count() as u64;
+        let hist_blocks = layout::history_blocks(layout_of_history) as u64;
         let per_pair_bytes = 16 * hist_blocks.max(1);
         // Room for the first list comes once its pairs are counted (make_room_for_the_first_list).
         let pair_capacity = pairs.unwrap_or(n.max(1024)).max(1).min(binding / per_pair_bytes).min(binding / 16);
@@ -522,7 +522,9 @@ impl GpuEngine {
             ("COHESION_LAW", m.cohesion.code() as f64),
             ("HAS_TANGENTIAL_HISTORY", self.history.tangential as u8 as f64),
             ("HAS_ROLLING_HISTORY", self.history.rolling as u8 as f64),
+            ("NORMAL_SLOT", layout::normal_slot(self.history) as f64),
             ("LIMIT_DAMPING", m.limit_damping as u8 as f64),
+            ("CENTRED_KICKS", Schedule::new(scene.integrator, 1.0).centred_kicks as u8 as f64),
         ];
         let orientation = ("TRACK_ORIENTATION", self.track_orientation as u8 as f64);
         let wall_response = ("WALL_RESPONSE", self.servo.is_some() as u8 as f64);

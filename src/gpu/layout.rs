@@ -108,6 +108,45 @@ pub struct PairCoeffs {
     pub beta: f32,
 }
 
+/// The vec4 history blocks a contact keeps on the GPU, in order: the tangential spring with
+/// the sliding flag in w, the rolling spring, the bridge volume in x (last: `find_bridge_events`
+/// and `update_bridges` read it there); the normal velocity at the previous evaluation takes
+/// a spare component of one of them ([`normal_slot`]), or a block of its own where there is
+/// none. At most three, which the rebuild's scratch holds (`remap_history`).
+pub fn history_blocks(layout: crate::model::HistoryLayout) -> u32 {
+    let own = normal_slot(layout) == normal_slot::OWN;
+    [layout.tangential, layout.rolling, layout.bridge, own].into_iter().filter(|&b| b).count() as u32
+}
+
+/// Where a contact's normal velocity sits in its GPU history blocks (WGSL `NORMAL_SLOT`).
+pub fn normal_slot(layout: crate::model::HistoryLayout) -> u32 {
+    if !layout.normal {
+        normal_slot::NONE
+    } else if layout.tangential && !layout.sliding {
+        normal_slot::TANGENTIAL_W
+    } else if layout.rolling {
+        normal_slot::ROLLING_W
+    } else if layout.bridge {
+        normal_slot::BRIDGE_Y
+    } else {
+        normal_slot::OWN
+    }
+}
+
+/// The places of [`normal_slot`].
+pub mod normal_slot {
+    /// No normal velocity kept.
+    pub const NONE: u32 = 0;
+    /// The tangential block's w (free where there is no sliding flag).
+    pub const TANGENTIAL_W: u32 = 1;
+    /// The rolling block's w.
+    pub const ROLLING_W: u32 = 2;
+    /// The bridge block's y.
+    pub const BRIDGE_Y: u32 = 3;
+    /// A block of its own, x.
+    pub const OWN: u32 = 4;
+}
+
 /// Wall kinds (WGSL `WALL_*`).
 pub mod wall_kind {
     /// A plane.
@@ -404,4 +443,26 @@ pub struct CdControl {
     pub _pad2: f32,
     /// Padding.
     pub _pad3: f32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::HistoryLayout;
+
+    /// Every layout a model can ask for (the sliding flag only with both springs: seed 000's
+    /// law) fits the rebuild's three scratch buffers of history blocks (`remap_history`), and
+    /// its normal velocity has a place.
+    #[test]
+    fn every_history_fits_three_blocks() {
+        for bits in 0..32u32 {
+            let [tangential, sliding, rolling, bridge, normal] = std::array::from_fn(|k| bits >> k & 1 == 1);
+            if sliding && !(tangential && rolling) {
+                continue;
+            }
+            let layout = HistoryLayout { tangential, normal, sliding, rolling, bridge };
+            assert!(history_blocks(layout) <= 3, "{layout:?}");
+            assert_eq!(normal_slot(layout) == normal_slot::NONE, !normal, "{layout:?}");
+        }
+    }
 }

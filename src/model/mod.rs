@@ -16,6 +16,7 @@ pub mod restitution;
 mod rolling;
 mod tangential;
 mod twisting;
+pub mod window;
 
 pub use capillary::{capillary_force, capillary_potential, decay_length, rupture_distance, share_liquid, within_rupture};
 pub use geometry::{Bodies, Geometry, Kinematics};
@@ -23,6 +24,7 @@ pub use normal::{normal_damping, normal_elastic, normal_force, normal_stiffness}
 pub use rolling::rolling_sds;
 pub use tangential::{contact_tangential_velocity, mindlin_tangential, oquendo_tangential, rotate_into_plane, since_touch, TangentialOut};
 pub use twisting::twisting_torque;
+pub use window::{at_edge, driven_normal_velocity, parted_normal_force, windowed_normal_force, KickWindow};
 
 use crate::real::{Real, Vec3};
 
@@ -326,6 +328,7 @@ impl<T: Real> ContactModel<T> {
             tangential: !matches!(self.tangential, TangentialLaw::None),
             sliding: matches!(self.tangential, TangentialLaw::Oquendo(_)),
             rolling: !matches!(self.rolling, RollingLaw::None) || matches!(self.tangential, TangentialLaw::Oquendo(_)),
+            normal: !matches!(self.damping, DampingLaw::None),
             bridge: !matches!(self.cohesion, CohesionLaw::None),
         }
     }
@@ -345,6 +348,9 @@ impl<T: Real> ContactModel<T> {
 pub struct HistoryLayout {
     /// Accumulated tangential spring displacement `xi` (m).
     pub tangential: bool,
+    /// The normal velocity at the previous evaluation (m/s), one real: damped laws, whose
+    /// dashpot sees the velocity carried forward from it ([`window`]).
+    pub normal: bool,
     /// Whether the contact is sliding (one real, 0 or 1): friction with two coefficients.
     pub sliding: bool,
     /// Accumulated rolling displacement `psi` (m): the rolling law's, or seed 000's rolling
@@ -355,9 +361,10 @@ pub struct HistoryLayout {
 }
 
 impl HistoryLayout {
-    /// Reals a contact's history holds: 3 per spring, 1 for the sliding flag, 1 for a bridge.
+    /// Reals a contact's history holds: 3 per spring, 1 for the normal velocity, 1 for the
+    /// sliding flag, 1 for a bridge.
     pub fn reals(&self) -> usize {
-        3 * self.tangential as usize + self.sliding as usize + 3 * self.rolling as usize + self.bridge as usize
+        3 * self.tangential as usize + self.normal as usize + self.sliding as usize + 3 * self.rolling as usize + self.bridge as usize
     }
 }
 
@@ -366,6 +373,9 @@ impl HistoryLayout {
 pub struct History<T> {
     /// Tangential spring displacement `xi` (m).
     pub tangential: Vec3<T>,
+    /// The normal velocity the contact forces drive at the previous evaluation (m/s,
+    /// [`driven_normal_velocity`]); 0 in a new contact.
+    pub v_n: T,
     /// Sliding at the last evaluation (seed 000's regimes).
     pub sliding: bool,
     /// Rolling spring displacement `psi` (m).
@@ -509,8 +519,11 @@ impl Regime {
 ///
 /// `elapsed` is the time (s) since the previous force evaluation: the tangential and rolling
 /// springs grow by the relative velocity times `elapsed`, or, on the evaluation that finds the
-/// contact new, times the time since the surfaces met ([`since_touch`]).
+/// contact new, times the time since the surfaces met ([`since_touch`]). `window` is the span
+/// of kicks the force stands for, centred on this evaluation: the normal force is its mean
+/// over it ([`windowed_normal_force`]).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub fn contact_force<T: Real>(
     model: &ContactModel<T>,
     c: &PairCoeffs<T>,
@@ -519,12 +532,15 @@ pub fn contact_force<T: Real>(
     bodies: &Bodies<T>,
     hist: &mut History<T>,
     elapsed: T,
+    window: KickWindow<T>,
 ) -> ContactForce<T> {
     let v_rel = kin.v_i - kin.v_j;
     let v_n = v_rel.dot(geo.n);
     let (f_el, k_secant) = normal_elastic(&model.normal, c, geo);
     let eta_n = normal_damping(&model.damping, &model.normal, c, geo);
-    let (f_n, clamped) = normal_force(f_el, eta_n, v_n, model.limit_damping);
+    let driven = driven_normal_velocity(kin.v_i, kin.v_j, geo.n, bodies.j_is_wall);
+    let (f_n, clamped) = windowed_normal_force(model, c, geo, f_el, eta_n, v_n, driven - hist.v_n, window);
+    hist.v_n = driven;
     let mut out = ContactForce { f_i: geo.n * f_n, f_j: geo.n * (-f_n), f_n, clamped, ..Default::default() };
     // The friction limits take the normal force's magnitude: unclamped, the dashpot can pull.
     let f_n = f_n.abs();

@@ -5,8 +5,10 @@ use super::*;
 /// The GPU's history (one vec4 per block and contact: tangential with the sliding flag in w,
 /// rolling, bridge volume in x) in the CPU engine's packed slots.
 fn cpu_history(blocks: &[[f32; 4]], slots: &crate::cpu::HistorySlots) -> Vec<f32> {
+    use layout::normal_slot;
     let layout = slots.layout;
-    let per_contact = [layout.tangential, layout.rolling, layout.bridge].into_iter().filter(|&b| b).count().max(1);
+    let per_contact = (layout::history_blocks(layout) as usize).max(1);
+    let normal = layout::normal_slot(layout);
     let mut out = Vec::with_capacity(blocks.len() / per_contact * slots.stride);
     for contact in blocks.chunks_exact(per_contact) {
         let mut s = vec![0.0f32; slots.stride];
@@ -17,13 +19,26 @@ fn cpu_history(blocks: &[[f32; 4]], slots: &crate::cpu::HistorySlots) -> Vec<f32
             if layout.sliding {
                 s[slots.sliding] = t[3];
             }
+            if normal == normal_slot::TANGENTIAL_W {
+                s[slots.normal] = t[3];
+            }
         }
         if layout.rolling {
             let r = b.next().expect("a rolling block");
             s[slots.rolling..slots.rolling + 3].copy_from_slice(&r[..3]);
+            if normal == normal_slot::ROLLING_W {
+                s[slots.normal] = r[3];
+            }
         }
         if layout.bridge {
-            s[slots.bridge] = b.next().expect("a bridge block")[0];
+            let v = b.next().expect("a bridge block");
+            s[slots.bridge] = v[0];
+            if normal == normal_slot::BRIDGE_Y {
+                s[slots.normal] = v[1];
+            }
+        }
+        if normal == normal_slot::OWN {
+            s[slots.normal] = b.next().expect("a normal block")[0];
         }
         out.extend(s);
     }
@@ -76,6 +91,7 @@ impl GpuEngine {
             n_materials: self.n_materials,
             slots,
             elapsed: 0.0,
+            window: 0.0,
             periodic: crate::periodic::Periodic::default(),
             residual: &residual,
             material,
@@ -97,6 +113,7 @@ impl GpuEngine {
         let contact_records = contacts.then(|| -> Result<Vec<ContactRecord>, SimError> {
             let np = self.control.n_pairs as u64;
             let blocks = self.params.hist_blocks as u64;
+            let rolling_block = self.history.tangential as usize;
             let both = self.model.keeps_both_forces();
             let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, if both { 16 * np } else { 0 }), ("hist", 0, 16 * np * blocks), ("out_tj", 0, 16 * np)])?;
             let (pi, pj): (&[u32], &[u32]) = (&parts[0], &parts[1]);
@@ -120,8 +137,8 @@ impl GpuEngine {
                         force: xyz(&fi[k]),
                         force_j: if both { xyz(&fj[k]) } else { xyz(&fi[k]).map(|f| -f) },
                         tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
-                        rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + self.history.tangential as usize]) } else { [0.0; 3] },
-                        bridge_volume: if self.history.bridge { hist[k * blocks as usize + self.history.tangential as usize + self.history.rolling as usize][0] as f64 } else { 0.0 },
+                        rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + rolling_block]) } else { [0.0; 3] },
+                        bridge_volume: if self.history.bridge { hist[k * blocks as usize + blocks as usize - 1][0] as f64 } else { 0.0 },
                     })
                 })
                 .collect())
