@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Seed 000's oedometric test at the paper's parameters, end to end and timed: the 280-grain
+# Oquendo et al.'s oedometric test at the paper's parameters, end to end and timed: the 280-grain
 # scene and the 1200-grain one (pour, seating load, eight pressure steps, fits). Prints each
 # run's line with its wall time and particle-steps/s, its Bauer fits and its e0 profile.
 # Usage: bash benches/oedometer.sh [OUT_DIR]   (THREADS=N to change the thread count, default 2)

@@ -61,7 +61,7 @@ pub enum BenchPart {
     Ladder,
     /// Steps per second of small scenes (280, 1200 and 10^4 grains), dispatch-bound on a GPU.
     Small,
-    /// Seed 001's isotropic compaction to 100 Pa by DEM and by contact dynamics
+    /// Richefeu et al.'s isotropic compaction to 100 Pa by DEM and by contact dynamics
     /// (`--compaction-grains`): wall times, sweeps and contact updates per second.
     Compaction,
     /// Throughput and ladder (not the small scenes or the compaction).
@@ -143,7 +143,7 @@ pub enum Command {
         /// The run's --out directory.
         run: PathBuf,
         /// Another finished run (with contact forces) whose force PDF is drawn beside this
-        /// run's, over this run's force scale (seed 001's Fig. 7: wet and dry at 100 Pa):
+        /// run's, over this run's force scale (Richefeu et al.'s Fig. 7: wet and dry at 100 Pa):
         /// force_pdf_beside.png.
         #[arg(long, value_name = "RUN")]
         beside: Option<PathBuf>,

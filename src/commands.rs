@@ -87,7 +87,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                         println!("{:>9.4}  {:>11.4e}  {:.4}  {:.2e}", q.e0, q.h_s / 1e6, q.eta, q.rms);
                     }
                     if let Some(l) = p.power_law {
-                        println!("along the profile: {} (seed 000's sweep: {})", l.line(), grains::analysis::seed000::POWER_LAW.line());
+                        println!("along the profile: {} (Oquendo et al.'s sweep: {})", l.line(), grains::analysis::oquendo::POWER_LAW.line());
                     }
                 }
             }

@@ -148,7 +148,7 @@ pub struct Stats {
     /// evaluation; 0 in checkpoints written before grains counted them.
     #[serde(default)]
     pub sliding: u64,
-    /// Contacts in seed 000's rolling regime at full rolling friction at the last force
+    /// Contacts in Oquendo et al.'s rolling regime at full rolling friction at the last force
     /// evaluation (the rest of the touching contacts stick).
     #[serde(default)]
     pub rolling: u64,
@@ -327,7 +327,7 @@ pub struct ContactRecord {
     pub normal_force: f64,
     /// Total force on i (N).
     pub force: [f64; 3],
-    /// Total force on j (N): `-force` except in seed 000's rolling regime.
+    /// Total force on j (N): `-force` except in Oquendo et al.'s rolling regime.
     pub force_j: [f64; 3],
     /// Tangential spring `xi` (m), zero when the model keeps none.
     pub tangential_spring: [f64; 3],
@@ -426,7 +426,7 @@ pub trait Engine {
     /// fixed strain rate (1/s, positive closing) or back to pressure control (`None`).
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>);
     /// Wets the sample with `volume` (m^3) of liquid: shared among the pairs closer than their
-    /// rupture distance in proportion to their reduced diameter (seed 001, PHYSICS.md).
+    /// rupture distance in proportion to their reduced diameter (Richefeu et al. (2009), PHYSICS.md).
     fn wet(&mut self, volume: f64) -> anyhow::Result<()>;
     /// Moves the piston to height `z` (m) and stops it; no effect without a piston. The host
     /// places it where it touches nothing yet, so the last forces stay valid.

@@ -5,7 +5,7 @@
 
 use crate::scene::Integrator;
 
-/// Seed 000's optimised velocity Verlet parameter (eqs. 11-15).
+/// Oquendo et al.'s optimised velocity Verlet parameter (eqs. 11-15).
 pub const OVV_XI: f64 = 0.1931833275037836;
 
 /// One operation of a step. Durations are seconds.

@@ -1,6 +1,6 @@
 //! Parameter sweeps: one scene run over a grid (or list) of parameter values, each point in
 //! its own directory, resumable, gathered into one table with the power law h_s = a eta^b
-//! across the points (seed 000's Figure 5) and, for scenes with the force-transmission
+//! across the points (Oquendo et al.'s Figure 5) and, for scenes with the force-transmission
 //! analysis (`output.analysis`), each figure's mean and spread over the points (a sweep over
 //! `seed` gives independent samples).
 //!
@@ -200,7 +200,7 @@ impl Table {
             }
         }
         if let Some(l) = &self.power_law {
-            s.push_str(&format!("power law across the points: {} (seed 000: {})\n", l.line(), crate::analysis::seed000::POWER_LAW.line()));
+            s.push_str(&format!("power law across the points: {} (Oquendo et al.: {})\n", l.line(), crate::analysis::oquendo::POWER_LAW.line()));
         }
         if !self.ensemble.is_empty() {
             s.push_str("force transmission over the points:\n");

@@ -1,4 +1,4 @@
-//! Bauer's law fitted by Levenberg-Marquardt (seed 000 eq. 19): synthetic data with known
+//! Bauer's law fitted by Levenberg-Marquardt (Oquendo et al. eq. 19): synthetic data with known
 //! parameters and noise, the paper's experimental parameters over an oedometer's pressure
 //! range, and the power law across runs.
 

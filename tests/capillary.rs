@@ -1,6 +1,6 @@
-//! Capillary cohesion (seed 001 eqs. 1-8): the law against the formula worked by hand, a wet
+//! Capillary cohesion (Richefeu et al. (2009) eqs. 1-8): the law against the formula worked by hand, a wet
 //! pair that a bridge holds together or lets go at its rupture distance as energy says it
-//! should, liquid conserved while bridges break and form, and seed 001's wet preparation
+//! should, liquid conserved while bridges break and form, and Richefeu et al.'s wet preparation
 //! keeping the liquid's books.
 
 mod common;
@@ -225,7 +225,7 @@ impl Recorder for LiquidBooks {
     }
 }
 
-/// Seed 001's wet preparations (300 grains, stages cut to 20 ms): wet_iso_0pa.toml (compacted
+/// Richefeu et al.'s wet preparations (300 grains, stages cut to 20 ms): wet_iso_0pa.toml (compacted
 /// dry at 100 Pa, wetted, released) and wet_iso_0pa_wetted_loose.toml (liquid poured on the
 /// loose gas, compacted, released). At every statistics read from the wetting on, the liquid
 /// in bridges and on grains adds up to what was poured; at each stage end the frame's bridges

@@ -1,5 +1,5 @@
 //! Conservation laws of the contact laws: linear and angular momentum of a frictional
-//! Hertz-Mindlin gas (round-off only), and the documented non-conservation of seed 000's
+//! Hertz-Mindlin gas (round-off only), and the documented non-conservation of Oquendo et al.'s
 //! rolling regime.
 
 mod common;
@@ -72,7 +72,7 @@ fn hertz_mindlin_conserves_linear_and_angular_momentum_to_round_off() {
 }
 
 /// Two counter-rotating equal grains of radius `r` in light contact (overlap `-gap`; no slip
-/// at the contact point, like meshing gears) after one step under seed 000's rolling
+/// at the contact point, like meshing gears) after one step under Oquendo et al.'s rolling
 /// friction `friction`; returns the scene and the engine.
 fn counter_rotating_pair(friction: &str, r: f64, gap: f64) -> (grains::scene::Scene, CpuEngine<f64>) {
     let text = format!(
@@ -125,7 +125,7 @@ fn hertz(scene: &grains::scene::Scene, r: f64, h: f64) -> f64 {
     4.0 / 3.0 * c.v_eff * (r / 2.0).sqrt() * h.powf(1.5)
 }
 
-/// Seed 000's rolling friction as the paper writes it applies eqs. 8-9 to each grain with its
+/// Oquendo et al.'s rolling friction as the paper writes it applies eqs. 8-9 to each grain with its
 /// own m, I, R', along the same t for both (v_r is the same vector seen from either grain), so
 /// the pair's momentum changes at `2 |F_n| tan(theta_r) / (1 + I/(m R'^2))` along `-t`.
 #[test]
@@ -145,7 +145,7 @@ fn the_rolling_regime_as_written_does_not_conserve_the_pairs_linear_momentum() {
     assert!((rate / (2.0 * each) - 1.0).abs() < RATE_TOLERANCE, "rate {rate:e} vs {:e}", 2.0 * each);
 }
 
-/// The default realisation puts seed 000's rolling friction on the pair as a torque pair
+/// The default realisation puts Oquendo et al.'s rolling friction on the pair as a torque pair
 /// `+-R'_eff |F_n| tan(theta_r)`: the pair's momentum stays zero and the relative spin slows
 /// at the rate that torque gives.
 #[test]

@@ -1,4 +1,4 @@
-//! Seed 000's integrator study (its Figure 2): the elastic gas of 50 frictionless, undamped
+//! Oquendo et al.'s integrator study (its Figure 2): the elastic gas of 50 frictionless, undamped
 //! Hertz grains conserves its mechanical energy; the fluctuation `<dE^2>^(1/2)` measures the
 //! integrator's error and must shrink as dt falls, and the optimised velocity Verlet must
 //! beat velocity Verlet at the same dt.

@@ -164,7 +164,7 @@ fn pair_force_wall_contacts_and_gather_match_the_cpu_twins() {
         println!("periodic {periodic}: largest load difference {worst:.3e} N, mean contact force {scale:.3e} N");
         assert!(scale > 0.0);
         assert!(worst < F32_LOAD_TOLERANCE * scale);
-        // Seed 000's regimes, contact by contact through the sliding flag and the rolling
+        // Oquendo et al.'s regimes, contact by contact through the sliding flag and the rolling
         // spring, counted alike.
         let (sg, sc) = (g.stats().unwrap(), c.stats().unwrap());
         println!("periodic {periodic}: gpu {} sliding, {} rolling; cpu {} sliding, {} rolling", sg.sliding, sg.rolling, sc.sliding, sc.rolling);
@@ -322,7 +322,7 @@ const SERVO_PRESSURE_TOLERANCE: f64 = 1e-2;
 fn servo_walls_on_the_gpu_follow_the_cpu_twin() {
     let scene = common::parse(&common::edit(
         &std::fs::read_to_string(common::scene_path("dry_iso_100pa.toml")).unwrap(),
-        // Seed 001's isotropic compaction with its density of grains, 300 of them.
+        // Richefeu et al.'s isotropic compaction with its density of grains, 300 of them.
         &[("count = 8000", "count = 300"), ("max = [28.0e-3, 28.0e-3, 28.0e-3]", "max = [9.4e-3, 9.4e-3, 9.4e-3]")],
     ));
     let Some(mut g) = common::gpu_engine(&scene) else { return };
@@ -424,7 +424,7 @@ fn bridges_follow_the_cpu(scene: &grains::scene::Scene) {
     assert!(worst_x / d_mean < CAPILLARY_POSITION_TOLERANCE);
 }
 
-/// Seed 001's wet protocol through the host loop on both engines, in both preparations: 300
+/// Richefeu et al.'s wet protocol through the host loop on both engines, in both preparations: 300
 /// grains compacted by the servo box and wetted as the walls back off, or wetted loose,
 /// compacted and released; then compacted again (every stage cut to 3 ms). At each stage end the GPU holds the same bridges as the CPU f32
 /// twin, the same liquid, and walls and energies within the f32 tolerances.
@@ -467,8 +467,8 @@ fn the_wet_protocol_runs_on_the_gpu_as_on_the_cpu() {
     }
 }
 
-/// `grains compare`'s verdicts on short horizons of the scenes seed 000 and 001 run, from
-/// their initial states: the 280-grain oedometer and seed 001's servo box with 300 grains.
+/// `grains compare`'s verdicts on short horizons of the scenes Oquendo et al. and Richefeu et al. (2009) run, from
+/// their initial states: the 280-grain oedometer and Richefeu et al.'s servo box with 300 grains.
 #[test]
 fn compare_passes_on_short_horizons_of_the_papers_scenes() {
     let servo_box = common::parse(&common::edit(
@@ -487,9 +487,9 @@ fn compare_passes_on_short_horizons_of_the_papers_scenes() {
     }
 }
 
-/// The pair records, both ways a law keeps them: seed 001's Mindlin law (the partner's force
+/// The pair records, both ways a law keeps them: Richefeu et al.'s Mindlin law (the partner's force
 /// is the owner's reversed, so the pair pass stores one force and the gather subtracts it) and
-/// seed 000's (both forces stored). On a software adapter, which runs the CPU twin's
+/// Oquendo et al.'s (both forces stored). On a software adapter, which runs the CPU twin's
 /// arithmetic, every grain's position and velocity stays bitwise equal to the CPU f32 engine's
 /// through 200 steps; on any adapter the clamped, sliding and rolling contacts (the regime and
 /// the clamp share a word of the record) are counted alike, and the Mindlin gas has some
@@ -498,8 +498,8 @@ fn compare_passes_on_short_horizons_of_the_papers_scenes() {
 fn pair_records_give_the_cpus_bits_with_one_force_or_two() {
     // The quickstart's grains set moving, so that they collide from the first steps.
     let mindlin = common::parse(&common::edit(&std::fs::read_to_string(common::scene_path("quickstart.toml")).unwrap(), &[("region = { shape", "random_speed = 2.0\nregion = { shape")]));
-    for (name, scene) in [("mindlin", mindlin), ("seed 000", gas(false))] {
-        assert_eq!(scene.model.keeps_both_forces(), name == "seed 000");
+    for (name, scene) in [("mindlin", mindlin), ("Oquendo et al.", gas(false))] {
+        assert_eq!(scene.model.keeps_both_forces(), name == "Oquendo et al.");
         let Some(mut g) = common::gpu_engine(&scene) else { return };
         let mut c: CpuEngine<f32> = common::engine(&scene);
         g.advance(200).unwrap();
@@ -686,7 +686,7 @@ fn a_pour_that_outgrows_the_pair_buffers_stops_and_goes_on_with_the_same_bits() 
 fn rebuilds_that_stop_on_full_pair_buffers_keep_each_scenes_bits() {
     // Runs that start with buffers for 16 pairs (every rebuild that outgrows them stops the
     // run until they have grown, the prologue's first) against runs sized for the first list,
-    // on the GPU alone: seed 000's gas under optimized Verlet (two rebuild checks a step,
+    // on the GPU alone: Oquendo et al.'s gas under optimized Verlet (two rebuild checks a step,
     // rolling springs, orientations, a floor in a periodic box), the wet gas with rolling
     // springs (three history blocks, bridges; wetted through a stopped prologue) and seed
     // 001's servo box (servo walls moved in the carried steps).

@@ -102,7 +102,7 @@ fn contact_time_error_falls_with_the_time_step() {
     assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
 }
 
-/// Restitution under the papers' damping `m_eff gamma_n sqrt(h) v_n` (seed 000 eq. 1) falls as
+/// Restitution under the papers' damping `m_eff gamma_n sqrt(h) v_n` (Oquendo et al. eq. 1) falls as
 /// gamma_n grows; undamped it is 1.
 #[test]
 fn restitution_falls_with_the_papers_damping_coefficient() {

@@ -95,7 +95,7 @@ fn pour(dir: &Path) -> PathBuf {
     path
 }
 
-/// Seed 000's oedometer, small and short: 150 grains poured for 20 ms, the piston lowered
+/// Oquendo et al.'s oedometer, small and short: 150 grains poured for 20 ms, the piston lowered
 /// onto them and one pressure step of 5 ms at 12.5 kPa.
 fn oedometer(dir: &Path) -> PathBuf {
     let text = std::fs::read_to_string(common::scene_path("oedometer.toml")).unwrap();

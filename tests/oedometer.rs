@@ -166,7 +166,7 @@ fn plots_are_written_as_png_and_svg() {
     }
 }
 
-/// Seed 000's packing at the paper's parameters (the shipped scene, 300 grains, V = 18 GPa,
+/// Oquendo et al.'s packing at the paper's parameters (the shipped scene, 300 grains, V = 18 GPa,
 /// friction on the walls too) settles at every pressure step up to 1.6 MPa, with its contacts
 /// sticking: the regime switching that kept the old law's packings creeping does not return.
 #[test]

@@ -1,4 +1,4 @@
-//! Omelyan's norm-preserving quaternion update (seed 000 eqs. 16-18).
+//! Omelyan's norm-preserving quaternion update (Oquendo et al. eqs. 16-18).
 
 mod common;
 

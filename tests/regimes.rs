@@ -1,4 +1,4 @@
-//! Seed 000's tangential regimes under the loads the oedometer reaches, not only at one light
+//! Oquendo et al.'s tangential regimes under the loads the oedometer reaches, not only at one light
 //! contact: a loaded sphere must come to rest, the low-load rolling and sliding laws must keep
 //! their rigid-body values, and no regime switch may create energy.
 

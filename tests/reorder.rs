@@ -2,7 +2,7 @@
 //! for bit: trajectories, statistics, frames with their contacts, and a checkpoint written by a
 //! renumbered run and resumed, against the same scene never renumbered. The scenes cover what
 //! reads an order: wall sums feeding a servo, liquid bridges forming and breaking, the gather's
-//! partner sums, periodic images, and seed 000's law, which keeps the owner's force.
+//! partner sums, periodic images, and Oquendo et al.'s law, which keeps the owner's force.
 
 mod common;
 
@@ -10,7 +10,7 @@ use grains::cpu::CpuEngine;
 use grains::engine::Engine;
 use grains::scene::Scene;
 
-/// The box gas of `common::box_gas` (seed 000's laws, orientations) with about 5,000 grains,
+/// The box gas of `common::box_gas` (Oquendo et al.'s laws, orientations) with about 5,000 grains,
 /// so that every reduction splits into several chunks.
 fn dry() -> String {
     common::box_gas(5000, 22.0e-3)

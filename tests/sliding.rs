@@ -37,7 +37,7 @@ fn check(tangential: &str) {
 }
 
 #[test]
-fn seed_000_regimes_slide_then_roll_at_five_sevenths() {
+fn oquendo_regimes_slide_then_roll_at_five_sevenths() {
     check("tangential = \"oquendo\"");
 }
 

@@ -166,7 +166,7 @@ fn within_rupture(v_b: f32, delta: f32) -> bool {
     return delta <= 0.0 || delta * delta * delta <= k * k * k * v_b;
 }
 
-// Decay length of the capillary force across the gap (m), seed 001 eq. 8.
+// Decay length of the capillary force across the gap (m), Richefeu et al. (2009) eq. 8.
 fn decay_length(r_i: f32, r_j: f32, v_b: f32) -> f32 {
     let ratio = max(r_i / r_j, r_j / r_i);
     return params.capillary_c * 0.70710678118654752 * sqrt((1.0 / r_i + 1.0 / r_j) / ratio * v_b);
@@ -369,7 +369,7 @@ fn elastic_plastic(s: vec3<f32>, v: vec3<f32>, k: f32, eta: f32, stick: f32, sli
     return out;
 }
 
-// Seed 000 eqs. 8-9 for one grain, fr = |F_n| tan(theta_r) t on the cap: (force, torque).
+// Oquendo et al. eqs. 8-9 for one grain, fr = |F_n| tan(theta_r) t on the cap: (force, torque).
 fn rolling_regime(fr: vec3<f32>, m: f32, inertia: f32, rp: f32, n: vec3<f32>, out_f: ptr<function, vec3<f32>>, out_t: ptr<function, vec3<f32>>) {
     let mr2 = m * rp * rp;
     *out_f = fr * (-1.0 / (1.0 + inertia / mr2));
@@ -411,7 +411,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
 
     out.regime = REGIME_STATIC;
     if (TANGENTIAL_LAW == TANGENTIAL_OQUENDO) {
-        // Seed 000's regimes (src/model/tangential.rs oquendo_tangential).
+        // Oquendo et al.'s regimes (src/model/tangential.rs oquendo_tangential).
         let k_t = tangential_stiffness(c, g, el.y);
         let v_t = contact_tangential_velocity(g, k);
         let xi = rotate_into_plane((*hist).tangential, g.n) + v_t * elapsed;

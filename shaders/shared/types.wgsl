@@ -26,8 +26,8 @@ struct Params {
     k_r: f32,             // rolling stiffness (N/m)
     gamma_r: f32,         // rolling damping (N s/m)
     mu_r: f32,            // rolling friction
-    static_damping: f32,  // seed 000's static and rolling springs: fraction of critical damping
-    rolling_as_written: u32, // seed 000's rolling friction: 0 torque pair, 1 eqs. 8-9 on each grain
+    static_damping: f32,  // Oquendo et al.'s static and rolling springs: fraction of critical damping
+    rolling_as_written: u32, // Oquendo et al.'s rolling friction: 0 torque pair, 1 eqs. 8-9 on each grain
     theta: f32,           // capillary contact angle (rad)
     capillary_c: f32,     // capillary decay-length coefficient (-)
     bridge_cap: f32,      // largest bridge volume (m^3)

@@ -1,4 +1,4 @@
-//! Bauer's compression law (seed 000 eq. 19) fitted by Levenberg-Marquardt, the power law
+//! Bauer's compression law (Oquendo et al. eq. 19) fitted by Levenberg-Marquardt, the power law
 //! across a sweep, and the concise `value(uncertainty)` notation the paper prints.
 //!
 //! A three-parameter least-squares problem needs a 3x3 solve and nothing more, so the
@@ -52,7 +52,7 @@ pub fn concise(value: f64, error: f64) -> String {
     }
 }
 
-/// Bauer's law `e = e0 exp(-(s p / h_s)^eta)`, `s` = 1 (vertical stress, seed 000 eq. 19) or 3
+/// Bauer's law `e = e0 exp(-(s p / h_s)^eta)`, `s` = 1 (vertical stress, Oquendo et al. eq. 19) or 3
 /// (the abstract's mean-stress form).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct BauerFit {

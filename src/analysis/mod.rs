@@ -3,8 +3,8 @@
 pub mod ensemble;
 pub mod fit;
 pub mod network;
-pub mod seed000;
-pub mod seed001;
+pub mod oquendo;
+pub mod richefeu;
 pub mod tail;
 
 use crate::engine::Frame;
@@ -94,7 +94,7 @@ pub fn container_volume(scene: &Scene, piston_z: f64) -> Option<f64> {
 }
 
 /// Per grain, the sum over its contacts of `f (x) c` (N m): `f` the force on the grain, `c`
-/// the vector from its centre to the contact point (seed 001 eq. 11 before the division by
+/// the vector from its centre to the contact point (Richefeu et al. (2009) eq. 11 before the division by
 /// the grain's volume). Grain-grain and grain-wall contacts of the frame count; the frame
 /// must have been taken with contacts. Indexed like the frame's grains (slot = permanent id).
 pub fn contact_moments(frame: &Frame, periodic: &Periodic<f64>) -> Vec<Tensor> {
@@ -124,7 +124,7 @@ pub fn contact_moments(frame: &Frame, periodic: &Periodic<f64>) -> Vec<Tensor> {
 }
 
 /// Volume-weighted mean of the particle stresses over a volume (Pa): `(1/V) sum_i sum_c f (x) c`
-/// (the particle volumes cancel). Negative in compression, as seed 001 eq. 11 defines it.
+/// (the particle volumes cancel). Negative in compression, as Richefeu et al. (2009) eq. 11 defines it.
 pub fn macroscopic_stress(moments: &[Tensor], volume: f64) -> Tensor {
     let mut s = [[0.0; 3]; 3];
     for t in moments {

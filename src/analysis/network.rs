@@ -1,4 +1,4 @@
-//! Force transmission in a packing (seed 001): normal-force statistics with their exponential
+//! Force transmission in a packing (Richefeu et al. (2009)): normal-force statistics with their exponential
 //! tails, bonds counted by sign, particle stresses and pressures, the macroscopic stress, the
 //! bi-percolation of the positive- and negative-pressure phases, and the fabric anisotropy.
 

@@ -1,4 +1,4 @@
-//! Contact dynamics against DEM on the same packing: seed 001's isotropic compaction
+//! Contact dynamics against DEM on the same packing: Richefeu et al.'s isotropic compaction
 //! (`dry_iso_100pa.toml` and `cd_iso_100pa.toml`, the same grains, friction, servo box and
 //! pressure), shrunk to a given grain count, run by each method to its scene's settle criteria
 //! on each backend; the wall time of each, and contact dynamics' sweeps: how many a step took,

@@ -41,7 +41,7 @@ pub struct BenchOptions {
     pub ladder: bool,
     /// Run the small-scene part (steps per second at 280, 1200 and 10^4 grains).
     pub small: bool,
-    /// Run the compaction part at this many grains: seed 001's isotropic compaction to 100 Pa
+    /// Run the compaction part at this many grains: Richefeu et al.'s isotropic compaction to 100 Pa
     /// by DEM and by contact dynamics.
     pub compaction: Option<usize>,
     /// Where the poured bed is cached.
@@ -321,7 +321,7 @@ impl BenchReport {
             }
         }
         if !self.compaction.is_empty() {
-            s.push_str("\nthe same compaction to 100 Pa by DEM and by contact dynamics (seed 001's sample scaled to the grains, each scene's settle criteria)\n");
+            s.push_str("\nthe same compaction to 100 Pa by DEM and by contact dynamics (Richefeu et al.'s sample scaled to the grains, each scene's settle criteria)\n");
             s.push_str("method            backend prec thr grains        dt   steps   wall s  settled     Z  pressure Pa  sweeps/step  capped  contact updates/s  sweep share\n");
             let opt = |x: Option<f64>, digits: usize| x.map_or("-".to_string(), |v| format!("{v:.digits$}"));
             for r in &self.compaction {

@@ -1,5 +1,5 @@
 //! Contact dynamics (Moreau-Jean) for rigid frictional spheres and the scene's walls, beside
-//! the DEM engine: the method of seed 001's samples S1 and S2.
+//! the DEM engine: the method of Richefeu et al.'s samples S1 and S2.
 //!
 //! One step of length `h`:
 //! 1. Contacts: every grain pair whose surfaces are within the gap allowance of each other

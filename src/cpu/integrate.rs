@@ -1,5 +1,5 @@
 //! `integrate`: kicks (velocity updates) and drifts (position and orientation updates) of
-//! one grain. Velocity Verlet and seed 000's optimised velocity Verlet are sequences of these.
+//! one grain. Velocity Verlet and Oquendo et al.'s optimised velocity Verlet are sequences of these.
 
 use super::built_at;
 use super::state::{Body, Load, Props};
@@ -46,7 +46,7 @@ fn kick_drift_portable<T: Real>(body: &mut [Body<T>], residual: &mut [Vec3<T>], 
 }
 
 /// Omelyan's norm-preserving rotation of a unit quaternion (scalar first) by the world-frame
-/// angular velocity `w` over `tau` (seed 000 eqs. 16-18):
+/// angular velocity `w` over `tau` (Oquendo et al. eqs. 16-18):
 /// `q' = ((1 - a) q + tau/2 (0, w) * q) / (1 + a)`, `a = tau^2 |w|^2 / 16`, a rotation by
 /// `4 atan(tau |w| / 4)` about `w`. The body-frame form of eq. 18, `Q(w_b) q`, equals
 /// `1/2 (0, w) * q` because `w = q w_b q*`. It is evaluated as `q + (tau/2 (0, w) * q - 2 a q) / (1 + a)`

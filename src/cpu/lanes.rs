@@ -482,7 +482,7 @@ duration = 1.0e-3
     /// Each grain's load from the pair pass's owner sums and the gather against the sum the
     /// gather made when it read whole per-pair records (gravity, the owned pairs' forces on
     /// the owner in pair order, the forces on it as partner in pair order, the walls), bit for
-    /// bit, on `SCENE` with its Mindlin law (the lanes) and with seed 000's laws (one pair at a
+    /// bit, on `SCENE` with its Mindlin law (the lanes) and with Oquendo et al.'s laws (one pair at a
     /// time, the force on the owner kept per pair; this gas has no pair in the rolling regime,
     /// where the two forces are not each other's reverse, so the count printed is 0).
     fn check_loads<T: Real>(oquendo: bool) {

@@ -16,7 +16,7 @@ pub fn chunked<R: Send, F: Fn(Range<usize>) -> R + Sync + Send>(n: usize, f: F) 
 /// more than the work (measured on the 3000-grain pour: 2 threads were slower than 1 with 512).
 pub const PAR_MIN_ITEMS: usize = 4096;
 
-/// Fewest pairs a task of the pair pass takes: a pair of seed 000's law costs several times
+/// Fewest pairs a task of the pair pass takes: a pair of Oquendo et al.'s law costs several times
 /// a per-grain pass's item (the 1200-grain oedometer, about 3600 pairs, ran in 185 s on 2
 /// threads with this against 234 s with [`PAR_MIN_ITEMS`], which kept it on one).
 pub const PAR_MIN_PAIRS: usize = 1024;

@@ -55,9 +55,9 @@ pub struct Params {
     pub gamma_r: f32,
     /// Rolling friction.
     pub mu_r: f32,
-    /// Seed 000's static and rolling spring damping, fraction of critical (-).
+    /// Oquendo et al.'s static and rolling spring damping, fraction of critical (-).
     pub static_damping: f32,
-    /// Seed 000's rolling friction: 0 a torque pair, 1 eqs. 8-9 on each grain as written.
+    /// Oquendo et al.'s rolling friction: 0 a torque pair, 1 eqs. 8-9 on each grain as written.
     pub rolling_as_written: u32,
     /// Capillary contact angle (rad).
     pub theta: f32,
@@ -450,7 +450,7 @@ mod tests {
     use super::*;
     use crate::model::HistoryLayout;
 
-    /// Every layout a model can ask for (the sliding flag only with both springs: seed 000's
+    /// Every layout a model can ask for (the sliding flag only with both springs: Oquendo et al.'s
     /// law) fits the rebuild's three scratch buffers of history blocks (`remap_history`), and
     /// its normal velocity has a place.
     #[test]

@@ -1,11 +1,11 @@
-//! Capillary cohesion of a liquid bridge (seed 001 eqs. 1-8, PHYSICS.md), derived from the
+//! Capillary cohesion of a liquid bridge (Richefeu et al. (2009) eqs. 1-8, PHYSICS.md), derived from the
 //! paper: the force is `f0 = -kappa R` while the grains touch, decays as `f0 exp(-delta/lambda)`
 //! across the gap `delta`, and vanishes beyond the rupture distance `delta_max`.
 
 use crate::real::Real;
 
 /// `delta_max = (1 + theta/2) V_b^(1/3)` (m), `theta` the contact angle (rad), `V_b` the
-/// bridge volume (m^3) (seed 001 eq. 5).
+/// bridge volume (m^3) (Richefeu et al. (2009) eq. 5).
 #[inline(always)]
 pub fn rupture_distance<T: Real>(theta: T, v_b: T) -> T {
     (T::ONE + theta * T::of(0.5)) * v_b.powf(T::of(1.0 / 3.0))
@@ -22,7 +22,7 @@ pub fn within_rupture<T: Real>(theta: T, v_b: T, delta: T) -> bool {
 }
 
 /// `lambda = c / sqrt(2) sqrt((1/R_i + 1/R_j) / max(R_i/R_j, R_j/R_i) V_b)` (m), the decay
-/// length of the force across the gap (seed 001 eq. 8).
+/// length of the force across the gap (Richefeu et al. (2009) eq. 8).
 #[inline(always)]
 pub fn decay_length<T: Real>(c: T, r_i: T, r_j: T, v_b: T) -> T {
     let ratio = (r_i / r_j).max(r_j / r_i);
@@ -74,7 +74,7 @@ pub fn capillary_potential<T: Real>(kappa: T, theta: T, c: T, r_i: T, r_j: T, v_
 /// capped at `cap` (m^3); pairs beyond the rupture distance of their share drop out and raise
 /// the others' shares, until none drops. `pairs` are each pair's radii and surface gap
 /// `(R_i, R_j, gap)` (m), `theta` the contact angle (rad). Returns each wetted pair's
-/// `(index, volume)` and the volume left over, which waits on the grains (seed 001,
+/// `(index, volume)` and the volume left over, which waits on the grains (Richefeu et al. (2009),
 /// PHYSICS.md).
 pub fn share_liquid(volume: f64, pairs: &[(f64, f64, f64)], cap: f64, theta: f64) -> (Vec<(usize, f64)>, f64) {
     let d: Vec<f64> = pairs.iter().map(|&(ri, rj, _)| 2.0 * ri * rj / (ri + rj)).collect();

@@ -2,7 +2,7 @@
 
 use crate::real::{Real, Vec3};
 
-/// Geometry of one contact (seed 000 eq. 3 for the contact point).
+/// Geometry of one contact (Oquendo et al. eq. 3 for the contact point).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Geometry<T> {
     /// Unit normal from j to i.
@@ -39,7 +39,7 @@ pub struct Kinematics<T> {
     pub w_j: Vec3<T>,
 }
 
-/// Mass and moment of inertia of the two partners, for seed 000's rolling regime.
+/// Mass and moment of inertia of the two partners, for Oquendo et al.'s rolling regime.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Bodies<T> {
     /// Mass of i (kg).

@@ -164,7 +164,7 @@ impl<T> CohesionLaw<T> {
 /// Elastic normal law.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum NormalLaw<T> {
-    /// Hertz: `F = 4/3 sqrt(R_eff) V_eff h^(3/2)` (seed 000 eq. 1).
+    /// Hertz: `F = 4/3 sqrt(R_eff) V_eff h^(3/2)` (Oquendo et al. eq. 1).
     Hertz,
     /// Linear spring: `F = k_n h`, `k_n` in N/m.
     Linear {
@@ -178,7 +178,7 @@ pub enum NormalLaw<T> {
 pub enum DampingLaw<T> {
     /// No normal dissipation.
     None,
-    /// The papers' nonlinear damping `-m_eff gamma_n sqrt(h) v_n` (seed 000 eq. 1),
+    /// The papers' nonlinear damping `-m_eff gamma_n sqrt(h) v_n` (Oquendo et al. eq. 1),
     /// `gamma_n` (s^-1 m^-1/2) from the materials.
     Papers,
     /// Viscous damping that gives a binary impact the restitution coefficient `e` of the
@@ -208,7 +208,7 @@ pub enum TangentialStiffness<T> {
 pub enum TangentialLaw<T> {
     /// Frictionless.
     None,
-    /// Seed 000's three regimes: static (history spring up to `mu_s`), sliding (at `mu_k`
+    /// Oquendo et al.'s three regimes: static (history spring up to `mu_s`), sliding (at `mu_k`
     /// once the spring's Coulomb test fails, until it unloads), rolling (eqs. 8-9's friction
     /// once a rolling spring reaches `tan(theta_r) |F_n|`, when not sliding); see
     /// [`oquendo_tangential`].
@@ -224,7 +224,7 @@ pub enum TangentialLaw<T> {
     },
 }
 
-/// The parameters of seed 000's tangential regimes (see [`oquendo_tangential`]).
+/// The parameters of Oquendo et al.'s tangential regimes (see [`oquendo_tangential`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OquendoLaw<T> {
     /// Damping of the static and rolling springs as a fraction of their critical damping (-).
@@ -235,7 +235,7 @@ pub struct OquendoLaw<T> {
     pub rolling_friction: RollingFriction,
 }
 
-/// How seed 000's rolling friction (eqs. 8-9) is applied (see [`oquendo_tangential`]).
+/// How Oquendo et al.'s rolling friction (eqs. 8-9) is applied (see [`oquendo_tangential`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum RollingFriction {
     /// A torque pair of magnitude `R'_eff |F_n| tan(theta_r)` when rolling: eqs. 8-9 for a
@@ -257,7 +257,7 @@ impl RollingFriction {
     }
 }
 
-/// Rolling-resistance law (the momentum-conserving alternative to seed 000's rolling regime).
+/// Rolling-resistance law (the momentum-conserving alternative to Oquendo et al.'s rolling regime).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum RollingLaw<T> {
     /// No rolling resistance.
@@ -279,7 +279,7 @@ pub enum RollingLaw<T> {
 pub enum TwistingLaw {
     /// No twisting torque.
     None,
-    /// Seed 000 eq. 2: `tau_i = -4 pi gamma_nt m_eff R_eff h w_n`.
+    /// Oquendo et al. eq. 2: `tau_i = -4 pi gamma_nt m_eff R_eff h w_n`.
     Oquendo,
 }
 
@@ -288,13 +288,13 @@ pub enum TwistingLaw {
 pub enum CohesionLaw<T> {
     /// No cohesion.
     None,
-    /// Capillary bridges (seed 001 eqs. 1-8), per-pair liquid volume as history.
+    /// Capillary bridges (Richefeu et al. (2009) eqs. 1-8), per-pair liquid volume as history.
     Capillary {
         /// `kappa = 2 pi gamma_s cos(theta)` (N/m).
         kappa: T,
         /// Contact angle (rad).
         theta: T,
-        /// The decay-length constant `c` (0.9 in seed 001).
+        /// The decay-length constant `c` (0.9 in Richefeu et al. (2009)).
         c: T,
     },
 }
@@ -334,7 +334,7 @@ impl<T: Real> ContactModel<T> {
     }
 
     /// True when a pair's force on its owner is not always its force on the partner reversed,
-    /// bit for bit, so that an engine must keep both: seed 000's rolling regime moves both
+    /// bit for bit, so that an engine must keep both: Oquendo et al.'s rolling regime moves both
     /// grains along their own rolling directions. Every other law applies `f` to i and `-f`
     /// to j (a negation commutes with rounding, so `-f` is exact).
     pub fn keeps_both_forces(&self) -> bool {
@@ -353,7 +353,7 @@ pub struct HistoryLayout {
     pub normal: bool,
     /// Whether the contact is sliding (one real, 0 or 1): friction with two coefficients.
     pub sliding: bool,
-    /// Accumulated rolling displacement `psi` (m): the rolling law's, or seed 000's rolling
+    /// Accumulated rolling displacement `psi` (m): the rolling law's, or Oquendo et al.'s rolling
     /// spring.
     pub rolling: bool,
     /// Liquid bridge volume `V_b` (m^3), one real.
@@ -376,7 +376,7 @@ pub struct History<T> {
     /// The normal velocity the contact forces drive at the previous evaluation (m/s,
     /// [`driven_normal_velocity`]); 0 in a new contact.
     pub v_n: T,
-    /// Sliding at the last evaluation (seed 000's regimes).
+    /// Sliding at the last evaluation (Oquendo et al.'s regimes).
     pub sliding: bool,
     /// Rolling spring displacement `psi` (m).
     pub rolling: Vec3<T>,
@@ -475,7 +475,7 @@ impl<T: Real> PairCoeffs<T> {
 pub struct ContactForce<T> {
     /// Force on i (N).
     pub f_i: Vec3<T>,
-    /// Force on j (N); `-f_i` except in seed 000's rolling regime.
+    /// Force on j (N); `-f_i` except in Oquendo et al.'s rolling regime.
     pub f_j: Vec3<T>,
     /// Torque on i (N m).
     pub t_i: Vec3<T>,
@@ -500,7 +500,7 @@ pub enum Regime {
     Static = 0,
     /// On the Coulomb limit.
     Sliding = 1,
-    /// Seed 000's rolling friction at full strength.
+    /// Oquendo et al.'s rolling friction at full strength.
     Rolling = 2,
 }
 
@@ -728,7 +728,7 @@ mod tests {
     }
 
     #[test]
-    fn geometry_puts_the_contact_point_per_seed_000_eq_3() {
+    fn geometry_puts_the_contact_point_per_oquendo_eq_3() {
         let (_, g) = pair();
         assert!(close(g.h, 1.0e-6));
         assert!(close(g.r_eff, 2.5e-4) && close(g.m_eff, 1.3875e-6 / 2.0));

@@ -1,4 +1,4 @@
-//! Normal force: elastic law, damping law, no-pull clamp (seed 000 eq. 1, PHYSICS.md).
+//! Normal force: elastic law, damping law, no-pull clamp (Oquendo et al. eq. 1, PHYSICS.md).
 
 use super::{DampingLaw, Geometry, NormalLaw, PairCoeffs};
 use crate::real::Real;

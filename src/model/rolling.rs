@@ -1,5 +1,5 @@
 //! Elastic-plastic spring-dashpot rolling resistance (the momentum-conserving alternative to
-//! seed 000's rolling regime; as LAMMPS `rolling sds`).
+//! Oquendo et al.'s rolling regime; as LAMMPS `rolling sds`).
 
 use super::tangential::rotate_into_plane;
 use super::{Geometry, Kinematics};

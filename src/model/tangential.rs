@@ -1,10 +1,10 @@
-//! Tangential laws: seed 000's sliding / rolling / static regimes and the standard
+//! Tangential laws: Oquendo et al.'s sliding / rolling / static regimes and the standard
 //! Hertz-Mindlin history law.
 
 use super::{Bodies, Geometry, History, Kinematics, OquendoLaw, PairCoeffs, Regime, RollingFriction};
 use crate::real::{Real, Vec3};
 
-/// Forces and torques of seed 000's tangential regimes on both partners.
+/// Forces and torques of Oquendo et al.'s tangential regimes on both partners.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TangentialOut<T> {
     /// Force on i (N).
@@ -46,7 +46,7 @@ pub fn since_touch<T: Real>(hist: &History<T>, h: T, v_n: T, elapsed: T) -> T {
     if new && approach * elapsed > h { h / approach } else { elapsed }
 }
 
-/// Tangential velocity of the contact points, `v_t = v_p - (v_p.n) n` with seed 000 eq. 4
+/// Tangential velocity of the contact points, `v_t = v_p - (v_p.n) n` with Oquendo et al. eq. 4
 /// `v_p = v_i - v_j - (R'_i w_i + R'_j w_j) x n`.
 #[inline(always)]
 pub fn contact_tangential_velocity<T: Real>(g: &Geometry<T>, k: &Kinematics<T>) -> Vec3<T> {
@@ -54,7 +54,7 @@ pub fn contact_tangential_velocity<T: Real>(g: &Geometry<T>, k: &Kinematics<T>) 
     v_p - g.n * v_p.dot(g.n)
 }
 
-/// Seed 000's three regimes (PHYSICS.md "Tangential force"), realised so that a loaded
+/// Oquendo et al.'s three regimes (PHYSICS.md "Tangential force"), realised so that a loaded
 /// contact that should stick does stick at any `F_n dt / m*`:
 ///
 /// - **static**: an elastic spring `xi` (history, m), rotated into the tangent plane and grown
@@ -71,7 +71,7 @@ pub fn contact_tangential_velocity<T: Real>(g: &Geometry<T>, k: &Kinematics<T>) 
 ///   continuous force. Deciding by force rather than by `|v_t| > v_slip` is what keeps an
 ///   explicit step from jumping over the sticking band: the spring absorbs the overshoot.
 ///   The spring is only ever scaled down, so no regime switch creates energy; with
-///   `mu_k > mu_s` (seed 000's Table 3 at mu_s = 0.1, 0.2) a contact therefore holds up to
+///   `mu_k > mu_s` (Oquendo et al.'s Table 3 at mu_s = 0.1, 0.2) a contact therefore holds up to
 ///   `mu_k |F_n|`, where the paper's speed threshold let it creep at `v_slip`.
 /// - **rolling** (not sliding): the rolling velocity `v_r = R'_eff (w_i - w_j) x n` loads a
 ///   rolling spring `psi` (history, m) in the same way, `F_r = -k_t psi - eta_r v_r` (the
@@ -180,7 +180,7 @@ fn elastic_plastic<T: Real>(s: Vec3<T>, v: Vec3<T>, k: T, eta: T, stick: T, slip
     }
 }
 
-/// Seed 000 eqs. 8-9 for one grain: force `-fr / (1 + I/(m R'^2))` and torque
+/// Oquendo et al. eqs. 8-9 for one grain: force `-fr / (1 + I/(m R'^2))` and torque
 /// `R' / (1 + m R'^2 / I) fr x n`, `fr = |F_n| tan(theta_r) t` on the cap (the rolling
 /// spring's force below it).
 #[inline(always)]

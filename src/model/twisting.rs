@@ -1,4 +1,4 @@
-//! Twisting torque of seed 000 eq. 2.
+//! Twisting torque of Oquendo et al. eq. 2.
 
 use super::{Geometry, Kinematics};
 use crate::real::{Real, Vec3};

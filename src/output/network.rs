@@ -1,7 +1,7 @@
 //! The force-transmission report of a packing: `analysis.json` and its pictures.
 
 use crate::analysis::network::{analyze, force_density, forces_over, mean_compressive_force, NetworkAnalysis};
-use crate::analysis::seed001;
+use crate::analysis::richefeu;
 use crate::analysis::tail::TailFit;
 use crate::analysis::sample_bounds;
 use crate::engine::{Frame, Stats};
@@ -48,16 +48,16 @@ fn force_tails(a: &NetworkAnalysis, wet: bool) -> Vec<Tail> {
         let Some(t) = fit else { continue };
         let start = sign * t.threshold;
         tails.push(Tail { start, rate: t.rate, amplitude: t.density_at(0.0), label: Some(format!("{side}: exp(-{:.2} |x|), fitted", t.rate)), published: false });
-        let rate = if wet { seed001::ALPHA_W } else { seed001::BETA };
+        let rate = if wet { richefeu::ALPHA_W } else { richefeu::BETA };
         // One legend entry for the paper's lines.
-        let label = (k == 0).then(|| format!("exp(-{rate} |x|), seed 001"));
+        let label = (k == 0).then(|| format!("exp(-{rate} |x|), Richefeu et al. (2009)"));
         tails.push(Tail { start, rate, amplitude: t.density_at(t.threshold) * (rate * t.threshold).exp(), label, published: true });
     }
     tails
 }
 
 /// This run's force PDF beside `other`'s (its scene and frame, taken with contacts), as
-/// `force_pdf_beside.png` and `.svg` in `dir`. Two dry packings (seed 001's Figs. 2-3: MD
+/// `force_pdf_beside.png` and `.svg` in `dir`. Two dry packings (Richefeu et al.'s Figs. 2-3: MD
 /// beside CD, isotropic beside anisotropic) are each over their own mean force, which compares
 /// the shapes; otherwise both are over this run's force scale (Fig. 7: wet and dry over the
 /// wet run's `f0`).

@@ -7,7 +7,7 @@
 //! error names the fix; the run's data files are unaffected.
 
 use crate::analysis::fit::{BauerFit, Estimate, PowerLaw};
-use crate::analysis::seed000::{self, GUAMO};
+use crate::analysis::oquendo::{self, GUAMO};
 use crate::protocol::CompressionPoint;
 use anyhow::Context;
 use plotters::coord::Shift;
@@ -116,7 +116,7 @@ pub fn compression(stem: &Path, title: &str, points: &[CompressionPoint], fits: 
 }
 
 /// h_s against eta (log-log) across a sweep, with the power law and the Guamo point; with
-/// `paper`, seed 000's Tables 2-3 and its power law beside them.
+/// `paper`, Oquendo et al.'s Tables 2-3 and its power law beside them.
 pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: Option<&PowerLaw>, paper: bool) -> anyhow::Result<()> {
     fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str, points: &[(Estimate, Estimate)], law: Option<&PowerLaw>, paper: bool) -> anyhow::Result<()>
     where
@@ -124,7 +124,7 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
     {
         let err = |e: DrawingAreaErrorKind<DB::ErrorType>| anyhow::anyhow!("{e:?}");
         root.fill(&WHITE).map_err(err)?;
-        let published: Vec<(Estimate, Estimate)> = if paper { seed000::TABLES.iter().map(|r| (r.eta, r.h_s)).collect() } else { Vec::new() };
+        let published: Vec<(Estimate, Estimate)> = if paper { oquendo::TABLES.iter().map(|r| (r.eta, r.h_s)).collect() } else { Vec::new() };
         let all: Vec<&(Estimate, Estimate)> = points.iter().chain(&published).chain(std::iter::once(&GUAMO)).collect();
         // The x range reaches a decade's bounds, so that the log axis has labelled ticks.
         let x_lo = (all.iter().map(|p| (p.0.value - p.0.error).max(p.0.value * 0.5)).fold(f64::INFINITY, f64::min) * 0.8).min(0.1);
@@ -157,12 +157,12 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
         }
         if paper {
             let grey = RGBColor(150, 150, 150);
-            let l = seed000::POWER_LAW;
+            let l = oquendo::POWER_LAW;
             let line: Vec<(f64, f64)> = (0..=100).map(|k| x_lo * (x_hi / x_lo).powf(k as f64 / 100.0)).map(|x| (x, l.a.value * x.powf(l.b.value))).filter(|p| p.1 >= y_lo && p.1 <= y_hi).collect();
             chart
                 .draw_series(DashedLineSeries::new(line, 6, 4, grey.stroke_width(2)))
                 .map_err(err)?
-                .label(format!("seed 000: {}", l.line()))
+                .label(format!("Oquendo et al.: {}", l.line()))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey));
             chart
                 .draw_series(published.iter().map(|(eta, h)| ErrorBar::new_vertical(eta.value, (h.value - h.error).max(y_lo), h.value, h.value + h.error, grey.filled(), 6)))
@@ -170,7 +170,7 @@ pub fn hardness(stem: &Path, title: &str, points: &[(Estimate, Estimate)], law: 
             chart
                 .draw_series(published.iter().map(|(eta, h)| Rectangle::new([(eta.value * 0.985, h.value * 0.93), (eta.value * 1.015, h.value * 1.07)], grey.filled())))
                 .map_err(err)?
-                .label("seed 000, Tables 2-3")
+                .label("Oquendo et al., Tables 2-3")
                 .legend(move |(x, y)| Rectangle::new([(x + 4, y - 4), (x + 12, y + 4)], grey.filled()));
         }
         chart

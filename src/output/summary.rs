@@ -181,7 +181,7 @@ impl Summary {
             let _ = writeln!(s, "  Bauer's law, e0 fitted: {}; correlations ln h_s-eta {:.3}, ln h_s-e0 {}, eta-e0 {}", b.line(), c.ln_h_s_eta, r(c.ln_h_s_e0), r(c.eta_e0));
         }
         if let Some((p, a, b)) = self.bauer_profile.as_ref().and_then(|p| Some((p, p.points.first()?, p.points.last()?))) {
-            let law = p.power_law.map_or(String::new(), |l| format!("; along it {} (seed 000's sweep: {})", l.line(), crate::analysis::seed000::POWER_LAW.line()));
+            let law = p.power_law.map_or(String::new(), |l| format!("; along it {} (Oquendo et al.'s sweep: {})", l.line(), crate::analysis::oquendo::POWER_LAW.line()));
             let _ = writeln!(s, "  e0 profile: e0 {:.4} -> {:.4} moves h_s {:.3e} -> {:.3e} MPa and eta {:.3} -> {:.3}{law}", a.e0, b.e0, a.h_s / 1e6, b.h_s / 1e6, a.eta, b.eta);
         }
         let pf = self.final_state.packing_fraction.map_or("n/a".to_string(), |p| format!("{p:.4}"));
@@ -235,7 +235,7 @@ pub(crate) fn engine_bytes(scene: &Scene, real: usize, pairs_per_grain: f64) -> 
     let walls = !scene.walls.is_empty();
     let per_grain = ((18 + some(real == 4, 3) + some(scene.track_orientation, 4) + some(capillary, 1)) * real + 3 * 4 + 3 * 4 + some(scene.materials.len() > 1, 4) + 2 * scene.periodic.iter().filter(|p| p.is_some()).count()) as f64 + if walls { (1.0 + 4.0) / 64.0 } else { 0.0 };
     // The partner and the reverse index (u32), the history, the partner's share 6 and the
-    // normal force 1 reals, the capillary force, the owner's force (seed 000's law), the flags.
+    // normal force 1 reals, the capillary force, the owner's force (Oquendo et al.'s law), the flags.
     let per_pair = 8 + (stride + 7 + some(capillary, 1) + some(owner_force, 3)) * real + 1;
     // One history block per wall for each grain a wall can reach (`cpu::wall_springs`), as placed.
     let wall_springs = wall_candidates(scene) * scene.walls.len() * stride * real;

@@ -599,11 +599,11 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
         }
     };
     for (key, v, why) in [
-        ("v_slip", m.v_slip, "seed 000's contacts slide when their static spring fails its Coulomb test (mu_s), not above a speed"),
-        ("v_roll", m.v_roll, "seed 000's contacts roll when their rolling spring reaches the rolling friction, not above a speed"),
+        ("v_slip", m.v_slip, "Oquendo et al.'s contacts slide when their static spring fails its Coulomb test (mu_s), not above a speed"),
+        ("v_roll", m.v_roll, "Oquendo et al.'s contacts roll when their rolling spring reaches the rolling friction, not above a speed"),
     ] {
         if let Some(v) = v {
-            return Err(c.invalid(format!("model.{key}"), v, format!("is no longer used: {why}"), format!("remove `{key}` (see the README's \"Seed 000's contact law\")")));
+            return Err(c.invalid(format!("model.{key}"), v, format!("is no longer used: {why}"), format!("remove `{key}` (see the README's \"Oquendo et al.'s contact law\")")));
         }
     }
     let tangential_name = law(&m.tangential, "none");

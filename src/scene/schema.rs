@@ -84,7 +84,7 @@ pub struct MaterialSpec {
     pub mu_s: f64,
     /// Kinetic (sliding) friction coefficient mu_k (-). Default: mu_s.
     pub mu_k: Option<f64>,
-    /// Rolling angle theta_r (degrees) of seed 000's rolling regime. Default 0.
+    /// Rolling angle theta_r (degrees) of Oquendo et al.'s rolling regime. Default 0.
     #[serde(default)]
     pub rolling_angle: f64,
     /// Normal damping gamma_n (s^-1 m^-1/2) of `damping = "papers"`. Default 0.
@@ -284,7 +284,7 @@ pub struct ModelSpec {
     pub rolling: Option<String>,
     /// "none" (default) or "oquendo".
     pub twisting: Option<String>,
-    /// "none" (default) or "capillary" (seed 001's liquid bridges; a stage must wet the
+    /// "none" (default) or "capillary" (Richefeu et al.'s liquid bridges; a stage must wet the
     /// sample with `water_content`).
     pub cohesion: Option<String>,
     /// Liquid surface tension gamma_s (N/m), `cohesion = "capillary"`. Default 0.0728 (water).
@@ -301,16 +301,16 @@ pub struct ModelSpec {
     /// the elastic and damping normal force at zero where the dashpot would pull; false lets it
     /// pull at the end of a contact, as LIGGGHTS, EDEM and MercuryDPM do.
     pub limit_damping: Option<bool>,
-    /// No longer used (seed 000's contacts slide on their spring's Coulomb test); read only to
+    /// No longer used (Oquendo et al.'s contacts slide on their spring's Coulomb test); read only to
     /// say so.
     pub v_slip: Option<f64>,
-    /// No longer used (seed 000's contacts roll on their rolling spring's limit); read only to
+    /// No longer used (Oquendo et al.'s contacts roll on their rolling spring's limit); read only to
     /// say so.
     pub v_roll: Option<f64>,
-    /// Damping of seed 000's static and rolling springs as a fraction of their critical
+    /// Damping of Oquendo et al.'s static and rolling springs as a fraction of their critical
     /// damping (-), `tangential = "oquendo"`. Default 0.3.
     pub static_damping: Option<f64>,
-    /// How seed 000's rolling friction acts, `tangential = "oquendo"`: "torque" (default, a
+    /// How Oquendo et al.'s rolling friction acts, `tangential = "oquendo"`: "torque" (default, a
     /// momentum-conserving torque pair) or "as_written" (eqs. 8-9 on each grain).
     pub rolling_friction: Option<String>,
     /// Tangential spring as a ratio of the normal secant stiffness (-). Default: Mindlin
@@ -366,7 +366,7 @@ pub struct SimulationSpec {
     #[serde(default = "default_gravity")]
     pub gravity: [f64; 3],
     /// "velocity_verlet" (default; one force evaluation per step) or "optimized_verlet"
-    /// (seed 000 eqs. 11-15, two evaluations per step).
+    /// (Oquendo et al. eqs. 11-15, two evaluations per step).
     pub integrator: Option<String>,
     /// Time step (s) or "auto" (default): the smaller of 0.1 t_R and t_c / 50.
     pub dt: Option<DtSpec>,
@@ -446,7 +446,7 @@ pub struct StageSpec {
     pub p0: Option<f64>,
     /// "oedometer": last pressure (Pa), reached or not exceeded.
     pub p_max: Option<f64>,
-    /// "oedometer": pressure multiplier between steps. Default 2 (seed 000).
+    /// "oedometer": pressure multiplier between steps. Default 2 (Oquendo et al.).
     pub factor: Option<f64>,
     /// "oedometer": a seating load (Pa, below p0) put on the sample before p0, as an
     /// experimenter seats the cap: its void ratio is Bauer's e0 and it is not fitted.

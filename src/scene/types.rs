@@ -127,12 +127,12 @@ pub struct Wall {
     pub material: u16,
 }
 
-/// Time integration scheme (seed 000 sec. 3).
+/// Time integration scheme (Oquendo et al. sec. 3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Integrator {
     /// Velocity Verlet: one force evaluation per step.
     VelocityVerlet,
-    /// Optimised velocity Verlet (seed 000 eqs. 11-15), `xi = 0.1931833275037836`, two force
+    /// Optimised velocity Verlet (Oquendo et al. eqs. 11-15), `xi = 0.1931833275037836`, two force
     /// evaluations per step.
     OptimizedVerlet,
 }
@@ -346,7 +346,7 @@ pub struct BridgeLimits {
     pub reach: f64,
 }
 
-/// Default damping of seed 000's static and rolling springs, as a fraction of critical (-).
+/// Default damping of Oquendo et al.'s static and rolling springs, as a fraction of critical (-).
 pub const DEFAULT_STATIC_DAMPING: f64 = 0.3;
 /// Default tangential-to-normal stiffness ratio for the linear law (the classic 2/7).
 pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
@@ -354,7 +354,7 @@ pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
 pub const DEFAULT_UNBALANCED_FORCE: f64 = 0.01;
 /// Water's surface tension (N/m), the default of `model.surface_tension`.
 pub const DEFAULT_SURFACE_TENSION: f64 = 0.0728;
-/// Seed 001's decay-length constant `c` (its eq. 6).
+/// Richefeu et al.'s decay-length constant `c` (its eq. 6).
 pub const CAPILLARY_C: f64 = 0.9;
 /// Default liquid density (kg/m^3).
 pub const DEFAULT_LIQUID_DENSITY: f64 = 1000.0;
@@ -367,7 +367,7 @@ pub const BRIDGE_CAP_IN_MEANS: f64 = 8.0;
 
 /// Default tolerance on the piston's pressure at the end of a pressure stage.
 pub const DEFAULT_PRESSURE_TOLERANCE: f64 = 0.01;
-/// Default pressure multiplier between oedometer steps (seed 000: doubled).
+/// Default pressure multiplier between oedometer steps (Oquendo et al.: doubled).
 pub const DEFAULT_OEDOMETER_FACTOR: f64 = 2.0;
 /// Default settle speed, as a fraction of `sqrt(|g| d_mean)`.
 pub const DEFAULT_SETTLE_SPEED_FRACTION: f64 = 1e-2;

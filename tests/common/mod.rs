@@ -65,7 +65,7 @@ pub fn edit(text: &str, edits: &[(&str, &str)]) -> String {
     })
 }
 
-/// Seed 000's elastic gas made frictional, damped and wet (w = 0.01): 120 grains whose
+/// Oquendo et al.'s elastic gas made frictional, damped and wet (w = 0.01): 120 grains whose
 /// liquid bridges break and form as they collide.
 pub fn wet_gas() -> Scene {
     let text = std::fs::read_to_string(scene_path("elastic_gas.toml")).unwrap();
@@ -83,7 +83,7 @@ pub fn wet_gas() -> Scene {
 }
 
 /// A dense, frictional, colliding gas of `count` grains (0.8-1.2 mm) in a box of `side` metres
-/// under gravity, with seed 000's laws (the force on the owner kept per pair) and orientations
+/// under gravity, with Oquendo et al.'s laws (the force on the owner kept per pair) and orientations
 /// tracked: many pairs, wall contacts and rebuilds.
 pub fn box_gas(count: usize, side: f64) -> String {
     format!(

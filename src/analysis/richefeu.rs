@@ -1,4 +1,4 @@
-//! Seed 001's published figures (Richefeu, El Youssofi, Azema, Radjai 2009), for the reports
+//! Richefeu et al.'s published figures (Richefeu, El Youssofi, Azema, Radjai 2009), for the reports
 //! that set ours beside them.
 
 /// `beta` of the dry force PDF's tail, `P ~ exp(-beta f/<f>)` (eq. 9, samples S_1 and S_4).

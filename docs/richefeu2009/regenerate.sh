@@ -1,5 +1,5 @@
 #!/bin/bash
-# Regenerates docs/seed001/: runs seed 001's four samples (with the wetted-loose variants of
+# Regenerates docs/richefeu2009/: runs Richefeu et al.'s four samples (with the wetted-loose variants of
 # the wet ones, and the dry ones again by contact dynamics) over three seeds each as sweeps,
 # draws Fig. 7 (wet beside dry at 100 Pa) and the CD samples beside the MD ones, and copies
 # the seed-5 figures and each sweep's ensemble.csv here. About 5 h of CPU (the CD samples
@@ -9,7 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/../.."
 cargo build --release
 G=target/release/grains
-DOCS=docs/seed001
+DOCS=docs/richefeu2009
 for s in dry_iso_100pa dry_triaxial wet_iso_0pa wet_iso_100pa wet_iso_0pa_wetted_loose wet_iso_100pa_wetted_loose cd_iso_100pa cd_triaxial; do
   "$G" sweep "scenes/seeds/$s.toml" --jobs 2 --threads 1
   cp "scenes/seeds/$s-runs/ensemble.csv" "$DOCS/$s.csv"

@@ -1,4 +1,4 @@
-//! Seed 000's published results (its Tables 2 and 3, its power law and its Guamo sand
+//! Oquendo et al.'s published results (its Tables 2 and 3, its power law and its Guamo sand
 //! experiment), to be drawn and tabulated beside ours.
 //!
 //! The tables vary one micro-parameter at a time around the base set V = 18 GPa, gamma_n =
