@@ -80,7 +80,7 @@ impl Schedule {
         let first = with_elapsed(&step, 0.0);
         let step = with_elapsed(&step, drifts_after_last);
         let (first_sweeps, step_sweeps) = (sweeps(&first), sweeps(&step));
-        let centred_kicks = matches!(integrator, Integrator::VelocityVerlet);
+        let centred_kicks = centred_kicks(integrator);
         Schedule { prologue: vec![Op::RebuildIfNeeded, Op::Forces { elapsed: 0.0 }], needs_loads: matches!(step[0], Kick { .. }), centred_kicks, first, step, first_sweeps, step_sweeps }
     }
 
@@ -131,6 +131,12 @@ fn with_elapsed(ops: &[Op], carried: f64) -> Vec<Op> {
             }
         })
         .collect()
+}
+
+/// Whether `integrator`'s force evaluations each stand for the kicks half a step either side
+/// of them (velocity Verlet): [`Schedule::centred_kicks`].
+pub fn centred_kicks(integrator: Integrator) -> bool {
+    matches!(integrator, Integrator::VelocityVerlet)
 }
 
 /// A record of the operations an engine ran, for checking both engines walk one schedule.

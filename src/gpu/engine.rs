@@ -524,7 +524,7 @@ impl GpuEngine {
             ("HAS_ROLLING_HISTORY", self.history.rolling as u8 as f64),
             ("NORMAL_SLOT", layout::normal_slot(self.history) as f64),
             ("LIMIT_DAMPING", m.limit_damping as u8 as f64),
-            ("CENTRED_KICKS", Schedule::new(scene.integrator, 1.0).centred_kicks as u8 as f64),
+            ("CENTRED_KICKS", crate::schedule::centred_kicks(scene.integrator) as u8 as f64),
         ];
         let orientation = ("TRACK_ORIENTATION", self.track_orientation as u8 as f64);
         let wall_response = ("WALL_RESPONSE", self.servo.is_some() as u8 as f64);
