@@ -13,7 +13,7 @@
 use super::pairs::PairList;
 use super::state::{Body, HistorySlots, Load, PairFlags, Props};
 use super::lanes::PairSink;
-use crate::model::{capillary_force, contact_force, parted_normal_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, KickWindow, Kinematics, PairCoeffs};
+use crate::model::{capillary_force, contact_force, parted_normal_force, Bodies, CohesionLaw, ContactForce, ContactModel, Geometry, KickWindow, Kinematics, PairCoeffs};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 
@@ -60,11 +60,10 @@ impl<'a, T: Real> ForceContext<'a, T> {
         coeffs_of(self.coeffs, self.n_materials, wall as usize, grain)
     }
 
-    /// Whether a contact that has parted can still pull ([`parted_normal_force`]): a damped
-    /// law without the no-pull clamp, inside a window.
+    /// Whether a contact that has parted can still pull ([`crate::model::window::ends_pull`]).
     #[inline(always)]
     pub fn ends_pull(&self) -> bool {
-        !self.model.limit_damping && !matches!(self.model.damping, DampingLaw::None) && self.window > T::ZERO
+        crate::model::window::ends_pull(self.model, self.window)
     }
 
     /// The separation `r_i - r_j` of slots `i` and `j` (m, minimum image, residuals included).

@@ -137,6 +137,13 @@ pub fn driven_normal_velocity<T: Real>(v_i: crate::real::Vec3<T>, v_j: crate::re
     if j_is_wall { v_i.dot(n) } else { (v_i - v_j).dot(n) }
 }
 
+/// Whether a contact of `model` that has parted can still pull within a window of `window`
+/// (s): a damped law without the no-pull clamp, inside a window ([`parted_normal_force`]).
+#[inline(always)]
+pub fn ends_pull<T: Real>(model: &ContactModel<T>, window: T) -> bool {
+    !model.limit_damping && !matches!(model.damping, DampingLaw::None) && window > T::ZERO
+}
+
 /// The normal force (N, compressive positive; negative: a pull) a contact without the no-pull
 /// clamp applies on the evaluation after it parted, `h <= 0` (m) the overlap now: where the
 /// last drift's separation `v_n` (m/s, positive separating) took it from touching at the
@@ -146,7 +153,7 @@ pub fn driven_normal_velocity<T: Real>(v_i: crate::real::Vec3<T>, v_j: crate::re
 #[inline(always)]
 pub fn parted_normal_force<T: Real>(model: &ContactModel<T>, c: &PairCoeffs<T>, geo: &Geometry<T>, v_n: T, window: T) -> T {
     let half = T::of(0.5) * window;
-    if model.limit_damping || matches!(model.damping, DampingLaw::None) || !(v_n * half > -geo.h) {
+    if !ends_pull(model, window) || !(v_n * half > -geo.h) {
         return T::ZERO;
     }
     // The contact lasted `span` into this window, its overlap falling to zero at the parting.
