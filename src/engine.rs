@@ -426,7 +426,7 @@ pub trait Engine {
     /// fixed strain rate (1/s, positive closing) or back to pressure control (`None`).
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>);
     /// Wets the sample with `volume` (m^3) of liquid: shared among the pairs closer than their
-    /// rupture distance in proportion to their reduced diameter (Richefeu et al. (2009), PHYSICS.md).
+    /// rupture distance in proportion to their reduced diameter (Richefeu et al. (2009), docs/physics.md).
     fn wet(&mut self, volume: f64) -> anyhow::Result<()>;
     /// Moves the piston to height `z` (m) and stops it; no effect without a piston. The host
     /// places it where it touches nothing yet, so the last forces stay valid.

@@ -41,7 +41,7 @@ pub trait Real:
     /// True for the GPU's precision (`f32`): its CPU engine is the GPU's twin and adds the
     /// walls' sums in the GPU's workgroup order ([`crate::workgroup`]), so the two agree bit
     /// for bit. `f64`, the reference, keeps its running sums over fixed chunks of ids, the order
-    /// every figure the README quotes from it was computed in.
+    /// every figure the documentation quotes from it was computed in.
     const GPU_TWIN: bool;
     /// Converts from `f64`, rounding to nearest.
     fn of(x: f64) -> Self;

@@ -1,4 +1,4 @@
-//! Time step from the Rayleigh and Hertz times (PHYSICS.md "Time step").
+//! Time step from the Rayleigh and Hertz times (docs/physics.md "Time step").
 //!
 //! * Rayleigh time `t_R = pi R_min sqrt(rho / G) / (0.1631 nu + 0.8766)`, `G = E / (2 (1 + nu))`,
 //!   for the smallest grain of each material (Hertz law only: the linear law has no elastic

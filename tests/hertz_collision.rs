@@ -1,4 +1,4 @@
-//! Head-on collision of two spheres against the Hertz formulas (PHYSICS.md "Time step") and
+//! Head-on collision of two spheres against the Hertz formulas (docs/physics.md "Time step") and
 //! the peers' published figures (shared/peers/README.md, two-sphere collision).
 
 mod common;

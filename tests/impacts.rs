@@ -181,7 +181,7 @@ mod oblique {
         4.0 / 3.0 * std::f64::consts::PI * R.powi(3) * RHO
     }
 
-    /// `V_eff` and `G_eff` (Pa) of steel on steel (PHYSICS.md's mixing).
+    /// `V_eff` and `G_eff` (Pa) of steel on steel (docs/physics.md's mixing).
     pub fn moduli() -> (f64, f64) {
         let v = E / (1.0 - NU * NU);
         let g = E / (2.0 * (1.0 + NU));

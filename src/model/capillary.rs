@@ -1,4 +1,4 @@
-//! Capillary cohesion of a liquid bridge (Richefeu et al. (2009) eqs. 1-8, PHYSICS.md), derived from the
+//! Capillary cohesion of a liquid bridge (Richefeu et al. (2009) eqs. 1-8, docs/physics.md), derived from the
 //! paper: the force is `f0 = -kappa R` while the grains touch, decays as `f0 exp(-delta/lambda)`
 //! across the gap `delta`, and vanishes beyond the rupture distance `delta_max`.
 
@@ -75,7 +75,7 @@ pub fn capillary_potential<T: Real>(kappa: T, theta: T, c: T, r_i: T, r_j: T, v_
 /// the others' shares, until none drops. `pairs` are each pair's radii and surface gap
 /// `(R_i, R_j, gap)` (m), `theta` the contact angle (rad). Returns each wetted pair's
 /// `(index, volume)` and the volume left over, which waits on the grains (Richefeu et al. (2009),
-/// PHYSICS.md).
+/// docs/physics.md).
 pub fn share_liquid(volume: f64, pairs: &[(f64, f64, f64)], cap: f64, theta: f64) -> (Vec<(usize, f64)>, f64) {
     let d: Vec<f64> = pairs.iter().map(|&(ri, rj, _)| 2.0 * ri * rj / (ri + rj)).collect();
     let gaps: Vec<f64> = pairs.iter().map(|p| p.2).collect();

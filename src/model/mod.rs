@@ -1,7 +1,7 @@
 //! Contact sub-models as pure functions, composed in a fixed order:
 //! geometry -> normal (elastic + damping, no-pull clamp) -> tangential -> rolling -> twisting.
 //!
-//! Every law follows `PHYSICS.md`. Conventions: the normal `n` points from partner `j` to grain
+//! Every law follows docs/physics.md. Conventions: the normal `n` points from partner `j` to grain
 //! `i`; the overlap `h > 0` in contact; forces and torques are "on i" unless named `_j`.
 //! A wall is a partner with infinite radius and mass (`R_eff = R_i`, `m_eff = m_i`) that does
 //! not spin.
@@ -315,7 +315,7 @@ pub struct ContactModel<T> {
     /// Cohesion.
     pub cohesion: CohesionLaw<T>,
     /// The no-pull clamp: the elastic and damping normal force together is held at zero
-    /// where the dashpot would pull (PHYSICS.md ruling; LAMMPS' `limit_damping`). Off, the
+    /// where the dashpot would pull (docs/physics.md ruling; LAMMPS' `limit_damping`). Off, the
     /// dashpot pulls at the end of a contact (as in LIGGGHTS, EDEM and MercuryDPM) and the
     /// friction limits take the force's magnitude.
     pub limit_damping: bool,
@@ -440,7 +440,7 @@ impl MaterialConstants {
 
 impl<T: Real> PairCoeffs<T> {
     /// Coefficients for a contact between materials `a` and `b`. Elastic constants combine
-    /// as PHYSICS.md rules; friction coefficients and the rolling angle take the smaller of
+    /// as docs/physics.md rules; friction coefficients and the rolling angle take the smaller of
     /// the two (as YADE does: a frictionless wall makes frictionless contacts); damping and
     /// restitution take the arithmetic mean. Equal materials give their own values. The
     /// dashpot ratio is sized for `model`'s normal law and clamp.
@@ -683,7 +683,7 @@ impl ContactModel<f64> {
 
 #[cfg(test)]
 mod tests {
-    //! The laws against values computed by hand from PHYSICS.md.
+    //! The laws against values computed by hand from docs/physics.md.
     use super::*;
 
     /// Relative tolerance for hand-computed values (f64 round-off and printed digits).

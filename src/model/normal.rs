@@ -1,4 +1,4 @@
-//! Normal force: elastic law, damping law, no-pull clamp (Oquendo et al. eq. 1, PHYSICS.md).
+//! Normal force: elastic law, damping law, no-pull clamp (Oquendo et al. eq. 1, docs/physics.md).
 
 use super::{DampingLaw, Geometry, NormalLaw, PairCoeffs};
 use crate::real::Real;
@@ -35,7 +35,7 @@ pub fn normal_damping<T: Real>(law: &DampingLaw<T>, normal: &NormalLaw<T>, c: &P
 }
 
 /// Total normal force magnitude `F_el - eta v_n` (N, compressive positive), with the no-pull
-/// clamp when `limit_damping`: then held at zero where the dashpot would pull (PHYSICS.md
+/// clamp when `limit_damping`: then held at zero where the dashpot would pull (docs/physics.md
 /// ruling; LAMMPS' `limit_damping`). Returns the force and whether the clamp acted.
 #[inline(always)]
 pub fn normal_force<T: Real>(f_elastic: T, eta: T, v_n: T, limit_damping: bool) -> (T, bool) {

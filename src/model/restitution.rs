@@ -184,7 +184,7 @@ mod tests {
     }
 
     /// The clamp cuts the dashpot's pull at the end of a contact, so the same dashpot gives a
-    /// larger restitution clamped (the figures the README quotes: e = 0.2 sized as LIGGGHTS
+    /// larger restitution clamped (the figures docs/physics.md quotes: e = 0.2 sized as LIGGGHTS
     /// sizes it gives 0.32 under the clamp).
     #[test]
     fn the_clamp_raises_the_restitution_of_a_given_dashpot() {

@@ -54,7 +54,7 @@ pub fn contact_tangential_velocity<T: Real>(g: &Geometry<T>, k: &Kinematics<T>) 
     v_p - g.n * v_p.dot(g.n)
 }
 
-/// Oquendo et al.'s three regimes (PHYSICS.md "Tangential force"), realised so that a loaded
+/// Oquendo et al.'s three regimes (docs/physics.md "Tangential force"), realised so that a loaded
 /// contact that should stick does stick at any `F_n dt / m*`:
 ///
 /// - **static**: an elastic spring `xi` (history, m), rotated into the tangent plane and grown

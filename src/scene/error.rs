@@ -60,11 +60,11 @@ impl SceneError {
         let key = text.lines().nth(line.saturating_sub(1)).and_then(|l| l.split_once('=')).map(|(k, _)| format!("key `{}`: ", k.trim()));
         let message = format!("{}{}{}", key.unwrap_or_default(), err.message().replace('\n', " ").trim(), table.unwrap_or_default());
         let fix = if message.contains("unknown field") {
-            "correct the key's spelling or remove it (the README's scene reference lists every key)"
+            "correct the key's spelling or remove it (docs/scene-reference.md lists every key)"
         } else if message.contains("missing field") {
-            "add the key (the README's scene reference gives its unit and meaning)"
+            "add the key (docs/scene-reference.md gives its unit and meaning)"
         } else {
-            "correct the value to the type the README's scene reference gives"
+            "correct the value to the type docs/scene-reference.md gives"
         };
         SceneError::Syntax { file: file.to_path_buf(), line, message, fix: fix.to_string() }
     }

@@ -603,7 +603,7 @@ fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains:
         ("v_roll", m.v_roll, "Oquendo et al.'s contacts roll when their rolling spring reaches the rolling friction, not above a speed"),
     ] {
         if let Some(v) = v {
-            return Err(c.invalid(format!("model.{key}"), v, format!("is no longer used: {why}"), format!("remove `{key}` (see the README's \"Oquendo et al.'s contact law\")")));
+            return Err(c.invalid(format!("model.{key}"), v, format!("is no longer used: {why}"), format!("remove `{key}` (docs/physics.md, \"Oquendo et al.'s contact law\")")));
         }
     }
     let tangential_name = law(&m.tangential, "none");

@@ -1,7 +1,7 @@
 //! The TOML scene schema, as written by users. Every key is documented with its unit; unknown
 //! keys are rejected. [`super::load`] turns a file into a validated [`super::Scene`].
 //!
-//! Keep the README's scene reference in step with this file.
+//! docs/scene-reference.md documents every key; tests/docs.rs checks it against this schema.
 
 use serde::Deserialize;
 
@@ -297,7 +297,7 @@ pub struct ModelSpec {
     pub k_n: Option<f64>,
     /// Viscous coefficient c_n (N s/m), `damping = "viscous"`.
     pub c_n: Option<f64>,
-    /// The no-pull clamp (LAMMPS' `limit_damping`): true (default, PHYSICS.md's ruling) holds
+    /// The no-pull clamp (LAMMPS' `limit_damping`): true (default, docs/physics.md's ruling) holds
     /// the elastic and damping normal force at zero where the dashpot would pull; false lets it
     /// pull at the end of a contact, as LIGGGHTS, EDEM and MercuryDPM do.
     pub limit_damping: Option<bool>,

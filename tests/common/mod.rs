@@ -37,6 +37,15 @@ pub fn with_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R 
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool").install(f)
 }
 
+/// Says on the terminal that the running test is skipped and why. The test harness captures
+/// `eprintln!` of a passing test, so this writes to stderr itself: `cargo test` then shows one
+/// `SKIPPED` line per test that returned early, under its name.
+pub fn skipped(reason: &str) {
+    use std::io::Write;
+    let name = std::thread::current().name().unwrap_or("(unnamed)").to_string();
+    let _ = writeln!(std::io::stderr().lock(), "test {name} ... SKIPPED: {reason}");
+}
+
 /// Opens the best GPU adapter. Without one, CI fails (it installs lavapipe) and a developer
 /// machine skips the test with a visible message.
 pub fn gpu() -> Option<grains::gpu::Gpu> {
@@ -44,7 +53,7 @@ pub fn gpu() -> Option<grains::gpu::Gpu> {
         Ok(g) => Some(g),
         Err(e) if std::env::var_os("CI").is_some() => panic!("CI must have a GPU adapter (lavapipe): {e}"),
         Err(e) => {
-            eprintln!("SKIPPED (no GPU adapter): {e}");
+            skipped(&e.to_string());
             None
         }
     }
@@ -137,7 +146,7 @@ pub fn reader(program: &str, args: &[&str], package: &str) -> bool {
         if std::env::var_os("CI").is_some() {
             panic!("CI must have {program} (Debian package {package}); .ci/run installs it");
         }
-        eprintln!("SKIPPED ({program} from the Debian package {package} is not installed)");
+        skipped(&format!("{program} is not installed; install the Debian package {package}"));
     }
     ok
 }

@@ -48,7 +48,7 @@ pub struct VtkRecorder {
     written: Vec<(f64, usize)>,
     /// The last statistics read: where the servo walls stand, for particle pressures.
     stats: Stats,
-    /// Bytes of the last frame's grain file, for the README's figure.
+    /// Bytes of the last frame's grain file, for the bytes-per-grain figure of docs/outputs.md.
     last_grain_bytes: u64,
     /// The lowest number the next file may take (after every file on disk when resumed).
     floor: usize,
