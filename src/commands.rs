@@ -13,9 +13,9 @@ use std::path::Path;
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Run { scene, resume, backend, adapter, precision, out, json, vtk, threads, force } => {
-            // Under mpirun, one run over every process (see grains::ranks); alone, one process.
+            // Under mpirun, one run over every process (see grains::cpu::ranks); alone, one process.
             #[cfg(feature = "mpi")]
-            let _mpi = grains::ranks::init();
+            let _mpi = grains::cpu::ranks::init();
             // The whole run happens on a worker of the pool, so that the CPU kernels' parallel
             // loops split work among workers instead of waking them from outside every time.
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads.unwrap_or(0)).build().context("cannot start the worker threads")?;

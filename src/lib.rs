@@ -19,12 +19,11 @@ pub mod output;
 pub mod periodic;
 pub mod position;
 pub mod protocol;
-#[cfg(feature = "mpi")]
-pub mod ranks;
 pub mod real;
 pub mod runner;
 pub mod schedule;
 pub mod scene;
+pub mod state;
 pub mod sweep;
 pub mod timestep;
 pub mod walls;

@@ -35,8 +35,8 @@ pub fn cpu_engine(scene: &Scene, precision: &str) -> anyhow::Result<Box<dyn Engi
     #[cfg(feature = "mpi")]
     if processes() > 1 {
         return Ok(match precision {
-            "f32" => Box::new(crate::ranks::Distributed::<f32>::new(scene)?),
-            "f64" => Box::new(crate::ranks::Distributed::<f64>::new(scene)?),
+            "f32" => Box::new(crate::cpu::ranks::Distributed::<f32>::new(scene)?),
+            "f64" => Box::new(crate::cpu::ranks::Distributed::<f64>::new(scene)?),
             other => anyhow::bail!("precision `{other}`: the CPU engine computes in f32 or f64; fix: give --precision f32 or f64"),
         });
     }
@@ -124,7 +124,7 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
 /// several processes (feature `mpi`), where rank 0 alone does.
 pub fn is_root() -> bool {
     #[cfg(feature = "mpi")]
-    return crate::ranks::is_root();
+    return crate::cpu::ranks::is_root();
     #[cfg(not(feature = "mpi"))]
     true
 }
@@ -132,7 +132,7 @@ pub fn is_root() -> bool {
 /// Processes this run is spread over: 1, unless started by mpirun (feature `mpi`).
 pub fn processes() -> usize {
     #[cfg(feature = "mpi")]
-    return crate::ranks::size();
+    return crate::cpu::ranks::size();
     #[cfg(not(feature = "mpi"))]
     1
 }

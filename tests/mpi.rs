@@ -13,7 +13,7 @@ mod common;
 
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
-use grains::ranks::{Grid, Slabs};
+use grains::cpu::ranks::{Grid, Slabs};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

@@ -260,7 +260,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
     }
 
     fn memory_bytes(&self) -> u64 {
-        use crate::cpu::allocated;
+        use crate::state::allocated;
         let warm = (self.warm.capacity() * std::mem::size_of::<((u32, Partner), Vec3<T>)>()) as u64;
         allocated(&self.id) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.contacts) + warm
     }

@@ -37,8 +37,8 @@
 //! contacts one after the other; the schedule depends on the contacts alone, so a step gives
 //! the same bits on any thread count.
 
-use crate::cpu::profile::{PhaseClock, Phases};
-use crate::cpu::{Body, PairList, Props};
+use crate::state::profile::{PhaseClock, Phases};
+use crate::state::{Body, PairList, Props};
 use crate::engine::SimError;
 use crate::periodic::Periodic;
 use crate::position;
@@ -348,9 +348,9 @@ impl<T: Real> ContactDynamics<T> {
     fn detect(&mut self) {
         let allowance = T::of(self.params.gap_allowance);
         let periodic = Periodic::<T>::of(&[None, None, None]);
-        let mut grid = crate::cpu::CellGrid::default();
+        let mut grid = crate::state::CellGrid::default();
         let cutoff = self.r_max * T::of(2.0) + allowance;
-        crate::cpu::hash_cells(&self.body, cutoff, &periodic, &mut grid);
+        crate::state::hash_cells(&self.body, cutoff, &periodic, &mut grid);
         let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grid, &periodic, allowance, usize::MAX).unwrap_or_default();
         let mut contacts = Vec::with_capacity(pairs.len() + self.walls.len());
         for (a, &b) in pairs.owners_of(0..pairs.len()).zip(&pairs.partner) {

@@ -4,8 +4,8 @@
 use super::colour::Schedule;
 use super::{Contact, Partner, Solved, Sweeps, WallMotion};
 use crate::engine::SimError;
-use crate::cpu::reduce::PAR_MIN_PAIRS;
-use crate::cpu::Body;
+use crate::state::reduce::PAR_MIN_PAIRS;
+use crate::state::Body;
 use crate::real::{Real, Vec3};
 use rayon::prelude::*;
 

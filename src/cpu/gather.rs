@@ -3,8 +3,8 @@
 //! grain owns there; the wall pass adds the walls' after). No float atomics, so the result
 //! does not depend on scheduling.
 
-use super::pairs::PairList;
-use super::state::Load;
+use crate::state::PairList;
+use crate::state::Load;
 use crate::real::{Real, Vec3};
 
 /// `gather` for grain `i`, whose load holds the pair pass's owner sum.

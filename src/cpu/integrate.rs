@@ -2,7 +2,7 @@
 //! one grain. Velocity Verlet and Oquendo et al.'s optimised velocity Verlet are sequences of these.
 
 use super::built_at;
-use super::state::{Body, Load, Props};
+use crate::state::{Body, Load, Props};
 use crate::position;
 use crate::real::{Real, Vec3};
 

@@ -13,9 +13,9 @@
 //! force `f0` by a select. Same operations on the same inputs, so the same bits as
 //! `pair_force`; `tests` below check it.
 
-use super::pair_force::ForceContext;
-use super::pairs::PairList;
-use super::state::{Body, Props};
+use crate::state::ForceContext;
+use crate::state::PairList;
+use crate::state::{Body, Props};
 use crate::model::{at_edge, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, Regime, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw, KickWindow};
 use crate::position::{complete, residual_at};
 use crate::real::{Real, Vec3};
@@ -402,7 +402,7 @@ mod tests {
     use crate::cpu::pair_force::pair_force;
     use crate::cpu::CpuEngine;
     use crate::engine::Engine;
-    use crate::cpu::state::Load;
+    use crate::state::Load;
     use crate::cpu::wall_contacts::wall_contacts;
 
     const SCENE: &str = r#"

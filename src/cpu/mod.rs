@@ -8,23 +8,21 @@
 //! invocation writes its own output, and reductions combine fixed chunks in order.
 
 mod gather;
-mod grid;
 mod built_at;
 mod controllers;
 mod integrate;
 mod lanes;
 mod pair_force;
-mod pairs;
-// What a run over several processes reads and writes of the engine (src/ranks).
+// What a run over several processes reads and writes of the engine (ranks/).
 #[cfg(feature = "mpi")]
 mod parts;
-pub(crate) mod profile;
-pub(crate) mod reduce;
 mod reorder;
 mod snapshot;
 mod split;
 pub mod simd;
-mod state;
+// One run over several processes: the engine's step with hooks between its operations.
+#[cfg(feature = "mpi")]
+pub mod ranks;
 mod stats;
 mod traffic;
 mod wall_contacts;
@@ -32,15 +30,11 @@ mod wall_springs;
 mod warm;
 
 pub use integrate::rotate;
-pub use pairs::{owned_pairs, PairList};
 #[cfg(feature = "mpi")]
 pub(crate) use parts::{state_of_rows, touch_of_row, touches_state, RowWidths, Rows, BRIDGE_ROW, TOUCH_ROW};
 #[cfg(feature = "mpi")]
 pub(crate) use wall_contacts::WallTouch as WallContact;
-pub use pair_force::ForceContext;
-pub use profile::PHASE_NAMES;
-pub use state::{Body, Counts, HistorySlots, ImageCount, Images, Load, PairFlags, PairReports, Props};
-pub use wall_contacts::{wall_contact_records, WallState};
+use crate::state::{allocated, renew, Body, Counts, ForceContext, HistorySlots, ImageCount, Images, Load, PairFlags, PairList, PairReports, Props, WallState};
 
 use crate::engine::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
@@ -53,13 +47,13 @@ use crate::scene::{Scene, WallShape};
 use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
 use gather::gather_block;
-pub(crate) use grid::{hash_cells, CellGrid};
+use crate::state::{hash_cells, CellGrid};
 use pair_force::{owner_block, OwnerBlock, TaskScratch};
-use profile::{Phase, PhaseClock};
+use crate::state::profile::{Phase, PhaseClock};
 use reorder::Renumbering;
 use rayon::prelude::*;
 use std::borrow::Cow;
-use reduce::{chunked, CHUNK, PAR_MIN_ITEMS};
+use crate::state::reduce::{chunked, CHUNK, PAR_MIN_ITEMS};
 use wall_contacts::{wall_block, WallTouch};
 use wall_springs::WallSprings;
 
@@ -285,7 +279,7 @@ impl<T: Real> CpuEngine<T> {
             .map_err(|(i, count)| SimError::Capacity { step: self.step, grain: self.id[i], count, capacity: self.capacity })?;
         self.clock.stop(Phase::Detect, t);
         let t = self.clock.start();
-        self.hist = pairs::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
+        self.hist = crate::state::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
         self.pairs = pairs;
         if self.reorder_every > 0 && self.rebuilds.is_multiple_of(self.reorder_every) {
             self.reorder(&grid);
@@ -750,7 +744,7 @@ impl<T: Real> CpuEngine<T> {
 
 /// What a driver does between the operations of a step: the distributed engine exchanges
 /// the grains other processes own after each drift, decides rebuilds over every process and
-/// sums the walls' loads over them after each force evaluation ([`crate::ranks`]).
+/// sums the walls' loads over them after each force evaluation ([`crate::cpu::ranks`]).
 pub(crate) trait StepHooks<T: Real> {
     /// After each drift.
     fn drifted(&mut self, e: &mut CpuEngine<T>) -> Result<(), SimError>;
@@ -1085,15 +1079,6 @@ fn take_front<'a, X>(s: &mut &'a mut [X], n: usize) -> &'a mut [X] {
     front
 }
 
-/// Resizes `v` to `n` default values with no growth slack (a pair array of 10^6 grains is tens
-/// of megabytes).
-pub(crate) fn renew<X: Clone + Default>(v: &mut Vec<X>, n: usize) {
-    v.clear();
-    v.shrink_to(n);
-    v.reserve_exact(n);
-    v.resize(n, X::default());
-}
-
 /// `slot` where it is kept (as long as `id`), else the inverse of `id`.
 fn kept_or_found<'a>(slot: &'a [u32], id: &[u32]) -> Cow<'a, [u32]> {
     if slot.len() == id.len() {
@@ -1110,12 +1095,6 @@ fn slots_of(id: &[u32]) -> Vec<u32> {
         slot[i as usize] = s as u32;
     }
     slot
-}
-
-/// Bytes a vector holds allocated.
-#[allow(clippy::ptr_arg)] // the capacity lives on the Vec, not the slice
-pub(crate) fn allocated<X>(v: &Vec<X>) -> u64 {
-    (v.capacity() * std::mem::size_of::<X>()) as u64
 }
 
 impl<T: Real> Engine for CpuEngine<T> {

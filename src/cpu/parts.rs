@@ -1,5 +1,5 @@
 //! The engine's state cut into rows, one per grain and one per pair, keyed by permanent id:
-//! what the processes of a distributed run ([`crate::ranks`]) send one another when grains
+//! what the processes of a distributed run ([`crate::cpu::ranks`]) send one another when grains
 //! change hands, and what they gather into the whole state. A set of rows becomes a state
 //! again ([`state_of_rows`]) in the checkpoint's format, so that `restore_state` takes it.
 //! Also what a distributed driver reads and writes of the engine between the operations of a
@@ -99,7 +99,7 @@ impl Rows {
             }
         }
         let (starts, partner) = (&s.ints["owner_start"], &s.ints["partner"]);
-        for (slot, k) in super::pairs::owned_pairs(starts) {
+        for (slot, k) in crate::state::owned_pairs(starts) {
             let (a, b) = (id[slot] as u32, id[partner[k] as usize] as u32);
             if keep_pair(a, b) {
                 rows.pairs.extend([a as f64, b as f64]);

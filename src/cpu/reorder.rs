@@ -7,17 +7,17 @@
 //! moves too, and every order that reaches a result is taken in permanent ids, so a run gives
 //! the same bits however its slots are numbered.
 
-use super::grid::CellGrid;
-use super::pairs::PairList;
-use super::reduce::chunked;
-use super::state::Body;
+use crate::state::CellGrid;
+use crate::state::PairList;
+use crate::state::reduce::chunked;
+use crate::state::Body;
 use crate::real::Real;
 use rayon::prelude::*;
 
 /// The slots in Z order of their cells (slot order within a cell): the `from` of a
 /// [`Renumbering`] into cell order.
 pub fn z_order<T: Real>(grid: &CellGrid<T>, body: &[Body<T>]) -> Vec<u32> {
-    let mut keyed: Vec<(u64, u32)> = body.par_iter().with_min_len(super::reduce::PAR_MIN_ITEMS).enumerate().map(|(i, b)| (morton(grid.coords(b.pos)), i as u32)).collect();
+    let mut keyed: Vec<(u64, u32)> = body.par_iter().with_min_len(crate::state::reduce::PAR_MIN_ITEMS).enumerate().map(|(i, b)| (morton(grid.coords(b.pos)), i as u32)).collect();
     keyed.par_sort_unstable();
     keyed.into_iter().map(|(_, i)| i).collect()
 }
@@ -71,7 +71,7 @@ impl Renumbering {
             return;
         }
         let old = &*v;
-        let moved: Vec<X> = self.from.par_iter().with_min_len(super::reduce::PAR_MIN_ITEMS).flat_map_iter(|&o| old[o as usize * width..(o as usize + 1) * width].iter().copied()).collect();
+        let moved: Vec<X> = self.from.par_iter().with_min_len(crate::state::reduce::PAR_MIN_ITEMS).flat_map_iter(|&o| old[o as usize * width..(o as usize + 1) * width].iter().copied()).collect();
         *v = moved;
     }
 

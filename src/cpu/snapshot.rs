@@ -1,6 +1,7 @@
 //! Snapshots of the engine: frames for the recording, and the whole state for checkpoints.
 
 use super::*;
+use crate::state::wall_contact_records;
 
 impl<T: Real> CpuEngine<T> {
     /// The grain state in permanent-id order, and the touching pairs (canonical order) and

@@ -19,8 +19,8 @@
 //! without being kept in step with them.
 
 use super::pair_force::OWNERS;
-use super::pairs::PairList;
-use super::reduce::PAR_MIN_PAIRS;
+use crate::state::PairList;
+use crate::state::reduce::PAR_MIN_PAIRS;
 
 /// Parts start at multiples of this many slots: the pair pass's owner blocks.
 pub const ALIGN: usize = OWNERS;

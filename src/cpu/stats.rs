@@ -3,7 +3,7 @@
 //! however the slots are numbered).
 
 use super::*;
-use super::pair_force::coeffs_of;
+use crate::state::coeffs_of;
 
 /// Per-chunk partial sums of the statistics over grains.
 #[derive(Clone, Copy, Default)]
@@ -87,7 +87,7 @@ impl<T: Real> CpuEngine<T> {
                     let h = p.radius - dist;
                     if h > T::ZERO {
                         contacts += 1;
-                        let c = coeffs_of(&self.coeffs, self.n_materials, wall.material as usize, state::material_at(&self.material, i));
+                        let c = coeffs_of(&self.coeffs, self.n_materials, wall.material as usize, crate::state::material_at(&self.material, i));
                         s.wall_contacts += 1;
                         s.wall_elastic += normal_potential(&self.model.normal, c, p.radius, h).f64();
                         s.max_wall_overlap = max_by_first(s.max_wall_overlap, ((h / p.radius).f64(), self.id[i]));
@@ -115,7 +115,7 @@ impl<T: Real> CpuEngine<T> {
                     continue;
                 }
                 let (pi, pj) = (&self.prop[i], &self.prop[j]);
-                let c = coeffs_of(&self.coeffs, self.n_materials, state::material_at(&self.material, i), state::material_at(&self.material, j));
+                let c = coeffs_of(&self.coeffs, self.n_materials, crate::state::material_at(&self.material, i), crate::state::material_at(&self.material, j));
                 let r_eff = pi.radius * pj.radius / (pi.radius + pj.radius);
                 s.contacts += 1;
                 s.clamped += self.report.clamped(k) as u64;

@@ -1,24 +1,10 @@
 //! `wall_contacts`: one invocation computes the contacts of one grain with every wall, with
 //! the same laws as grain-grain contacts (the wall is a partner of infinite radius and mass).
 
-use super::pair_force::ForceContext;
 use super::wall_springs::is_candidate;
-use super::state::{Body, Load, Props};
-use crate::model::{contact_force, normal_damping, normal_stiffness, parted_normal_force, Bodies, ContactForce, Geometry, KickWindow, Kinematics, PairCoeffs, Regime};
-use crate::engine::WallContactRecord;
+use crate::state::{wall_contact, Body, ForceContext, Load, Props, WallState};
+use crate::model::{normal_damping, normal_stiffness, parted_normal_force, Geometry, Regime};
 use crate::real::{Real, Vec3};
-use crate::walls::WallGeom;
-
-/// A wall as the force pass sees it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct WallState<T> {
-    /// Surface now.
-    pub geom: WallGeom<T>,
-    /// Velocity (m/s).
-    pub velocity: Vec3<T>,
-    /// Material index.
-    pub material: u32,
-}
 
 /// What one grain-wall contact adds to its wall's sums.
 #[derive(Clone, Copy, Debug)]
@@ -105,22 +91,6 @@ pub fn wall_contacts<T: Real>(
     load
 }
 
-/// The contact of a grain of material `material` with a wall it touches, seen from the wall's
-/// frame (`n`, `dist`: [`WallGeom::frame`]): its geometry, coefficients and force; the history
-/// in `h_slot` advances by `ctx.elapsed`.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, material: usize, wall: &WallState<T>, ctx: &ForceContext<'c, T>, h_slot: &mut [T]) -> (Geometry<T>, &'c PairCoeffs<T>, ContactForce<T>) {
-    let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
-    let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
-    let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
-    let c = ctx.wall_coeffs(wall.material, material);
-    let mut h = ctx.slots.load(h_slot);
-    let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed, KickWindow::centred(ctx.window));
-    ctx.slots.store(&h, h_slot);
-    (geo, c, f)
-}
-
 super::simd::dispatch! {
     /// `wall_contacts` for the candidates among slots `first..first + loads.len()` (at most
     /// one part of [`split::split`](super::split::split); `id`, `body`, `residual` (empty
@@ -148,25 +118,4 @@ fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], candidate: 
         l.torque += w.torque;
         e += 1;
     }
-}
-
-/// Every touching grain-wall contact, with its force evaluated from the current state
-/// (springs read, not advanced: `ctx.elapsed` should be 0), grains in permanent-id order,
-/// walls in order.
-pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[u32], walls: &[WallState<T>], ctx: &ForceContext<T>, hist: &[T]) -> Vec<WallContactRecord> {
-    let stride = ctx.slots.stride;
-    let mut out = Vec::new();
-    for (i, (b, p)) in body.iter().zip(prop).enumerate() {
-        for (w, wall) in walls.iter().enumerate() {
-            let (n, dist) = wall.geom.frame(b.pos, crate::position::residual_at(ctx.residual, i));
-            if dist >= p.radius {
-                continue;
-            }
-            let at = (i * walls.len() + w) * stride;
-            let (geo, _, f) = wall_contact(n, dist, b, p, ctx.material(i), wall, ctx, &mut hist[at..at + stride].to_vec());
-            out.push(WallContactRecord { grain: id[i], wall: w as u32, overlap: geo.h.f64(), normal: n.f64(), lever: geo.rp_i.f64(), force: f.f_i.f64() });
-        }
-    }
-    out.sort_by_key(|r| r.grain);
-    out
 }

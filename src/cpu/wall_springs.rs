@@ -11,8 +11,8 @@
 //! the run: an eighth of a byte per grain where an entry index per slot took four.
 
 use super::split::ALIGN;
-use super::state::Props;
-use super::wall_contacts::WallState;
+use crate::state::Props;
+use crate::state::WallState;
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
 

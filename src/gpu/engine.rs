@@ -318,7 +318,7 @@ impl GpuEngine {
         let residual: Vec<[f32; 4]> = g.position.iter().map(|&x| { let (_, r) = crate::position::split::<f32>(x); [r.x, r.y, r.z, 0.0] }).collect();
         let vel: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.velocity[i], g.mass[i])).collect();
         // The inertia in w as the CPU's f32 engine keeps it.
-        let inertia = |i: usize| crate::cpu::Props::<f32>::sphere(g.radius[i], g.mass[i]).inertia;
+        let inertia = |i: usize| crate::state::Props::<f32>::sphere(g.radius[i], g.mass[i]).inertia;
         let omega: Vec<[f32; 4]> = (0..g.len()).map(|i| { let w = g.angular_velocity[i]; [w[0] as f32, w[1] as f32, w[2] as f32, inertia(i)] }).collect();
         let material: Vec<u32> = g.material.iter().map(|&m| m as u32).collect();
         let history = model.history_layout();

@@ -14,7 +14,7 @@ use super::device::Gpu;
 use super::layout::{CdColour, CdContact, CdControl, CdParams};
 use super::pipeline::{bind_group, compute_pipeline, read_back};
 use crate::cd::{Contact, Partner, Schedule, Solved, Sweeps, WallMotion, MAX_COLOURS, MEASURE_BLOCK};
-use crate::cpu::Body;
+use crate::state::Body;
 use crate::engine::SimError;
 use crate::kernels::CD_KERNELS;
 use crate::real::Vec3;

@@ -4,7 +4,7 @@ use super::*;
 
 /// The GPU's history (one vec4 per block and contact: tangential with the sliding flag in w,
 /// rolling, bridge volume in x) in the CPU engine's packed slots.
-fn cpu_history(blocks: &[[f32; 4]], slots: &crate::cpu::HistorySlots) -> Vec<f32> {
+fn cpu_history(blocks: &[[f32; 4]], slots: &crate::state::HistorySlots) -> Vec<f32> {
     use layout::normal_slot;
     let layout = slots.layout;
     let per_contact = (layout::history_blocks(layout) as usize).max(1);
@@ -59,7 +59,7 @@ impl GpuEngine {
     /// Grain-wall contacts re-evaluated on the host from the GPU's state (the CPU twin's
     /// function in f32), given the grain arrays `[pos, vel, omega, residual, ..]` already read.
     pub(super) fn wall_contact_records(&self, arrays: &[Vec<[f32; 4]>]) -> Result<Vec<crate::engine::WallContactRecord>, SimError> {
-        use crate::cpu::{wall_contact_records, Body, ForceContext, HistorySlots, Props, WallState};
+        use crate::state::{wall_contact_records, Body, ForceContext, HistorySlots, Props, WallState};
         use crate::real::Vec3;
         let n_walls = self.wall_names.len();
         let blocks = self.params.hist_blocks as usize;

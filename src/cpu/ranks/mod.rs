@@ -6,7 +6,7 @@
 //! with a ghost is computed by both processes with the same operations on the same bits, and
 //! every sum a grain's load takes runs in permanent-id order whatever the numbering (see
 //! `cpu`), so each owned grain's load, and so its motion, is the one process's to the bit.
-//! Between the operations of a step ([`crate::cpu::CpuEngine::step_with`]):
+//! Between the operations of a step ([`super::CpuEngine::step_with`]):
 //! - after each drift, each process sends its neighbours the motion of the grains they hold
 //!   as ghosts, and the largest displacement since the last rebuild is the maximum over all;
 //! - when that calls for a rebuild, every process rebuilds at once: the cuts move to the
@@ -40,7 +40,7 @@ mod slabs;
 pub use grid::Grid;
 pub use slabs::Slabs;
 
-use crate::cpu::{touch_of_row, touches_state, CpuEngine, RowWidths, Rows, StepHooks, WallContact, BRIDGE_ROW, TOUCH_ROW};
+use super::{touch_of_row, touches_state, CpuEngine, RowWidths, Rows, StepHooks, WallContact, BRIDGE_ROW, TOUCH_ROW};
 use crate::engine::{Engine, EngineState, Frame, SimError, Stats};
 use crate::real::Real;
 use crate::scene::{Method, Scene};
@@ -151,7 +151,7 @@ impl<T: Real> Distributed<T> {
         rows.renumber(&net.widths, |l| net.gid[l as usize]);
         let (grains, pairs) = if everywhere { (Some(net.all_gather(&rows.grains)), Some(net.all_gather(&rows.pairs))) } else { (net.gather_to_root(&rows.grains), net.gather_to_root(&rows.pairs)) };
         let (Some(grains), Some(pairs)) = (grains, pairs) else { return Ok(()) };
-        let (whole_state, _) = crate::cpu::state_of_rows(&Rows { grains, pairs }, &net.widths, &state, &touches_state(&net.touches));
+        let (whole_state, _) = super::state_of_rows(&Rows { grains, pairs }, &net.widths, &state, &touches_state(&net.touches));
         let whole = match &mut self.whole {
             Some(w) => w,
             None => self.whole.insert(net.whole_engine().map_err(|e| net.internal(&self.local, &format!("{e:#}")))?),
@@ -183,7 +183,7 @@ impl<T: Real> Net<T> {
         let mut held: Vec<Vec<usize>> = owner.iter().map(|&o| vec![o]).collect();
         let ids = &state.ints["id"];
         let (starts, p) = (&state.ints["owner_start"], &state.ints["partner"]);
-        for (slot, k) in crate::cpu::owned_pairs(starts) {
+        for (slot, k) in crate::state::owned_pairs(starts) {
             let (a, b) = (ids[slot] as usize, ids[p[k] as usize] as usize);
             if owner[a] != owner[b] {
                 held[a].push(owner[b]);
@@ -214,7 +214,7 @@ impl<T: Real> Net<T> {
     /// A local engine holding the grains of `rows` (by permanent id), with the whole-engine
     /// values of `template`; notes their permanent ids.
     fn make_local(&mut self, rows: &Rows, template: &EngineState) -> anyhow::Result<CpuEngine<T>> {
-        let (state, gid) = crate::cpu::state_of_rows(rows, &self.widths, template, &touches_state::<T>(&[]));
+        let (state, gid) = super::state_of_rows(rows, &self.widths, template, &touches_state::<T>(&[]));
         let order: Vec<usize> = gid.iter().map(|&i| i as usize).collect();
         let mut grains = self.grains.permuted(&order);
         // Where the grains are now, for the list the new engine builds before the restore.

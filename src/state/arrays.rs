@@ -1,4 +1,5 @@
-//! Per-grain arrays of the CPU engine. The CPU keeps the data one kernel invocation reads
+//! Per-grain arrays: the CPU engine's state, and the form the GPU's state is read back in.
+//! The CPU keeps the data one kernel invocation reads
 //! together (array of structures: one or two cache lines per grain); the GPU keeps
 //! structures of arrays.
 

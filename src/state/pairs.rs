@@ -3,7 +3,7 @@
 
 use super::grid::{detect_pairs, CellGrid};
 use super::reduce::chunked;
-use super::state::{Body, Props};
+use super::arrays::{Body, Props};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 

@@ -2,7 +2,7 @@
 //! detection. One invocation of `detect_pairs` lists the pairs one grain owns.
 
 use super::reduce::chunked;
-use super::state::{Body, Props};
+use super::arrays::{Body, Props};
 use crate::periodic::Periodic;
 use crate::position;
 use crate::real::{Real, Vec3};
