@@ -209,3 +209,12 @@ fn the_readers_see_imports_and_loops() {
     assert_eq!(loops(&looped), vec![vec!["a".to_string(), "b".into(), "c".into()]]);
     assert!(loops(&BTreeMap::from([edge("a", "b"), edge("b", "c")])).is_empty());
 }
+
+#[test]
+fn no_source_file_is_a_grab_bag() {
+    // One job per file: past about 600 lines a file holds several, and a reader loses the
+    // thread (split by job, as cpu/, scene/ and model/ are).
+    const MOST_LINES: usize = 600;
+    let long: Vec<String> = sources().into_iter().filter(|(_, text)| text.lines().count() > MOST_LINES).map(|(path, text)| format!("{path}: {} lines", text.lines().count())).collect();
+    assert!(long.is_empty(), "files over {MOST_LINES} lines: {long:?}");
+}

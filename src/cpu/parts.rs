@@ -3,9 +3,11 @@
 //! change hands, and what they gather into the whole state. A set of rows becomes a state
 //! again ([`state_of_rows`]) in the checkpoint's format, so that `restore_state` takes it.
 //! Also what a distributed driver reads and writes of the engine between the operations of a
-//! step ([`super::StepHooks`]).
+//! step ([`super::step::StepHooks`]).
 
 use super::*;
+use super::bridges::{move_liquid, BridgeEvent};
+use super::wall_sums::WallSums;
 
 /// The per-grain arrays of a checkpoint, in row order, and whether each holds integers.
 const GRAIN_ARRAYS: [(&str, bool); 8] = [("body", false), ("load", false), ("residual", false), ("built_at", false), ("image", true), ("orientation", false), ("wall_hist", false), ("liquid", false)];
@@ -361,7 +363,7 @@ impl<T: Real> CpuEngine<T> {
     /// Keeps the slot of each permanent id from now on: the lookups by id below, which a
     /// process makes every step, read it.
     pub(crate) fn keep_slots(&mut self) {
-        self.slot = super::slots_of(&self.id);
+        self.slot = super::rebuild::slots_of(&self.id);
     }
 
     /// True when grain `id`'s position and velocities are finite.

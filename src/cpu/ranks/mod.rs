@@ -40,7 +40,8 @@ mod slabs;
 pub use grid::Grid;
 pub use slabs::Slabs;
 
-use super::{touch_of_row, touches_state, CpuEngine, RowWidths, Rows, StepHooks, WallContact, BRIDGE_ROW, TOUCH_ROW};
+use super::step::StepHooks;
+use super::{touch_of_row, touches_state, CpuEngine, RowWidths, Rows, WallContact, BRIDGE_ROW, TOUCH_ROW};
 use crate::engine::{Engine, EngineState, Frame, SimError, Stats};
 use crate::real::Real;
 use crate::scene::{Method, Scene};

@@ -1,0 +1,132 @@
+//! What a contact law reads besides the geometry: the materials' constants, each pair of
+//! materials' mixed coefficients, and the layout of the history a contact keeps.
+
+use super::*;
+
+/// Which per-contact history blocks exist: world-frame 3-vectors (m) and single reals; a
+/// block a model does not use is not allocated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct HistoryLayout {
+    /// Accumulated tangential spring displacement `xi` (m).
+    pub tangential: bool,
+    /// The normal velocity at the previous evaluation (m/s), one real: damped laws, whose
+    /// dashpot sees the velocity carried forward from it ([`window`]).
+    pub normal: bool,
+    /// Whether the contact is sliding (one real, 0 or 1): friction with two coefficients.
+    pub sliding: bool,
+    /// Accumulated rolling displacement `psi` (m): the rolling law's, or Oquendo et al.'s rolling
+    /// spring.
+    pub rolling: bool,
+    /// Liquid bridge volume `V_b` (m^3), one real.
+    pub bridge: bool,
+}
+
+impl HistoryLayout {
+    /// Reals a contact's history holds: 3 per spring, 1 for the normal velocity, 1 for the
+    /// sliding flag, 1 for a bridge.
+    pub fn reals(&self) -> usize {
+        3 * self.tangential as usize + self.normal as usize + self.sliding as usize + 3 * self.rolling as usize + self.bridge as usize
+    }
+}
+
+/// Per-contact history, world frame, zero when a contact forms.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct History<T> {
+    /// Tangential spring displacement `xi` (m).
+    pub tangential: Vec3<T>,
+    /// The normal velocity the contact forces drive at the previous evaluation (m/s,
+    /// [`driven_normal_velocity`]); 0 in a new contact.
+    pub v_n: T,
+    /// Sliding at the last evaluation (Oquendo et al.'s regimes).
+    pub sliding: bool,
+    /// Rolling spring displacement `psi` (m).
+    pub rolling: Vec3<T>,
+    /// Liquid bridge volume (m^3); 0 without a bridge.
+    pub bridge: T,
+}
+
+/// Coefficients of one pair of materials (see [`PairCoeffs::mix`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PairCoeffs<T> {
+    /// `V_eff = V_i V_j / (V_i + V_j)` (Pa), `V = E / (1 - nu^2)`.
+    pub v_eff: T,
+    /// Mindlin `G_eff`: `1/G_eff = (2 - nu_i)/G_i + (2 - nu_j)/G_j` (Pa).
+    pub g_eff: T,
+    /// Static friction coefficient (-).
+    pub mu_s: T,
+    /// Kinetic friction coefficient (-).
+    pub mu_k: T,
+    /// `tan(theta_r)` of the rolling angle (-).
+    pub tan_roll: T,
+    /// Papers' normal damping `gamma_n` (s^-1 m^-1/2).
+    pub gamma_n: T,
+    /// Twisting damping `gamma_nt` (s^-1).
+    pub gamma_nt: T,
+    /// Dashpot ratio `beta` (-) of `damping = "restitution"`, found for the mean restitution
+    /// of the two materials ([`restitution::dashpot_ratio`]); 0 under other damping laws.
+    pub beta: T,
+}
+
+/// The mechanical constants of one material, in SI units.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MaterialConstants {
+    /// Young's modulus (Pa).
+    pub youngs_modulus: f64,
+    /// Poisson ratio (-).
+    pub poisson_ratio: f64,
+    /// Static friction coefficient (-).
+    pub mu_s: f64,
+    /// Kinetic friction coefficient (-).
+    pub mu_k: f64,
+    /// Rolling angle `theta_r` (rad).
+    pub rolling_angle: f64,
+    /// `gamma_n` (s^-1 m^-1/2).
+    pub gamma_n: f64,
+    /// `gamma_nt` (s^-1).
+    pub gamma_nt: f64,
+    /// Restitution coefficient (-), used by [`DampingLaw::Restitution`].
+    pub restitution: f64,
+}
+
+impl MaterialConstants {
+    /// `V = E / (1 - nu^2)` (Pa).
+    pub fn stiffness(&self) -> f64 {
+        self.youngs_modulus / (1.0 - self.poisson_ratio * self.poisson_ratio)
+    }
+    /// Shear modulus `G = E / (2 (1 + nu))` (Pa).
+    pub fn shear_modulus(&self) -> f64 {
+        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+    }
+}
+
+impl<T: Real> PairCoeffs<T> {
+    /// Coefficients for a contact between materials `a` and `b`. Elastic constants combine
+    /// as docs/physics.md rules; friction coefficients and the rolling angle take the smaller of
+    /// the two (as YADE does: a frictionless wall makes frictionless contacts); damping and
+    /// restitution take the arithmetic mean. Equal materials give their own values. The
+    /// dashpot ratio is sized for `model`'s normal law and clamp.
+    pub fn mix(a: &MaterialConstants, b: &MaterialConstants, model: &ContactModel<f64>) -> Self {
+        let (va, vb) = (a.stiffness(), b.stiffness());
+        let g_inv = (2.0 - a.poisson_ratio) / a.shear_modulus() + (2.0 - b.poisson_ratio) / b.shear_modulus();
+        let mean = |x: f64, y: f64| 0.5 * (x + y);
+        PairCoeffs {
+            v_eff: T::of(va * vb / (va + vb)),
+            g_eff: T::of(1.0 / g_inv),
+            mu_s: T::of(a.mu_s.min(b.mu_s)),
+            mu_k: T::of(a.mu_k.min(b.mu_k)),
+            tan_roll: T::of(a.rolling_angle.min(b.rolling_angle).tan()),
+            gamma_n: T::of(mean(a.gamma_n, b.gamma_n)),
+            gamma_nt: T::of(mean(a.gamma_nt, b.gamma_nt)),
+            beta: T::of(match model.damping {
+                DampingLaw::Restitution => {
+                    let spring = match model.normal {
+                        NormalLaw::Hertz => restitution::Spring::Hertz,
+                        NormalLaw::Linear { .. } => restitution::Spring::Linear,
+                    };
+                    restitution::dashpot_ratio(mean(a.restitution, b.restitution), spring, model.limit_damping)
+                }
+                _ => 0.0,
+            }),
+        }
+    }
+}

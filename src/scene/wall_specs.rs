@@ -1,0 +1,202 @@
+//! `[[wall]]` tables into validated walls: each wall kind's geometry checked, the servo box and
+//! the piston found, the grains checked to start inside and clear of them, and the container's
+//! cross-section.
+
+use super::*;
+
+/// Walls before the piston's defaults are known.
+pub(super) struct PendingWall {
+    wall: Wall,
+    piston_mass: Option<f64>,
+    piston_area: Option<f64>,
+    /// The servo box this plane belongs to: (pressure, gain, max speed).
+    servo: Option<(f64, f64, f64)>,
+}
+
+pub(super) fn validate_walls(
+    c: &Complainer,
+    f: &SceneFile,
+    material_of: &dyn Fn(String, &str) -> Result<u16, SceneError>,
+) -> Result<Vec<PendingWall>, SceneError> {
+    let mut out = Vec::new();
+    let plain = |name: String, shape: WallShape, material: u16| PendingWall { wall: Wall { name, shape, material }, piston_mass: None, piston_area: None, servo: None };
+    for (i, w) in f.walls.iter().enumerate() {
+        let key = |k: &str| format!("wall[{i}].{k}");
+        match w {
+            WallSpec::Plane { material, point, normal } => {
+                let m = material_of(key("material"), material)?;
+                let point = finite3(c, &key("point"), *point)?;
+                let normal = finite3(c, &key("normal"), *normal)?;
+                let len = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
+                if len == 0.0 {
+                    return Err(c.invalid(key("normal"), format!("{normal:?}"), "is the zero vector", "give the direction into the domain, e.g. [0, 0, 1]"));
+                }
+                let normal = [normal[0] / len, normal[1] / len, normal[2] / len];
+                out.push(plain(format!("wall[{i}]"), WallShape::Plane { point, normal }, m));
+            }
+            WallSpec::Box { material, min, max, open_top } => {
+                let m = material_of(key("material"), material)?;
+                let (lo, hi) = (finite3(c, &key("min"), *min)?, finite3(c, &key("max"), *max)?);
+                if (0..3).any(|k| hi[k] <= lo[k]) {
+                    return Err(c.invalid(key("max"), format!("{hi:?}"), format!("must exceed min {lo:?} on every axis"), "give the upper corner above the lower one"));
+                }
+                let faces: [(&str, [f64; 3], [f64; 3]); 6] = [
+                    ("bottom", lo, [0.0, 0.0, 1.0]),
+                    ("top", hi, [0.0, 0.0, -1.0]),
+                    ("x_min", lo, [1.0, 0.0, 0.0]),
+                    ("x_max", hi, [-1.0, 0.0, 0.0]),
+                    ("y_min", lo, [0.0, 1.0, 0.0]),
+                    ("y_max", hi, [0.0, -1.0, 0.0]),
+                ];
+                for (face, point, normal) in faces {
+                    if *open_top && face == "top" {
+                        continue;
+                    }
+                    out.push(plain(format!("wall[{i}].{face}"), WallShape::Plane { point, normal }, m));
+                }
+            }
+            WallSpec::ServoBox { material, min, max, pressure, gain, max_speed } => {
+                let m = material_of(key("material"), material)?;
+                let (lo, hi) = (finite3(c, &key("min"), *min)?, finite3(c, &key("max"), *max)?);
+                if (0..3).any(|k| hi[k] <= lo[k]) {
+                    return Err(c.invalid(key("max"), format!("{hi:?}"), format!("must exceed min {lo:?} on every axis"), "give the upper corner above the lower one"));
+                }
+                if out.iter().any(|p: &PendingWall| p.servo.is_some()) {
+                    return Err(c.invalid(key("type"), "\"servo_box\"", "a scene has at most one servo box", "remove the extra one"));
+                }
+                let pressure = non_negative(c, &key("pressure"), *pressure, "give the target pressure in Pa")?;
+                let max_speed = positive(c, &key("max_speed"), max_speed.unwrap_or(DEFAULT_SERVO_SPEED), "give the largest wall speed in m/s")?;
+                let gain = positive(c, &key("gain"), gain.unwrap_or(max_speed / pressure.max(SERVO_PRESSURE_FLOOR)), "give the wall speed per pressure error in m/(s Pa)")?;
+                let faces: [(&str, [f64; 3], [f64; 3]); 6] = [
+                    ("x_min", lo, [1.0, 0.0, 0.0]),
+                    ("x_max", hi, [-1.0, 0.0, 0.0]),
+                    ("y_min", lo, [0.0, 1.0, 0.0]),
+                    ("y_max", hi, [0.0, -1.0, 0.0]),
+                    ("z_min", lo, [0.0, 0.0, 1.0]),
+                    ("z_max", hi, [0.0, 0.0, -1.0]),
+                ];
+                for (face, point, normal) in faces {
+                    let mut w = plain(format!("wall[{i}].{face}"), WallShape::Plane { point, normal }, m);
+                    w.servo = Some((pressure, gain, max_speed));
+                    out.push(w);
+                }
+            }
+            WallSpec::Cylinder { material, center, radius } => {
+                let m = material_of(key("material"), material)?;
+                let radius = positive(c, &key("radius"), *radius, "give the radius in metres")?;
+                out.push(plain(format!("wall[{i}]"), WallShape::Cylinder { center: *center, radius }, m));
+            }
+            WallSpec::Piston { material, z, pressure, mass, area } => {
+                let m = material_of(key("material"), material)?;
+                if !z.is_finite() {
+                    return Err(c.invalid(key("z"), z, "must be finite", "give the initial height in metres"));
+                }
+                let pressure = non_negative(c, &key("pressure"), *pressure, "give the pressure in Pa")?;
+                let piston_mass = mass.map(|v| positive(c, &key("mass"), v, "give the mass in kg or leave it out")).transpose()?;
+                let piston_area = area.map(|v| positive(c, &key("area"), v, "give the area in m^2 or leave it out")).transpose()?;
+                if out.iter().any(|p: &PendingWall| matches!(p.wall.shape, WallShape::Piston { .. })) {
+                    return Err(c.invalid(key("type"), "\"piston\"", "a scene has at most one piston", "remove the extra piston"));
+                }
+                out.push(PendingWall {
+                    wall: Wall { name: format!("wall[{i}]"), shape: WallShape::Piston { z: *z, pressure, mass: 0.0, area: 0.0 }, material: m },
+                    piston_mass,
+                    piston_area,
+                    servo: None,
+                });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Fills in the piston's default mass (total grain mass) and area (cross-section of the
+/// cylinder, or of a box's side walls).
+/// The servo box among the walls, if any.
+pub(super) fn servo_box(pending: &[PendingWall]) -> Option<ServoBox> {
+    let first = pending.iter().position(|p| p.servo.is_some())?;
+    let (pressure, gain, max_speed) = pending[first].servo?;
+    Some(ServoBox { walls: [0, 1, 2, 3, 4, 5].map(|k| first + k), pressure, gain, max_speed })
+}
+
+pub(super) fn finish_walls(c: &Complainer, pending: Vec<PendingWall>, grains: &Grains, periodic: &[Option<[f64; 2]>; 3]) -> Result<Vec<Wall>, SceneError> {
+    let section = cross_section(pending.iter().map(|p| &p.wall.shape), periodic);
+    let total_mass: f64 = grains.mass.iter().sum();
+    let mut out = Vec::with_capacity(pending.len());
+    for p in pending {
+        let mut wall = p.wall;
+        if let WallShape::Piston { mass, area, .. } = &mut wall.shape {
+            *mass = p.piston_mass.unwrap_or(total_mass);
+            *area = match p.piston_area.or(section) {
+                Some(a) => a,
+                None => {
+                    return Err(c.invalid(format!("{}.area", wall.name), "(none)", "the piston's area cannot be inferred without a cylinder or box wall", "give `area` in m^2"));
+                }
+            };
+        }
+        out.push(wall);
+    }
+    Ok(out)
+}
+
+/// Horizontal cross-section (m^2) of a container: a cylinder wall's, or that of the side
+/// planes of a box or the periods of the x and y axes; `None` when nothing bounds one.
+pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone, periodic: &[Option<[f64; 2]>; 3]) -> Option<f64> {
+    let cylinder = shapes.clone().find_map(|s| match *s {
+        WallShape::Cylinder { radius, .. } => Some(std::f64::consts::PI * radius * radius),
+        _ => None,
+    });
+    cylinder.or_else(|| {
+        let side = |n: [f64; 3]| {
+            shapes.clone().find_map(|s| match *s {
+                WallShape::Plane { point, normal } if normal == n => Some(point),
+                _ => None,
+            })
+        };
+        let span = |a: usize, n: [f64; 3]| match periodic[a] {
+            Some([lo, hi]) => Some(hi - lo),
+            None => {
+                let mut m = n;
+                m[a] = -n[a];
+                Some(side(m)?[a] - side(n)?[a])
+            }
+        };
+        Some(span(0, [1.0, 0.0, 0.0])? * span(1, [0.0, 1.0, 0.0])?)
+    })
+}
+
+/// Signed distance (m) from a point to a wall's surface at its initial position, positive on
+/// the grains' side.
+pub fn wall_distance(shape: &WallShape, p: [f64; 3]) -> f64 {
+    crate::walls::WallGeom::<f64>::of(shape).frame(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).1
+}
+
+/// Grains may not start overlapping a wall (grains read from a file: by more than
+/// [`READ_WALL_OVERLAP`]) or (listed grains) each other: the first step would release the
+/// stored energy at once.
+pub(super) fn check_overlaps(c: &Complainer, origins: &Origins, grains: &Grains, walls: &[Wall]) -> Result<(), SceneError> {
+    let listed = origins.listed;
+    let origin = |i: usize| origins.name(i);
+    for i in 0..grains.len() {
+        for w in walls {
+            let d = wall_distance(&w.shape, grains.position[i]);
+            let allowed = if origins.read(i) { READ_WALL_OVERLAP * grains.radius[i] } else { 0.0 };
+            if d < grains.radius[i] - allowed {
+                return Err(c.invalid(
+                    origin(i),
+                    format!("{:?}", grains.position[i]),
+                    format!("the grain (radius {:.4e} m) overlaps {} by {:.4e} m", grains.radius[i], w.name, grains.radius[i] - d),
+                    "move the grain or its generator's region inside the walls",
+                ));
+            }
+        }
+    }
+    for i in 0..listed {
+        for j in 0..i {
+            let d2: f64 = (0..3).map(|k| (grains.position[i][k] - grains.position[j][k]).powi(2)).sum();
+            if d2.sqrt() < grains.radius[i] + grains.radius[j] {
+                return Err(c.invalid(origin(i), format!("{:?}", grains.position[i]), format!("overlaps grain[{j}]"), "place listed grains apart"));
+            }
+        }
+    }
+    Ok(())
+}
