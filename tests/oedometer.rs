@@ -136,7 +136,7 @@ fn plots_are_written_as_png_and_svg() {
         .map(|k| {
             let p = 12.5e3 * 2f64.powi(k);
             let e = 0.72 * (-(p / 19.1e6f64).powf(0.57)).exp();
-            CompressionPoint { target_pressure: p, pressure: p, piston_z: 0.0, void_ratio: e, coordination: 5.0, kinetic_energy: 0.0, stress: [[0.0; 3]; 3], stress_zz: p, settled: true, seating: false }
+            CompressionPoint { target_pressure: p, pressure: p, piston_z: 0.0, void_ratio: e, coordination: 5.0, kinetic_energy: 0.0, stress: glam::DMat3::ZERO, stress_zz: p, settled: true, seating: false }
         })
         .collect();
     let fit = fit_bauer(&points.iter().map(|c| (c.pressure, c.void_ratio)).collect::<Vec<_>>(), None, 1.0).unwrap();

@@ -8,6 +8,7 @@ pub mod richefeu;
 pub mod tail;
 
 use crate::engine::Frame;
+use glam::{DMat3, DVec3};
 use crate::periodic::Periodic;
 use crate::real::Vec3;
 use crate::scene::{cross_section, Scene, WallShape};
@@ -69,8 +70,36 @@ pub fn packing_fraction(scene: &Scene, frame: &Frame, piston_z: Option<f64>) -> 
     (height > 0.0).then(|| solid / (area * height))
 }
 
-/// A 3x3 tensor, row-major.
-pub type Tensor = [[f64; 3]; 3];
+/// A 3x3 tensor: glam's column-major `DMat3`, element (a, b) in `t.col(b)[a]`; written to
+/// files as its three rows ([`tensor_rows`]).
+pub type Tensor = DMat3;
+
+/// The outer product `f (x) c` (element (a, b) = `f[a] c[b]`).
+pub fn outer(f: DVec3, c: DVec3) -> Tensor {
+    DMat3::from_cols(f * c.x, f * c.y, f * c.z)
+}
+
+/// The trace `t_xx + t_yy + t_zz`, summed in that order.
+pub fn trace(t: &Tensor) -> f64 {
+    t.x_axis.x + t.y_axis.y + t.z_axis.z
+}
+
+/// A tensor in `summary.json` and `analysis.json`: its rows, `[[xx, xy, xz], [yx, ..], ..]`
+/// (`#[serde(with = "crate::analysis::tensor_rows")]`).
+pub mod tensor_rows {
+    use glam::DMat3;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// Writes the rows.
+    pub fn serialize<S: Serializer>(t: &DMat3, s: S) -> Result<S::Ok, S::Error> {
+        t.transpose().to_cols_array_2d().serialize(s)
+    }
+
+    /// Reads the rows.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<DMat3, D::Error> {
+        Ok(DMat3::from_cols_array_2d(&<[[f64; 3]; 3]>::deserialize(d)?).transpose())
+    }
+}
 
 /// Volume of the grains (m^3).
 pub fn solid_volume(frame: &Frame) -> f64 {
@@ -98,14 +127,8 @@ pub fn container_volume(scene: &Scene, piston_z: f64) -> Option<f64> {
 /// the grain's volume). Grain-grain and grain-wall contacts of the frame count; the frame
 /// must have been taken with contacts. Indexed like the frame's grains (slot = permanent id).
 pub fn contact_moments(frame: &Frame, periodic: &Periodic<f64>) -> Vec<Tensor> {
-    let mut m = vec![[[0.0; 3]; 3]; frame.radius.len()];
-    let add = |t: &mut Tensor, f: [f64; 3], c: [f64; 3]| {
-        for a in 0..3 {
-            for b in 0..3 {
-                t[a][b] += f[a] * c[b];
-            }
-        }
-    };
+    let mut m = vec![DMat3::ZERO; frame.radius.len()];
+    let add = |t: &mut Tensor, f: [f64; 3], c: [f64; 3]| *t += outer(DVec3::from(f), DVec3::from(c));
     for r in frame.contacts.as_deref().unwrap_or(&[]) {
         let (i, j) = (r.i as usize, r.j as usize);
         let d = periodic.min_image(Vec3::of(frame.position[i]) - Vec3::of(frame.position[j]));
@@ -126,13 +149,9 @@ pub fn contact_moments(frame: &Frame, periodic: &Periodic<f64>) -> Vec<Tensor> {
 /// Volume-weighted mean of the particle stresses over a volume (Pa): `(1/V) sum_i sum_c f (x) c`
 /// (the particle volumes cancel). Negative in compression, as Richefeu et al. (2009) eq. 11 defines it.
 pub fn macroscopic_stress(moments: &[Tensor], volume: f64) -> Tensor {
-    let mut s = [[0.0; 3]; 3];
+    let mut s = DMat3::ZERO;
     for t in moments {
-        for a in 0..3 {
-            for b in 0..3 {
-                s[a][b] += t[a][b] / volume;
-            }
-        }
+        s += *t / volume;
     }
     s
 }

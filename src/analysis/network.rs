@@ -3,7 +3,8 @@
 //! bi-percolation of the positive- and negative-pressure phases, and the fabric anisotropy.
 
 use super::tail::{fit_tail, TailFit};
-use super::{contact_moments, Tensor};
+use super::{contact_moments, outer, trace, Tensor};
+use glam::{DMat3, DVec3};
 use crate::engine::Frame;
 use crate::periodic::Periodic;
 use crate::real::Vec3;
@@ -92,6 +93,7 @@ pub struct NetworkAnalysis {
     /// Solid fraction of the sample.
     pub solid_fraction: f64,
     /// Volume-weighted particle stress over the sample (Pa, compression positive).
+    #[serde(with = "super::tensor_rows")]
     pub macroscopic_stress: Tensor,
     /// Mean particle pressure over the sample (Pa, compression positive).
     pub mean_pressure: f64,
@@ -110,6 +112,7 @@ pub struct NetworkAnalysis {
     /// The negative-pressure phase.
     pub negative_phase: Percolation,
     /// Fabric tensor `<n (x) n>` over the bonds.
+    #[serde(with = "super::tensor_rows")]
     pub fabric: Tensor,
     /// Axisymmetric fabric anisotropy about z, `5 (F_zz - (F_xx + F_yy)/2)`.
     pub fabric_anisotropy: f64,
@@ -160,7 +163,7 @@ pub fn particle_stresses(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds
     let ball = |r: f64| 4.0 / 3.0 * std::f64::consts::PI * r.powi(3);
     let solid_fraction = frame.radius.iter().map(|&r| ball(r)).sum::<f64>() / volume;
     let moments = contact_moments(frame, periodic);
-    let pressures = moments.iter().zip(&frame.radius).map(|(m, &r)| -(m[0][0] + m[1][1] + m[2][2]) / (3.0 * (ball(r) / solid_fraction))).collect();
+    let pressures = moments.iter().zip(&frame.radius).map(|(m, &r)| -trace(m) / (3.0 * (ball(r) / solid_fraction))).collect();
     ParticleStresses { moments, volume, solid_fraction, pressures }
 }
 
@@ -205,15 +208,11 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
     };
 
     let ParticleStresses { moments, volume, solid_fraction: nu, pressures } = particle_stresses(frame, periodic, bounds);
-    let mut macro_stress = [[0.0; 3]; 3];
+    let mut macro_stress = DMat3::ZERO;
     for m in &moments {
-        for a in 0..3 {
-            for b in 0..3 {
-                macro_stress[a][b] -= m[a][b] / volume;
-            }
-        }
+        macro_stress -= *m / volume;
     }
-    let mean_pressure = (macro_stress[0][0] + macro_stress[1][1] + macro_stress[2][2]) / 3.0;
+    let mean_pressure = trace(&macro_stress) / 3.0;
     let d_mean = 2.0 * frame.radius.iter().sum::<f64>() / n.max(1) as f64;
     let pressure_scale = scale / (d_mean * d_mean);
     let pdf_over = |s: f64| {
@@ -225,23 +224,16 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
     let pressure_tail = |sign: f64| fit_tail(&p_norm, sign, 0.0, None, &[]);
 
     // Fabric over the bonds.
-    let mut fabric = [[0.0; 3]; 3];
+    let mut fabric = DMat3::ZERO;
     let mut n_bonds = 0.0f64;
     for c in contacts.iter().filter(|c| c.normal_force != 0.0) {
         let d = periodic.min_image(Vec3::of(frame.position[c.i as usize]) - Vec3::of(frame.position[c.j as usize]));
         let u = (d * (1.0 / d.norm())).f64();
-        for a in 0..3 {
-            for b in 0..3 {
-                fabric[a][b] += u[a] * u[b];
-            }
-        }
+        let u = DVec3::from(u);
+        fabric += outer(u, u);
         n_bonds += 1.0;
     }
-    for row in &mut fabric {
-        for x in row.iter_mut() {
-            *x /= n_bonds.max(1.0);
-        }
-    }
+    fabric /= n_bonds.max(1.0);
     let phase = |positive: bool| percolation(frame, contacts, &pressures, positive, bounds, d_mean);
     NetworkAnalysis {
         time: frame.time,
@@ -262,7 +254,7 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
         pressure_tail_negative: pressure_tail(-1.0),
         positive_phase: phase(true),
         negative_phase: phase(false),
-        fabric_anisotropy: 5.0 * (fabric[2][2] - 0.5 * (fabric[0][0] + fabric[1][1])),
+        fabric_anisotropy: 5.0 * (fabric.z_axis.z - 0.5 * (fabric.x_axis.x + fabric.y_axis.y)),
         fabric,
         pressures,
     }

@@ -60,6 +60,7 @@ pub struct CompressionPoint {
     /// Kinetic energy (J).
     pub kinetic_energy: f64,
     /// Volume-weighted particle stress over the sample, compression positive (Pa).
+    #[serde(with = "crate::analysis::tensor_rows")]
     pub stress: Tensor,
     /// Its vertical component (Pa), to compare with the pressure.
     pub stress_zz: f64,
@@ -73,11 +74,11 @@ pub struct CompressionPoint {
 impl CompressionPoint {
     /// Trace of the macroscopic stress, `3 p_mean` (Pa, compression positive).
     pub fn stress_trace(&self) -> f64 {
-        self.stress[0][0] + self.stress[1][1] + self.stress[2][2]
+        crate::analysis::trace(&self.stress)
     }
     /// Lateral over vertical stress, `(sigma_xx + sigma_yy) / (2 sigma_zz)`: K0 at rest (-).
     pub fn lateral_ratio(&self) -> f64 {
-        0.5 * (self.stress[0][0] + self.stress[1][1]) / self.stress[2][2]
+        0.5 * (self.stress.x_axis.x + self.stress.y_axis.y) / self.stress.z_axis.z
     }
 }
 
@@ -285,12 +286,7 @@ fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, sett
     let frame = engine.frame(true)?;
     let volume = container_volume(scene, piston.z).unwrap_or(f64::NAN);
     let moments = contact_moments(&frame, &Periodic::of(&scene.periodic));
-    let mut stress = macroscopic_stress(&moments, volume);
-    for row in &mut stress {
-        for x in row.iter_mut() {
-            *x = -*x;
-        }
-    }
+    let stress = -macroscopic_stress(&moments, volume);
     Ok(CompressionPoint {
         target_pressure: piston.target_pressure,
         pressure: piston.pressure,
@@ -298,7 +294,7 @@ fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, sett
         void_ratio: void_ratio(solid_volume(&frame), volume),
         coordination: stats.coordination,
         kinetic_energy: stats.kinetic_energy(),
-        stress_zz: stress[2][2],
+        stress_zz: stress.z_axis.z,
         stress,
         settled,
         seating: false,
