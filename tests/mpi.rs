@@ -266,47 +266,14 @@ fn cuts_move_to_the_quantiles_unless_a_slab_would_be_too_narrow() {
 /// ring along z, the first of its equally wide axes.
 fn periodic_gas(dir: &Path) -> PathBuf {
     let path = dir.join("periodic_gas.toml");
-    std::fs::write(&path, PERIODIC_GAS).unwrap();
+    std::fs::write(&path, periodic_gas_text()).unwrap();
     path
 }
 
-/// [`periodic_gas`]'s text.
-const PERIODIC_GAS: &str = r#"
-seed = 5
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
-restitution = 0.5
-
-[[generate]]
-material = "sand"
-count = 1300
-diameter = { min = 0.8e-3, max = 1.2e-3 }
-region = { shape = "box", min = [0.0, 0.0, 0.0], max = [14.0e-3, 14.0e-3, 14.0e-3] }
-random_speed = 0.5
-
-[periodic]
-x = [0.0, 14.0e-3]
-y = [0.0, 14.0e-3]
-z = [0.0, 14.0e-3]
-
-[model]
-normal = "hertz"
-damping = "restitution"
-tangential = "mindlin"
-tangential_damping_ratio = 0.9075
-
-[[stage]]
-kind = "run"
-duration = 4.0e-3
-
-[output]
-frame_interval = 5.0e-4
-contact_forces = true
-"#;
+/// [`periodic_gas`]'s text: the shared periodic gas, run for 4 ms with frames of its contacts.
+fn periodic_gas_text() -> String {
+    common::edit(include_str!("fixtures/periodic_gas.toml"), &[("duration = 1.0e-3\n", "duration = 4.0e-3\n\n[output]\nframe_interval = 5.0e-4\ncontact_forces = true\n")])
+}
 
 /// Along a wrapping axis the last slab borders the first: grains cross from one to the other
 /// through the period's ends, and contacts straddle them, computed with a ghost across the
@@ -366,7 +333,7 @@ fn a_ring_of_slabs_holds_ghosts_across_the_period() {
 /// new contacts and rupture as the gas jostles, their liquid moving between grains of
 /// different processes.
 fn wet_periodic_gas(dir: &Path) -> PathBuf {
-    let text = common::edit(PERIODIC_GAS, &[("[[stage]]\nkind = \"run\"", "[[stage]]\nkind = \"run\"\nwater_content = 0.007"), ("tangential_damping_ratio = 0.9075", "tangential_damping_ratio = 0.9075\ncohesion = \"capillary\"")]);
+    let text = common::edit(&periodic_gas_text(), &[("[[stage]]\nkind = \"run\"", "[[stage]]\nkind = \"run\"\nwater_content = 0.007"), ("tangential_damping_ratio = 0.9075", "tangential_damping_ratio = 0.9075\ncohesion = \"capillary\"")]);
     let path = dir.join("wet_periodic_gas.toml");
     std::fs::write(&path, text).unwrap();
     path

@@ -405,38 +405,8 @@ mod tests {
     use crate::state::Load;
     use crate::cpu::wall_contacts::wall_contacts;
 
-    const SCENE: &str = r#"
-seed = 5
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
-restitution = 0.5
-
-[[generate]]
-material = "sand"
-count = 1300
-diameter = { min = 0.8e-3, max = 1.2e-3 }
-region = { shape = "box", min = [0.0, 0.0, 0.0], max = [14.0e-3, 14.0e-3, 14.0e-3] }
-random_speed = 0.5
-
-[periodic]
-x = [0.0, 14.0e-3]
-y = [0.0, 14.0e-3]
-z = [0.0, 14.0e-3]
-
-[model]
-normal = "hertz"
-damping = "restitution"
-tangential = "mindlin"
-tangential_damping_ratio = 0.9075
-
-[[stage]]
-kind = "run"
-duration = 1.0e-3
-"#;
+    /// A periodic gas under the lanes' law, shared with `tests/mpi.rs`.
+    const SCENE: &str = include_str!("../../tests/fixtures/periodic_gas.toml");
 
     /// `SCENE` with a third of its grains of a second, stiffer and rougher material.
     fn two_materials() -> String {
