@@ -2,8 +2,10 @@
 //! resolves (file and heading), and every key the scene parser accepts is in the scene
 //! reference, under its table's heading.
 
+mod common;
+
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use grains::scene::schema::SceneFile;
 
@@ -13,19 +15,8 @@ fn root() -> PathBuf {
 
 /// Every Markdown file a reader is sent to: the README and everything under `docs/`.
 fn markdown_files() -> Vec<PathBuf> {
-    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-        let mut entries: Vec<_> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
-        entries.sort();
-        for p in entries {
-            if p.is_dir() {
-                walk(&p, out);
-            } else if p.extension().is_some_and(|e| e == "md") {
-                out.push(p);
-            }
-        }
-    }
     let mut files = vec![root().join("README.md")];
-    walk(&root().join("docs"), &mut files);
+    files.extend(common::files_below(&root().join("docs"), "md"));
     files
 }
 

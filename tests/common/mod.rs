@@ -223,3 +223,14 @@ water_content = 0.01
         grain(0.0, 0.0)
     )
 }
+
+/// The files below `dir` whose names end in `.ext`, every level down, in sorted order.
+pub fn files_below(dir: &std::path::Path, ext: &str) -> Vec<std::path::PathBuf> {
+    let mut out: Vec<std::path::PathBuf> = walkdir::WalkDir::new(dir)
+        .into_iter()
+        .map(|e| e.unwrap_or_else(|e| panic!("{}: {e}", dir.display())).into_path())
+        .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == ext))
+        .collect();
+    out.sort();
+    out
+}
