@@ -16,10 +16,9 @@ pub mod reduce;
 mod wall;
 
 pub use arrays::{material_at, Body, Counts, HistorySlots, ImageCount, Images, Load, PairFlags, PairReports, Props};
-pub use grid::{detect_pairs, hash_cells, CellGrid, MAX_CELLS_PER_GRAIN};
+pub use grid::{detect_pairs, hash_cells, CellGrid};
 pub use pairs::{owned_pairs, remap_all, remap_history, PairList};
 pub use context::{coeffs_of, ForceContext};
-pub use profile::PHASE_NAMES;
 pub use wall::{wall_contact, wall_contact_records, WallState};
 
 /// Bytes a vector holds allocated.
