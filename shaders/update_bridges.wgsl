@@ -31,8 +31,8 @@ fn update_bridges() {
         } else if (liquid[i] > 0.0 || liquid[j] > 0.0) {
             var a = liquid[i] * 0.5;
             var c = liquid[j] * 0.5;
-            if (a + c > params.bridge_cap) {
-                let s = params.bridge_cap / (a + c);
+            if (a + c > params.cohesion.w) {
+                let s = params.cohesion.w / (a + c);
                 a *= s;
                 c *= s;
             }

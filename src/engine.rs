@@ -323,7 +323,7 @@ pub struct ContactRecord {
     /// Overlap (m).
     pub overlap: f64,
     /// Total normal force (N, compressive positive, tensile negative): elastic + damping +
-    /// capillary.
+    /// capillary, less an adhesive law's pull-off.
     pub normal_force: f64,
     /// Total force on i (N).
     pub force: [f64; 3],

@@ -44,6 +44,7 @@ pub fn shared(name: &str) -> &'static str {
         "dispatch" => include_str!("../shaders/shared/dispatch.wgsl"),
         "grid" => include_str!("../shaders/shared/grid.wgsl"),
         "model" => include_str!("../shaders/shared/model.wgsl"),
+        "model/normal" => include_str!("../shaders/shared/model/normal.wgsl"),
         "neighbours" => include_str!("../shaders/shared/neighbours.wgsl"),
         "walls" => include_str!("../shaders/shared/walls.wgsl"),
         "reduce" => include_str!("../shaders/shared/reduce.wgsl"),
@@ -57,10 +58,17 @@ pub fn shared(name: &str) -> &'static str {
 }
 
 impl Kernel {
-    /// The full WGSL of the kernel: its includes, then its own file.
+    /// The full WGSL of the kernel: its includes, then its own file. The contact model's
+    /// files (`model`) come after the normal slot's law codes, written from its registry, and
+    /// its file (`shaders/shared/model/normal.wgsl`).
     pub fn wgsl(&self) -> String {
         let mut s = String::new();
         for inc in self.includes {
+            if *inc == "model" {
+                s.push_str(&crate::model::normal::wgsl_codes());
+                s.push_str(shared("model/normal"));
+                s.push('\n');
+            }
             s.push_str(shared(inc));
             s.push('\n');
         }

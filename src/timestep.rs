@@ -13,7 +13,7 @@
 //! `t_c /` [`WARN_COLLISION_STEPS`] gets a warning; above [`MAX_RAYLEIGH_FRACTION`] `t_R` or
 //! `t_c /` [`MAX_COLLISION_STEPS`] the scene is refused.
 
-use crate::model::{ContactModel, NormalLaw, PairCoeffs};
+use crate::model::{ContactModel, NormalSetup, PairCoeffs};
 pub use crate::scene::types::{CharacteristicTimes, TimeStep};
 use crate::scene::types::{Grains, Material, Wall};
 
@@ -84,10 +84,7 @@ pub fn rayleigh_time(r: f64, density: f64, youngs_modulus: f64, poisson_ratio: f
     std::f64::consts::PI * r * (density / g).sqrt() / (0.1631 * poisson_ratio + 0.8766)
 }
 
-/// Hertz collision time (s) at relative speed `v` (m/s).
-pub fn hertz_collision_time(m_eff: f64, r_eff: f64, v_eff: f64, v: f64) -> f64 {
-    2.868 * (m_eff * m_eff / (r_eff * v_eff * v_eff * v)).powf(0.2)
-}
+pub use crate::model::hertz_collision_time;
 
 /// Largest overlap (m) of an undamped Hertz collision at relative speed `v` (m/s).
 pub fn hertz_max_overlap(m_eff: f64, r_eff: f64, v_eff: f64, v: f64) -> f64 {
@@ -127,16 +124,13 @@ pub fn characteristic_times(materials: &[Material], grains: &Grains, walls: &[Wa
             Some((rb, mb)) => (ra * rb / (ra + rb), ma * mb / (ma + mb)),
             None => (ra, ma),
         };
-        match model.normal {
-            NormalLaw::Hertz => hertz_collision_time(m_eff, r_eff, c.v_eff, v),
-            NormalLaw::Linear { k_n } => std::f64::consts::PI * (m_eff / k_n).sqrt(),
-        }
+        model.normal.collision_time(m_eff, r_eff, c.v_eff, v)
     };
     let mut t_c = f64::INFINITY;
     let mut t_r = f64::INFINITY;
     for (a, sa) in smallest.iter().enumerate() {
         let Some(sa) = *sa else { continue };
-        if model.normal == NormalLaw::Hertz {
+        if model.normal.uses_moduli() {
             let m = &materials[a];
             t_r = t_r.min(rayleigh_time(sa.0, m.density.unwrap_or(0.0), m.constants.youngs_modulus, m.constants.poisson_ratio));
         }

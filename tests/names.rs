@@ -8,11 +8,10 @@ use std::path::Path;
 /// file below it but the build's and git's own.
 fn tracked() -> Vec<String> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    if let Ok(out) = std::process::Command::new("git").arg("-C").arg(root).arg("ls-files").output() {
-        if out.status.success() {
+    if let Ok(out) = std::process::Command::new("git").arg("-C").arg(root).arg("ls-files").output()
+        && out.status.success() {
             return String::from_utf8(out.stdout).expect("UTF-8 paths").lines().map(str::to_string).collect();
         }
-    }
     let mut files = Vec::new();
     let mut dirs = vec![root.to_path_buf()];
     while let Some(dir) = dirs.pop() {

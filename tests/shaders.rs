@@ -157,8 +157,8 @@ fn rust_mirrors_match_the_wgsl_structures() {
     let m = module(&format!("{src}\n@group(0) @binding(0) var<storage, read_write> c: Control;\n@compute @workgroup_size(1) fn main() {{ atomicStore(&c.max_disp2, 0u); }}"), "types");
     check_struct!(&m, layout::Params, "Params", [
         n_grains, n_walls, n_materials, pair_capacity, hash_size, max_neighbours, piston, hist_blocks,
-        gravity, cell, periodic_lo, periodic_len, periodic_dims, skin, k_n, c_n, reach, kappa, kt_ratio,
-        damping_ratio, k_r, gamma_r, mu_r, static_damping, rolling_as_written, theta, capillary_c, bridge_cap, kt_law
+        gravity, cell, periodic_lo, periodic_len, periodic_dims, normal, damping, tangential, rolling, cohesion,
+        skin, reach, kt_law, rolling_as_written
     ]);
     check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, then_kick]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);

@@ -1,9 +1,8 @@
 // Contact sub-models, the WGSL twins of src/model/*.rs. Conventions: n points from j to i;
 // h > 0 in contact; forces and torques are "on i" unless named _j.
 
-// The laws' codes (src/model/mod.rs `code`, checked by tests/shaders.rs).
-const NORMAL_HERTZ: u32 = 0u;
-const NORMAL_LINEAR: u32 = 1u;
+// The laws' codes (src/model/laws.rs `code`, checked by tests/shaders.rs; the normal slot's
+// are written from its registry, src/model/normal/mod.rs).
 const DAMPING_NONE: u32 = 0u;
 const DAMPING_PAPERS: u32 = 1u;
 const DAMPING_RESTITUTION: u32 = 2u;
@@ -162,14 +161,14 @@ const BRIDGE_TOUCH: u32 = 2u;
 // Capillary bridges (src/model/capillary.rs): whether the gap delta (m) lies within the
 // rupture distance (1 + theta/2) V^(1/3) (m), tested on the cubes as the CPU does.
 fn within_rupture(v_b: f32, delta: f32) -> bool {
-    let k = 1.0 + params.theta * 0.5;
+    let k = 1.0 + params.cohesion.y * 0.5;
     return delta <= 0.0 || delta * delta * delta <= k * k * k * v_b;
 }
 
 // Decay length of the capillary force across the gap (m), Richefeu et al. (2009) eq. 8.
 fn decay_length(r_i: f32, r_j: f32, v_b: f32) -> f32 {
     let ratio = max(r_i / r_j, r_j / r_i);
-    return params.capillary_c * 0.70710678118654752 * sqrt((1.0 / r_i + 1.0 / r_j) / ratio * v_b);
+    return params.cohesion.z * 0.70710678118654752 * sqrt((1.0 / r_i + 1.0 / r_j) / ratio * v_b);
 }
 
 // Capillary normal force (N, tensile negative) of a bridge of volume v_b at gap delta (m).
@@ -177,7 +176,7 @@ fn capillary_force(r_i: f32, r_j: f32, v_b: f32, delta: f32) -> f32 {
     if (v_b <= 0.0) {
         return 0.0;
     }
-    let f0 = -params.kappa * sqrt(r_i * r_j);
+    let f0 = -params.cohesion.x * sqrt(r_i * r_j);
     if (delta < 0.0) {
         return f0;
     }
@@ -212,37 +211,16 @@ fn geometry_grain_wall(n: vec3<f32>, dist: f32, r_i: f32, m_i: f32) -> Geometry 
     return g;
 }
 
-// Elastic normal force (N) and secant stiffness F/h (N/m).
-fn normal_elastic(c: PairCoeffs, g: Geometry) -> vec2<f32> {
-    if (NORMAL_LAW == NORMAL_HERTZ) {
-        let k = 4.0 / 3.0 * c.v_eff * sqrt(g.r_eff * g.h);
-        return vec2<f32>(k * g.h, k);
-    }
-    return vec2<f32>(params.k_n * g.h, params.k_n);
-}
-
-// Normal tangent stiffness dF_el/dh (N/m): 2 V_eff sqrt(R_eff h) (Hertz), k_n (linear).
-fn normal_stiffness(c: PairCoeffs, g: Geometry) -> f32 {
-    if (NORMAL_LAW == NORMAL_LINEAR) {
-        return params.k_n;
-    }
-    return 2.0 * c.v_eff * sqrt(g.r_eff * g.h);
-}
-
 // Damping coefficient eta (kg/s): the damping force on i is -eta v_n n.
 fn normal_damping(c: PairCoeffs, g: Geometry) -> f32 {
     if (DAMPING_LAW == DAMPING_PAPERS) {
         return g.m_eff * c.gamma_n * sqrt(g.h);
     }
     if (DAMPING_LAW == DAMPING_RESTITUTION) {
-        if (NORMAL_LAW == NORMAL_HERTZ) {
-            let s_n = 2.0 * c.v_eff * sqrt(g.r_eff * g.h);
-            return 2.0 * sqrt(5.0 / 6.0) * c.beta * sqrt(s_n * g.m_eff);
-        }
-        return 2.0 * c.beta * sqrt(params.k_n * g.m_eff);
+        return normal_restitution_damping(c, g);
     }
     if (DAMPING_LAW == DAMPING_VISCOUS) {
-        return params.c_n;
+        return params.damping.x;
     }
     return 0.0;
 }
@@ -252,13 +230,13 @@ fn kick_window(elapsed: f32) -> f32 {
     return select(0.0, elapsed, CENTRED_KICKS);
 }
 
-// Exponents (p, q) of the overlap in F_el ~ h^p and eta ~ h^q (src/model/window.rs).
+// Exponents (p, q) of the overlap in F_el ~ h^p and eta ~ h^q (src/model/window.rs): the
+// restitution dashpot goes as the root of the tangent stiffness, q = (p - 1) / 2.
 fn overlap_exponents() -> vec2<f32> {
-    var p = 1.5;
-    if (NORMAL_LAW == NORMAL_LINEAR) { p = 1.0; }
+    let p = normal_exponent();
     var q = 0.0;
     if (DAMPING_LAW == DAMPING_PAPERS) { q = 0.5; }
-    if (DAMPING_LAW == DAMPING_RESTITUTION && NORMAL_LAW == NORMAL_HERTZ) { q = 0.25; }
+    if (DAMPING_LAW == DAMPING_RESTITUTION) { q = (p - 1.0) * 0.5; }
     return vec2<f32>(p, q);
 }
 
@@ -340,7 +318,7 @@ fn contact_tangential_velocity(g: Geometry, k: Kinematics) -> vec3<f32> {
 
 fn tangential_stiffness(c: PairCoeffs, g: Geometry, k_secant: f32) -> f32 {
     if (params.kt_law == STIFFNESS_RATIO) {
-        return params.kt_ratio * k_secant;
+        return params.tangential.x * k_secant;
     }
     return 8.0 * c.g_eff * sqrt(g.r_eff * g.h);
 }
@@ -400,11 +378,17 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
     if (out.clamped) {
         f_signed = 0.0;
     }
+    // The friction limits take the normal force's magnitude (unclamped, the dashpot can pull);
+    // under an adhesive law, LAMMPS' |F_el - F_po + 2 F_po| (the dashpot left out).
+    var f_n = abs(f_signed);
+    if (normal_adhesive()) {
+        let pull = normal_pull_off(g);
+        f_signed -= pull;
+        f_n = abs(el.x + pull);
+    }
     out.f_n = f_signed;
     out.f_i = g.n * f_signed;
     out.f_j = -out.f_i;
-    // The friction limits take the normal force's magnitude: unclamped, the dashpot can pull.
-    let f_n = abs(f_signed);
     let elapsed = since_touch(*hist, g.h, v_n, elapsed_step);
     out.t_i = vec3<f32>(0.0);
     out.t_j = vec3<f32>(0.0);
@@ -418,7 +402,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
         let mobility_i = 1.0 / b.m_i + g.rp_i * g.rp_i / b.inertia_i;
         var mobility_j = 0.0;
         if (!b.j_is_wall) { mobility_j = 1.0 / b.m_j + g.rp_j * g.rp_j / b.inertia_j; }
-        let eta_t = 2.0 * params.static_damping * sqrt(k_t / (mobility_i + mobility_j));
+        let eta_t = 2.0 * params.tangential.z * sqrt(k_t / (mobility_i + mobility_j));
         var mu = max(c.mu_s, c.mu_k);
         if ((*hist).sliding) { mu = c.mu_k; }
         let t = elastic_plastic(xi, v_t, k_t, eta_t, mu * f_n, c.mu_k * f_n);
@@ -438,7 +422,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
             var mobility = 1.0 / b.inertia_i;
             if (!b.j_is_wall) { mobility = 1.0 / b.inertia_i + 1.0 / b.inertia_j; }
             let mobility_r = g.rp_eff * g.rp_eff * mobility;
-            let eta_r = 2.0 * params.static_damping * sqrt(k_t / mobility_r);
+            let eta_r = 2.0 * params.tangential.z * sqrt(k_t / mobility_r);
             let limit_r = f_n * c.tan_roll;
             let r = elastic_plastic(psi, v_r, k_t, eta_r, limit_r, limit_r);
             (*hist).rolling = r.spring;
@@ -474,7 +458,7 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
         let k_t = tangential_stiffness(c, g, el.y);
         let v_t = contact_tangential_velocity(g, k);
         (*hist).tangential = rotate_into_plane((*hist).tangential, g.n) + v_t * elapsed;
-        let damp = v_t * (eta_n * params.damping_ratio);
+        let damp = v_t * (eta_n * params.tangential.y);
         var f_t = -((*hist).tangential * k_t) - damp;
         let limit = c.mu_s * f_n;
         let mag2 = dot(f_t, f_t);
@@ -491,13 +475,13 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
     if (ROLLING_LAW == ROLLING_SDS) {
         let v_rl = cross(k.w_i - k.w_j, g.n) * g.r_eff;
         (*hist).rolling = rotate_into_plane((*hist).rolling, g.n) + v_rl * elapsed;
-        let damp = v_rl * params.gamma_r;
-        var f_r = -((*hist).rolling * params.k_r) - damp;
-        let limit = params.mu_r * f_n;
+        let damp = v_rl * params.rolling.y;
+        var f_r = -((*hist).rolling * params.rolling.x) - damp;
+        let limit = params.rolling.z * f_n;
         let mag2 = dot(f_r, f_r);
         if (mag2 > limit * limit) {
             f_r = f_r * (limit / sqrt(mag2));
-            if (params.k_r > 0.0) { (*hist).rolling = (f_r + damp) * (-1.0 / params.k_r); } else { (*hist).rolling = vec3<f32>(0.0); }
+            if (params.rolling.x > 0.0) { (*hist).rolling = (f_r + damp) * (-1.0 / params.rolling.x); } else { (*hist).rolling = vec3<f32>(0.0); }
         }
         let tau = cross(g.n, f_r) * g.r_eff;
         out.t_i += tau;
@@ -510,12 +494,4 @@ fn contact_force(c: PairCoeffs, g: Geometry, k: Kinematics, b: Bodies, hist: ptr
         out.t_j -= tau;
     }
     return out;
-}
-
-// Elastic energy (J) of a normal spring with overlap h.
-fn normal_potential(c: PairCoeffs, r_eff: f32, h: f32) -> f32 {
-    if (NORMAL_LAW == NORMAL_HERTZ) {
-        return 8.0 / 15.0 * sqrt(r_eff) * c.v_eff * h * h * sqrt(h);
-    }
-    return 0.5 * params.k_n * h * h;
 }

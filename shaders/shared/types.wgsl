@@ -16,22 +16,16 @@ struct Params {
     periodic_lo: vec4<f32>,
     periodic_len: vec4<f32>, // period per axis (m); 0 where the axis does not wrap
     periodic_dims: vec4<u32>, // cells per wrapping axis; 0 where it does not wrap
+    // One block per slot of the contact model, its laws' constants (src/model/):
+    normal: vec4<f32>,     // the normal law's (src/model/normal/<law>.rs gpu_block): x k_n (N/m, linear) or gamma (J/m^2, dmt)
+    damping: vec4<f32>,    // x: viscous c_n (N s/m)
+    tangential: vec4<f32>, // x: k_t / (F_el / h) when kt_law is STIFFNESS_RATIO; y: eta_t / eta_n (Hertz-Mindlin dashpot); z: Oquendo et al.'s spring damping, fraction of critical
+    rolling: vec4<f32>,    // sds: x k_r (N/m), y gamma_r (N s/m), z mu_r (-)
+    cohesion: vec4<f32>,   // capillary: x kappa = 2 pi gamma cos(theta) (N/m), y theta (rad), z decay-length c (-), w largest bridge volume (m^3)
     skin: f32,            // m
-    k_n: f32,             // linear normal stiffness (N/m)
-    c_n: f32,             // viscous damping (N s/m)
     reach: f32,           // distance beyond contact that pair detection reaches (m)
-    kappa: f32,           // capillary 2 pi gamma cos(theta) (N/m)
-    kt_ratio: f32,        // k_t / (F_el / h) when kt_law is STIFFNESS_RATIO
-    damping_ratio: f32,   // eta_t / eta_n (Hertz-Mindlin tangential dashpot)
-    k_r: f32,             // rolling stiffness (N/m)
-    gamma_r: f32,         // rolling damping (N s/m)
-    mu_r: f32,            // rolling friction
-    static_damping: f32,  // Oquendo et al.'s static and rolling springs: fraction of critical damping
+    kt_law: u32,          // STIFFNESS_MINDLIN or STIFFNESS_RATIO (tangential.x x the normal secant stiffness)
     rolling_as_written: u32, // Oquendo et al.'s rolling friction: 0 torque pair, 1 eqs. 8-9 on each grain
-    theta: f32,           // capillary contact angle (rad)
-    capillary_c: f32,     // capillary decay-length coefficient (-)
-    bridge_cap: f32,      // largest bridge volume (m^3)
-    kt_law: u32,          // STIFFNESS_MINDLIN or STIFFNESS_RATIO (kt_ratio x the normal secant stiffness)
 }
 
 // What changes between the dispatches of one step (uniform, dynamic offset).

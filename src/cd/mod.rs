@@ -250,6 +250,9 @@ impl<T: Real> ContactDynamics<T> {
         if !matches!(scene.model.cohesion, crate::model::CohesionLaw::None) {
             return unsupported("capillary cohesion", "drop [model] cohesion");
         }
+        if crate::model::NormalSetup::adhesive(&scene.model.normal) {
+            return unsupported("an adhesive normal law (DMT)", "use normal = \"hertz\" or the DEM method");
+        }
         let n_materials = scene.materials.len();
         let mut coeffs = Vec::with_capacity(n_materials * n_materials);
         for a in &scene.materials {

@@ -16,7 +16,7 @@
 use crate::state::ForceContext;
 use crate::state::PairList;
 use crate::state::{Body, Props};
-use crate::model::{at_edge, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, History, Kinematics, NormalLaw, PairCoeffs, Regime, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw, KickWindow};
+use crate::model::{at_edge, contact_force, Bodies, CohesionLaw, ContactForce, ContactModel, DampingLaw, Geometry, Hertz, History, Kinematics, NormalLaw, PairCoeffs, Regime, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw, KickWindow};
 use crate::position::{complete, residual_at};
 use crate::real::{Real, Vec3};
 
@@ -34,7 +34,7 @@ const _: () = assert!((LANES * std::mem::size_of::<f32>()).is_multiple_of(64));
 pub fn hertz_mindlin<T: Real>(model: &ContactModel<T>) -> Option<ContactModel<T>> {
     let TangentialLaw::Mindlin { damping_ratio, .. } = model.tangential else { return None };
     let fixed = ContactModel {
-        normal: NormalLaw::Hertz,
+        normal: NormalLaw::Hertz(Hertz),
         damping: DampingLaw::Restitution,
         tangential: TangentialLaw::Mindlin { damping_ratio, stiffness: TangentialStiffness::Mindlin },
         rolling: RollingLaw::None,

@@ -45,7 +45,7 @@ use crate::state::{allocated, renew, Body, Counts, ForceContext, HistorySlots, I
 use rebuild::kept_or_found;
 use crate::engine::EngineState;
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
-use crate::model::{capillary_potential, normal_potential, share_liquid, within_rupture, CohesionLaw, ContactModel, PairCoeffs};
+use crate::model::{capillary_potential, share_liquid, within_rupture, CohesionLaw, ContactModel, PairCoeffs};
 use crate::periodic::Periodic;
 use crate::position;
 use crate::real::{Real, Vec3};

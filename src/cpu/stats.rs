@@ -3,6 +3,7 @@
 //! however the slots are numbered).
 
 use super::*;
+use crate::model::NormalModel;
 use crate::state::coeffs_of;
 
 /// Per-chunk partial sums of the statistics over grains.
@@ -89,7 +90,7 @@ impl<T: Real> CpuEngine<T> {
                         contacts += 1;
                         let c = coeffs_of(&self.coeffs, self.n_materials, wall.material as usize, crate::state::material_at(&self.material, i));
                         s.wall_contacts += 1;
-                        s.wall_elastic += normal_potential(&self.model.normal, c, p.radius, h).f64();
+                        s.wall_elastic += self.model.normal.potential(c, p.radius, h).f64();
                         s.max_wall_overlap = max_by_first(s.max_wall_overlap, ((h / p.radius).f64(), self.id[i]));
                     }
                 }
@@ -120,7 +121,7 @@ impl<T: Real> CpuEngine<T> {
                 s.contacts += 1;
                 s.clamped += self.report.clamped(k) as u64;
                 s.regimes.count(self.report.regime(k));
-                s.elastic += normal_potential(&self.model.normal, c, r_eff, h).f64();
+                s.elastic += self.model.normal.potential(c, r_eff, h).f64();
                 s.force += 2.0 * self.owner_force(k).norm().f64();
                 s.max_overlap = max_by_first(s.max_overlap, ((h / r_min).f64(), self.id[i]));
             }

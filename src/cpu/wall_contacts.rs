@@ -3,7 +3,7 @@
 
 use super::wall_springs::is_candidate;
 use crate::state::{wall_contact, Body, ForceContext, Load, Props, WallState};
-use crate::model::{normal_damping, normal_stiffness, parted_normal_force, Geometry, Regime};
+use crate::model::{normal_damping, parted_normal_force, Geometry, NormalModel, Regime};
 use crate::real::{Real, Vec3};
 
 /// What one grain-wall contact adds to its wall's sums.
@@ -82,7 +82,7 @@ pub fn wall_contacts<T: Real>(
             grain: id,
             wall: w as u32,
             force: f.f_i,
-            stiffness: normal_stiffness(&ctx.model.normal, c, &geo),
+            stiffness: ctx.model.normal.stiffness(c, &geo),
             damping: normal_damping(&ctx.model.damping, &ctx.model.normal, c, &geo),
             regime: f.regime,
             touching: true,

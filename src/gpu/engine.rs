@@ -17,7 +17,7 @@ use encode::Size;
 use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, SCAN_BLOCK, STAT_ROW};
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
 use crate::kernels::KERNELS;
-use crate::model::{DampingLaw, HistoryLayout, NormalLaw, PairCoeffs, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness};
+use crate::model::{HistoryLayout, NormalSetup, PairCoeffs, RollingFriction, TangentialLaw};
 use super::plan::{Dispatch, Entry, Plans};
 use crate::schedule::{Op, Schedule, Trace};
 use crate::scene::{Scene, WallShape};
@@ -225,12 +225,8 @@ impl GpuEngine {
             cell: [cutoff as f32; 4],
             skin: scene.skin as f32,
             reach: reach as f32,
-            bridge_cap: scene.bridges.volume_cap as f32,
             ..Default::default()
         };
-        if let crate::model::CohesionLaw::Capillary { kappa, theta, c } = model.cohesion {
-            (params.kappa, params.theta, params.capillary_c) = (kappa as f32, theta as f32, c as f32);
-        }
         for a in 0..3 {
             if let Some([lo, hi]) = scene.periodic[a] {
                 let dims = ((hi - lo) / cutoff).floor().max(1.0);
@@ -240,34 +236,18 @@ impl GpuEngine {
                 params.cell[a] = ((hi - lo) / dims) as f32;
             }
         }
-        if let NormalLaw::Linear { k_n } = model.normal {
-            params.k_n = k_n as f32;
-        }
-        if let DampingLaw::Viscous { c_n } = model.damping {
-            params.c_n = c_n as f32;
-        }
-        let stiffness = |s: TangentialStiffness<f64>, params: &mut Params| {
-            params.kt_law = s.code();
-            if let TangentialStiffness::RatioToNormal(r) = s {
-                params.kt_ratio = r as f32;
-            }
-        };
+        params.normal = model.normal.gpu_block();
+        params.damping = model.damping.gpu_block();
+        params.tangential = model.tangential.gpu_block();
+        params.rolling = model.rolling.gpu_block();
+        params.cohesion = model.cohesion.gpu_block(scene.bridges.volume_cap);
         match model.tangential {
             TangentialLaw::None => {}
             TangentialLaw::Oquendo(l) => {
-                params.static_damping = l.static_damping as f32;
+                params.kt_law = l.stiffness.code();
                 params.rolling_as_written = (l.rolling_friction == RollingFriction::AsWritten) as u32;
-                stiffness(l.stiffness, &mut params);
             }
-            TangentialLaw::Mindlin { damping_ratio, stiffness: s } => {
-                params.damping_ratio = damping_ratio as f32;
-                stiffness(s, &mut params);
-            }
-        }
-        if let RollingLaw::Sds { k_r, gamma_r, mu_r } = model.rolling {
-            params.k_r = k_r as f32;
-            params.gamma_r = gamma_r as f32;
-            params.mu_r = mu_r as f32;
+            TangentialLaw::Mindlin { stiffness, .. } => params.kt_law = stiffness.code(),
         }
 
         // Walls.

@@ -34,40 +34,27 @@ pub struct Params {
     pub periodic_len: [f32; 4],
     /// Cells per periodic axis, 0 where it does not wrap.
     pub periodic_dims: [u32; 4],
+    /// The normal law's constants ([`crate::model::NormalSetup::gpu_block`]).
+    pub normal: [f32; 4],
+    /// The damping law's ([`crate::model::DampingLaw::gpu_block`]).
+    pub damping: [f32; 4],
+    /// The tangential law's ([`crate::model::TangentialLaw::gpu_block`]).
+    pub tangential: [f32; 4],
+    /// The rolling law's ([`crate::model::RollingLaw::gpu_block`]).
+    pub rolling: [f32; 4],
+    /// The cohesion law's ([`crate::model::CohesionLaw::gpu_block`]), the largest bridge
+    /// volume (m^3) in `w`.
+    pub cohesion: [f32; 4],
     /// Verlet skin (m).
     pub skin: f32,
-    /// Linear normal stiffness (N/m).
-    pub k_n: f32,
-    /// Viscous damping (N s/m).
-    pub c_n: f32,
     /// Distance beyond contact that pair detection reaches (m): the skin, plus the rupture
     /// distance of the largest liquid bridge in capillary scenes.
     pub reach: f32,
-    /// Capillary `kappa = 2 pi gamma cos(theta)` (N/m).
-    pub kappa: f32,
-    /// k_t over the normal secant stiffness, when `kt_law` is the ratio.
-    pub kt_ratio: f32,
-    /// Hertz-Mindlin tangential damping ratio.
-    pub damping_ratio: f32,
-    /// Rolling stiffness (N/m).
-    pub k_r: f32,
-    /// Rolling damping (N s/m).
-    pub gamma_r: f32,
-    /// Rolling friction.
-    pub mu_r: f32,
-    /// Oquendo et al.'s static and rolling spring damping, fraction of critical (-).
-    pub static_damping: f32,
+    /// Tangential stiffness: [`crate::model::code::STIFFNESS_MINDLIN`] or `STIFFNESS_RATIO`
+    /// (`tangential[0]` times the normal secant stiffness).
+    pub kt_law: u32,
     /// Oquendo et al.'s rolling friction: 0 a torque pair, 1 eqs. 8-9 on each grain as written.
     pub rolling_as_written: u32,
-    /// Capillary contact angle (rad).
-    pub theta: f32,
-    /// Capillary decay-length coefficient `c` (-).
-    pub capillary_c: f32,
-    /// Largest bridge volume (m^3).
-    pub bridge_cap: f32,
-    /// Tangential stiffness: [`crate::model::code::STIFFNESS_MINDLIN`] or `STIFFNESS_RATIO`
-    /// (`kt_ratio` times the normal secant stiffness).
-    pub kt_law: u32,
 }
 
 /// What changes between dispatches of one step (WGSL `Phase`, uniform with dynamic offset).

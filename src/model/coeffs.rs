@@ -119,11 +119,7 @@ impl<T: Real> PairCoeffs<T> {
             gamma_nt: T::of(mean(a.gamma_nt, b.gamma_nt)),
             beta: T::of(match model.damping {
                 DampingLaw::Restitution => {
-                    let spring = match model.normal {
-                        NormalLaw::Hertz => restitution::Spring::Hertz,
-                        NormalLaw::Linear { .. } => restitution::Spring::Linear,
-                    };
-                    restitution::dashpot_ratio(mean(a.restitution, b.restitution), spring, model.limit_damping)
+                    restitution::dashpot_ratio(mean(a.restitution, b.restitution), model.normal.spring(), model.limit_damping)
                 }
                 _ => 0.0,
             }),

@@ -14,7 +14,8 @@ pub struct ContactForce<T> {
     pub t_i: Vec3<T>,
     /// Torque on j (N m).
     pub t_j: Vec3<T>,
-    /// Elastic + damping normal force after the no-pull clamp (N, compressive positive).
+    /// Elastic + damping normal force after the no-pull clamp, less an adhesive normal law's
+    /// pull-off (N, compressive positive).
     pub f_n: T,
     /// Capillary normal force (N, tensile negative; 0 without a bridge).
     pub f_c: T,
@@ -69,14 +70,19 @@ pub fn contact_force<T: Real>(
 ) -> ContactForce<T> {
     let v_rel = kin.v_i - kin.v_j;
     let v_n = v_rel.dot(geo.n);
-    let (f_el, k_secant) = normal_elastic(&model.normal, c, geo);
+    let (f_el, k_secant) = model.normal.elastic(c, geo);
     let eta_n = normal_damping(&model.damping, &model.normal, c, geo);
     let driven = driven_normal_velocity(kin.v_i, kin.v_j, geo.n, bodies.j_is_wall);
     let (f_n, clamped) = windowed_normal_force(model, c, geo, f_el, eta_n, v_n, driven - hist.v_n, window);
     hist.v_n = driven;
+    // The friction limits take the normal force's magnitude (unclamped, the dashpot can pull);
+    // under an adhesive law, LAMMPS' |F_el - F_po + 2 F_po| (the dashpot left out).
+    let (f_n, friction_load) = match model.normal.pull_off(geo) {
+        None => (f_n, f_n.abs()),
+        Some(pull) => (f_n - pull, (f_el + pull).abs()),
+    };
     let mut out = ContactForce { f_i: geo.n * f_n, f_j: geo.n * (-f_n), f_n, clamped, ..Default::default() };
-    // The friction limits take the normal force's magnitude: unclamped, the dashpot can pull.
-    let f_n = f_n.abs();
+    let f_n = friction_load;
     let elapsed = since_touch(hist, geo.h, v_n, elapsed);
 
     match model.tangential {
@@ -126,15 +132,5 @@ pub(super) fn tangential_stiffness<T: Real>(s: &TangentialStiffness<T>, c: &Pair
     match *s {
         TangentialStiffness::Mindlin => T::of(8.0) * c.g_eff * (geo.r_eff * geo.h).sqrt(),
         TangentialStiffness::RatioToNormal(r) => r * k_secant,
-    }
-}
-
-/// Elastic potential energy (J) stored in the normal spring of a contact with overlap `h`:
-/// Hertz `8/15 sqrt(R_eff) V_eff h^(5/2)`, linear `k_n h^2 / 2`.
-#[inline]
-pub fn normal_potential<T: Real>(law: &NormalLaw<T>, c: &PairCoeffs<T>, r_eff: T, h: T) -> T {
-    match *law {
-        NormalLaw::Hertz => T::of(8.0 / 15.0) * r_eff.sqrt() * c.v_eff * h * h * h.sqrt(),
-        NormalLaw::Linear { k_n } => T::of(0.5) * k_n * h * h,
     }
 }

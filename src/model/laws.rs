@@ -6,10 +6,6 @@
 /// `shaders/shared/model.wgsl`, checked against these by `tests/shaders.rs`); each law's
 /// `code()` gives its own.
 pub mod code {
-    /// [`super::NormalLaw::Hertz`].
-    pub const NORMAL_HERTZ: u32 = 0;
-    /// [`super::NormalLaw::Linear`].
-    pub const NORMAL_LINEAR: u32 = 1;
     /// [`super::DampingLaw::None`].
     pub const DAMPING_NONE: u32 = 0;
     /// [`super::DampingLaw::Papers`].
@@ -42,8 +38,6 @@ pub mod code {
     pub const COHESION_CAPILLARY: u32 = 1;
     /// Every code by its WGSL name.
     pub const ALL: &[(&str, u32)] = &[
-        ("NORMAL_HERTZ", NORMAL_HERTZ),
-        ("NORMAL_LINEAR", NORMAL_LINEAR),
         ("DAMPING_NONE", DAMPING_NONE),
         ("DAMPING_PAPERS", DAMPING_PAPERS),
         ("DAMPING_RESTITUTION", DAMPING_RESTITUTION),
@@ -60,16 +54,6 @@ pub mod code {
         ("COHESION_NONE", COHESION_NONE),
         ("COHESION_CAPILLARY", COHESION_CAPILLARY),
     ];
-}
-
-impl<T> NormalLaw<T> {
-    /// The law's WGSL code.
-    pub fn code(&self) -> u32 {
-        match self {
-            NormalLaw::Hertz => code::NORMAL_HERTZ,
-            NormalLaw::Linear { .. } => code::NORMAL_LINEAR,
-        }
-    }
 }
 
 impl<T> DampingLaw<T> {
@@ -133,18 +117,6 @@ impl TwistingLaw {
             TwistingLaw::Oquendo => code::TWISTING_OQUENDO,
         }
     }
-}
-
-/// Elastic normal law.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum NormalLaw<T> {
-    /// Hertz: `F = 4/3 sqrt(R_eff) V_eff h^(3/2)` (Oquendo et al. eq. 1).
-    Hertz,
-    /// Linear spring: `F = k_n h`, `k_n` in N/m.
-    Linear {
-        /// Spring stiffness (N/m).
-        k_n: T,
-    },
 }
 
 /// Normal dissipation law, added to the elastic force before the no-pull clamp.
@@ -269,6 +241,56 @@ impl RollingFriction {
         match self {
             RollingFriction::Torque => "torque",
             RollingFriction::AsWritten => "as_written",
+        }
+    }
+}
+
+// Each slot's constants as the kernels read them: a block of four f32 per slot (WGSL
+// `params.<slot>`), so that a law's parameters never move the uniform's layout. Unused
+// components are zero.
+
+impl DampingLaw<f64> {
+    /// `[c_n, 0, 0, 0]` for the viscous dashpot (N s/m).
+    pub fn gpu_block(&self) -> [f32; 4] {
+        match *self {
+            DampingLaw::Viscous { c_n } => [c_n as f32, 0.0, 0.0, 0.0],
+            _ => [0.0; 4],
+        }
+    }
+}
+
+impl TangentialLaw<f64> {
+    /// `[k_t ratio, Hertz-Mindlin damping ratio, Oquendo et al.'s spring damping, 0]`.
+    pub fn gpu_block(&self) -> [f32; 4] {
+        let ratio = |s: TangentialStiffness<f64>| match s {
+            TangentialStiffness::RatioToNormal(r) => r as f32,
+            TangentialStiffness::Mindlin => 0.0,
+        };
+        match *self {
+            TangentialLaw::None => [0.0; 4],
+            TangentialLaw::Oquendo(l) => [ratio(l.stiffness), 0.0, l.static_damping as f32, 0.0],
+            TangentialLaw::Mindlin { damping_ratio, stiffness } => [ratio(stiffness), damping_ratio as f32, 0.0, 0.0],
+        }
+    }
+}
+
+impl RollingLaw<f64> {
+    /// `[k_r, gamma_r, mu_r, 0]` of the sds law.
+    pub fn gpu_block(&self) -> [f32; 4] {
+        match *self {
+            RollingLaw::None => [0.0; 4],
+            RollingLaw::Sds { k_r, gamma_r, mu_r } => [k_r as f32, gamma_r as f32, mu_r as f32, 0.0],
+        }
+    }
+}
+
+impl CohesionLaw<f64> {
+    /// `[kappa, theta, c, volume_cap]` of capillary bridges, `volume_cap` (m^3) the largest
+    /// bridge's volume (the scene's).
+    pub fn gpu_block(&self, volume_cap: f64) -> [f32; 4] {
+        match *self {
+            CohesionLaw::None => [0.0, 0.0, 0.0, volume_cap as f32],
+            CohesionLaw::Capillary { kappa, theta, c } => [kappa as f32, theta as f32, c as f32, volume_cap as f32],
         }
     }
 }

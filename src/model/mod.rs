@@ -1,5 +1,6 @@
 //! Contact sub-models as pure functions, composed in a fixed order:
-//! geometry -> normal (elastic + damping, no-pull clamp) -> tangential -> rolling -> twisting.
+//! geometry -> normal (elastic + damping, no-pull clamp, an adhesive law's pull-off) ->
+//! tangential -> rolling -> twisting -> cohesion.
 //!
 //! Every law follows docs/physics.md. Conventions: the normal `n` points from partner `j` to grain
 //! `i`; the overlap `h > 0` in contact; forces and torques are "on i" unless named `_j`.
@@ -12,9 +13,11 @@
 mod capillary;
 mod coeffs;
 mod contact;
+mod damping;
 mod geometry;
+pub mod keys;
 mod laws;
-mod normal;
+pub mod normal;
 pub mod restitution;
 mod rolling;
 mod tangential;
@@ -22,11 +25,12 @@ mod twisting;
 pub mod window;
 
 pub use coeffs::{History, HistoryLayout, MaterialConstants, PairCoeffs};
-pub use contact::{contact_force, normal_potential, ContactForce, Regime};
-pub use laws::{code, CohesionLaw, DampingLaw, NormalLaw, OquendoLaw, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
+pub use contact::{contact_force, ContactForce, Regime};
+pub use laws::{code, CohesionLaw, DampingLaw, OquendoLaw, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
 pub use capillary::{capillary_force, capillary_potential, decay_length, rupture_distance, share_liquid, within_rupture};
 pub use geometry::{Bodies, Geometry, Kinematics};
-pub use normal::{normal_damping, normal_elastic, normal_force, normal_stiffness};
+pub use damping::{normal_damping, normal_force};
+pub use normal::{hertz_collision_time, Hertz, Linear, NormalLaw, NormalModel, NormalSetup};
 pub use rolling::rolling_sds;
 pub use tangential::{contact_tangential_velocity, mindlin_tangential, oquendo_tangential, rotate_into_plane, since_touch, TangentialOut};
 pub use twisting::twisting_torque;
@@ -86,10 +90,7 @@ impl ContactModel<f64> {
             TangentialStiffness::RatioToNormal(r) => TangentialStiffness::RatioToNormal(u(r)),
         };
         ContactModel {
-            normal: match self.normal {
-                NormalLaw::Hertz => NormalLaw::Hertz,
-                NormalLaw::Linear { k_n } => NormalLaw::Linear { k_n: u(k_n) },
-            },
+            normal: self.normal.cast(),
             damping: match self.damping {
                 DampingLaw::None => DampingLaw::None,
                 DampingLaw::Papers => DampingLaw::Papers,
@@ -116,10 +117,7 @@ impl ContactModel<f64> {
 
     /// One line naming the law in each slot, for reports.
     pub fn describe(&self) -> String {
-        let normal = match self.normal {
-            NormalLaw::Hertz => "hertz".to_string(),
-            NormalLaw::Linear { k_n } => format!("linear(k_n={k_n:e} N/m)"),
-        };
+        let normal = self.normal.describe();
         let damping = match self.damping {
             DampingLaw::None => "none".to_string(),
             DampingLaw::Papers => "papers(gamma_n)".to_string(),
@@ -176,7 +174,7 @@ mod tests {
 
     /// Two 0.5 mm grains of 1.3875e-6 kg along x, overlapping by 1 um.
     fn pair() -> (PairCoeffs<f64>, Geometry<f64>) {
-        let c = PairCoeffs::mix(&sand(), &sand(), &restitution_model(NormalLaw::Hertz, true));
+        let c = PairCoeffs::mix(&sand(), &sand(), &restitution_model(NormalLaw::Hertz(Hertz), true));
         let g = Geometry::grain_grain(Vec3::new(0.999e-3, 0.0, 0.0), 0.999e-3, 5.0e-4, 5.0e-4, 1.3875e-6, 1.3875e-6);
         (c, g)
     }
@@ -192,9 +190,9 @@ mod tests {
         // that may pull has the oscillator's ln 2 / sqrt(ln^2 2 + pi^2).
         assert!(close(c.beta, restitution::dashpot_ratio(0.5, restitution::Spring::Hertz, true)));
         let (ln2, pi) = (std::f64::consts::LN_2, std::f64::consts::PI);
-        let linear: PairCoeffs<f64> = PairCoeffs::mix(&sand(), &sand(), &restitution_model(NormalLaw::Linear { k_n: 1.0e3 }, false));
+        let linear: PairCoeffs<f64> = PairCoeffs::mix(&sand(), &sand(), &restitution_model(NormalLaw::Linear(Linear { k_n: 1.0e3 }), false));
         assert!(close(linear.beta, ln2 / (ln2 * ln2 + pi * pi).sqrt()));
-        let papers = ContactModel { damping: DampingLaw::Papers, ..restitution_model(NormalLaw::Hertz, true) };
+        let papers = ContactModel { damping: DampingLaw::Papers, ..restitution_model(NormalLaw::Hertz(Hertz), true) };
         assert_eq!(PairCoeffs::<f64>::mix(&sand(), &sand(), &papers).beta, 0.0, "no dashpot ratio without restitution damping");
     }
 
@@ -213,16 +211,16 @@ mod tests {
     #[test]
     fn hertz_force_damping_and_clamp() {
         let (c, g) = pair();
-        let (f, k) = normal_elastic(&NormalLaw::Hertz, &c, &g);
+        let (f, k) = Hertz.elastic(&c, &g);
         // 4/3 sqrt(2.5e-4) 3.846153846e7 (1e-6)^1.5
         let hand = 4.0 / 3.0 * 0.015811388300841896 * (7.0e7 / 0.91 / 2.0) * 1.0e-9;
         assert!(close(f, hand) && close(k, hand / 1.0e-6));
         // m_eff gamma_n sqrt(h) = 6.9375e-7 * 1e5 * 1e-3
-        assert!(close(normal_damping(&DampingLaw::Papers, &NormalLaw::Hertz, &c, &g), 6.9375e-7 * 1.0e5 * 1.0e-3));
+        assert!(close(normal_damping(&DampingLaw::Papers, &NormalLaw::Hertz(Hertz), &c, &g), 6.9375e-7 * 1.0e5 * 1.0e-3));
         assert_eq!(normal_force(1.0, 2.0, -0.25, true), (1.5, false));
         assert_eq!(normal_force(1.0, 2.0, 1.0, true), (0.0, true));
         assert_eq!(normal_force(1.0, 2.0, 1.0, false), (-1.0, false), "unclamped, the dashpot pulls");
-        assert!(close(normal_potential(&NormalLaw::Hertz, &c, g.r_eff, g.h), 0.4 * hand * 1.0e-6));
+        assert!(close(Hertz.potential(&c, g.r_eff, g.h), 0.4 * hand * 1.0e-6));
     }
 
     #[test]

@@ -23,23 +23,21 @@
 //! The mends act on damped laws under velocity Verlet (a `window` of zero turns them off: the
 //! optimised scheme's evaluations are not centred on their kicks).
 
-use super::{normal_damping, normal_elastic, ContactModel, DampingLaw, Geometry, NormalLaw, PairCoeffs};
+use super::{normal_damping, ContactModel, DampingLaw, Geometry, NormalLaw, NormalModel, PairCoeffs};
 use crate::real::Real;
 
 /// Exponents `(p, q)` of the overlap in the elastic force `F_el ~ h^p` and the dashpot
-/// coefficient `eta ~ h^q`.
+/// coefficient `eta ~ h^q`: the restitution dashpot goes as the square root of the tangent
+/// stiffness, `q = (p - 1) / 2`.
 #[inline(always)]
 pub fn overlap_exponents<T: Real>(normal: &NormalLaw<T>, damping: &DampingLaw<T>) -> (T, T) {
-    let p = match normal {
-        NormalLaw::Hertz => 1.5,
-        NormalLaw::Linear { .. } => 1.0,
+    let p = normal.exponent();
+    let q = match damping {
+        DampingLaw::Papers => T::of(0.5),
+        DampingLaw::Restitution => (p - T::ONE) * T::of(0.5),
+        _ => T::ZERO,
     };
-    let q = match (damping, normal) {
-        (DampingLaw::Papers, _) => 0.5,
-        (DampingLaw::Restitution, NormalLaw::Hertz) => 0.25,
-        _ => 0.0,
-    };
-    (T::of(p), T::of(q))
+    (p, q)
 }
 
 /// The mean over a window of `window` (s) of the normal force (N, compressive positive) of a
@@ -49,7 +47,7 @@ pub fn overlap_exponents<T: Real>(normal: &NormalLaw<T>, damping: &DampingLaw<T>
 #[inline(always)]
 fn mean_over<T: Real>(model: &ContactModel<T>, c: &PairCoeffs<T>, geo: &Geometry<T>, h_far: T, span: T, u: T, window: T) -> T {
     let far = Geometry { h: h_far, ..*geo };
-    let (f_el, _) = normal_elastic(&model.normal, c, &far);
+    let (f_el, _) = model.normal.elastic(c, &far);
     let eta = normal_damping(&model.damping, &model.normal, c, &far);
     let (p, q) = overlap_exponents(&model.normal, &model.damping);
     span / window * (f_el / (p + T::ONE) - eta * u / (q + T::ONE))
@@ -169,7 +167,7 @@ mod tests {
 
     fn linear(limit_damping: bool) -> ContactModel<f64> {
         ContactModel {
-            normal: NormalLaw::Linear { k_n: 1.0 },
+            normal: NormalLaw::Linear(crate::model::Linear { k_n: 1.0 }),
             damping: DampingLaw::Restitution,
             tangential: TangentialLaw::None,
             rolling: RollingLaw::None,

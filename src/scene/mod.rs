@@ -22,7 +22,7 @@ use wall_specs::{check_overlaps, finish_walls, servo_box, validate_walls};
 
 use crate::model::restitution::MIN_RESTITUTION;
 use crate::model::{
-    CohesionLaw, ContactModel, DampingLaw, MaterialConstants, NormalLaw, OquendoLaw, RollingFriction, RollingLaw, TangentialLaw,
+    CohesionLaw, ContactModel, DampingLaw, MaterialConstants, NormalSetup, OquendoLaw, RollingFriction, RollingLaw, TangentialLaw,
     TangentialStiffness, TwistingLaw,
 };
 use crate::timestep;

@@ -19,14 +19,10 @@ pub(super) fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Materia
         }
     };
     let normal_name = law(&m.normal, "hertz");
-    let normal = match normal_name.as_str() {
-        "hertz" => {
-            unused("k_n", m.k_n.is_some(), "normal = \"hertz\"")?;
-            NormalLaw::Hertz
-        }
-        "linear" => NormalLaw::Linear { k_n: need("k_n", m.k_n, "give the linear stiffness k_n in N/m")? },
-        other => return Err(c.invalid("model.normal", format!("\"{other}\""), "unknown normal law", "use \"hertz\" or \"linear\"")),
-    };
+    let normal = crate::model::normal::parse(&normal_name, m).map_err(|problem| match problem {
+        Some(p) => c.invalid(format!("model.{}", p.key), p.value, p.problem, p.fix),
+        None => c.invalid("model.normal", format!("\"{normal_name}\""), "unknown normal law", format!("use {}", crate::model::normal::names())),
+    })?;
     let damping_name = law(&m.damping, "none");
     let damping = match damping_name.as_str() {
         "none" => DampingLaw::None,
@@ -61,10 +57,9 @@ pub(super) fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Materia
         return Err(c.invalid("model.damping", "\"papers\"", "no material sets gamma_n, so it would not damp", "set `gamma_n` (s^-1 m^-1/2) in the [[material]] tables or use damping = \"none\""));
     }
     let stiffness = |kt: Option<f64>| -> Result<TangentialStiffness<f64>, SceneError> {
-        match (kt, normal) {
-            (Some(r), _) => Ok(TangentialStiffness::RatioToNormal(positive(c, "model.kt_ratio", r, "give a ratio such as 2/7")?)),
-            (None, NormalLaw::Hertz) => Ok(TangentialStiffness::Mindlin),
-            (None, NormalLaw::Linear { .. }) => Ok(TangentialStiffness::RatioToNormal(DEFAULT_LINEAR_KT_RATIO)),
+        match kt {
+            Some(r) => Ok(TangentialStiffness::RatioToNormal(positive(c, "model.kt_ratio", r, "give a ratio such as 2/7")?)),
+            None => Ok(normal.default_tangential_stiffness()),
         }
     };
     for (key, v, why) in [

@@ -274,7 +274,7 @@ pub struct PeriodicSpec {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ModelSpec {
-    /// "hertz" (default) or "linear".
+    /// "hertz" (default), "linear" or "dmt" (Hertz with DMT adhesion).
     pub normal: Option<String>,
     /// "none" (default), "papers", "restitution" or "viscous".
     pub damping: Option<String>,
@@ -295,6 +295,9 @@ pub struct ModelSpec {
     pub liquid_density: Option<f64>,
     /// Linear normal stiffness k_n (N/m), `normal = "linear"`.
     pub k_n: Option<f64>,
+    /// Surface energy gamma (J/m^2) of DMT adhesion, `normal = "dmt"`: the pull-off force is
+    /// `4 pi gamma R_eff`.
+    pub surface_energy: Option<f64>,
     /// Viscous coefficient c_n (N s/m), `damping = "viscous"`.
     pub c_n: Option<f64>,
     /// The no-pull clamp (LAMMPS' `limit_damping`): true (default, docs/physics.md's ruling) holds
@@ -488,4 +491,15 @@ pub struct OutputSpec {
     /// end) when the run has `--out`; 0 checkpoints at stage ends only. Default
     /// [`crate::scene::DEFAULT_CHECKPOINT_INTERVAL`].
     pub checkpoint_interval: Option<f64>,
+}
+
+impl crate::model::keys::LawKeys for ModelSpec {
+    /// The laws' own keys by name (the normal slot's registry reads them through this).
+    fn number(&self, key: &str) -> Option<f64> {
+        match key {
+            "k_n" => self.k_n,
+            "surface_energy" => self.surface_energy,
+            _ => None,
+        }
+    }
 }

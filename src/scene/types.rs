@@ -348,8 +348,6 @@ pub struct BridgeLimits {
 
 /// Default damping of Oquendo et al.'s static and rolling springs, as a fraction of critical (-).
 pub const DEFAULT_STATIC_DAMPING: f64 = 0.3;
-/// Default tangential-to-normal stiffness ratio for the linear law (the classic 2/7).
-pub const DEFAULT_LINEAR_KT_RATIO: f64 = 2.0 / 7.0;
 /// Default settle criterion on the unbalanced-force ratio.
 pub const DEFAULT_UNBALANCED_FORCE: f64 = 0.01;
 /// Water's surface tension (N/m), the default of `model.surface_tension`.

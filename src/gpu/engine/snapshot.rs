@@ -199,7 +199,7 @@ impl GpuEngine {
                 (a[3] as f64, b[3] as f64, (crate::position::separation(&self.periodic, v3(a), v3(&residual[i]), v3(b), v3(&residual[j])).norm() - a[3] - b[3]) as f64)
             })
             .collect();
-        let (shares, rest) = crate::model::share_liquid(volume, &pairs, self.params.bridge_cap as f64, theta as f64);
+        let (shares, rest) = crate::model::share_liquid(volume, &pairs, self.params.cohesion[3] as f64, theta as f64);
         let last = blocks as usize - 1;
         for (k, v) in shares {
             hist[k * blocks as usize + last][0] += v as f32;
