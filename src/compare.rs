@@ -97,7 +97,7 @@ impl Comparison {
 }
 
 fn difference(a: &Frame, b: &Frame, sa: &Stats, sb: &Stats, d_mean: f64) -> Difference {
-    let max_abs = |x: &[[f64; 3]], y: &[[f64; 3]]| x.iter().zip(y).map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+    let max_abs = |x: &[glam::DVec3], y: &[glam::DVec3]| x.iter().zip(y).map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
     let v_max = b.velocity.iter().map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max).max(1e-30);
     let index = |c: &[ContactRecord]| c.iter().map(|r| ((r.i, r.j), r.normal_force)).collect::<HashMap<_, _>>();
     let (ca, cb) = (index(a.contacts.as_deref().unwrap_or(&[])), index(b.contacts.as_deref().unwrap_or(&[])));

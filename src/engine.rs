@@ -1,6 +1,7 @@
 //! What the host loop needs from a backend: advance, read a few statistics, take a frame.
 
 use anyhow::{bail, Context};
+use glam::{DQuat, DVec3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -285,6 +286,23 @@ impl Stats {
     }
 }
 
+/// Quaternions in MCAP frames as the engines keep them, scalar first: `[w, x, y, z]`
+/// (`#[serde(with = "scalar_first")]`; glam's own order is `[x, y, z, w]`).
+pub mod scalar_first {
+    use glam::DQuat;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// Writes each quaternion as `[w, x, y, z]`.
+    pub fn serialize<S: Serializer>(q: &Option<Vec<DQuat>>, s: S) -> Result<S::Ok, S::Error> {
+        q.as_ref().map(|v| v.iter().map(|q| [q.w, q.x, q.y, q.z]).collect::<Vec<_>>()).serialize(s)
+    }
+
+    /// Reads `[w, x, y, z]` quaternions.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<DQuat>>, D::Error> {
+        Ok(Option::<Vec<[f64; 4]>>::deserialize(d)?.map(|v| v.into_iter().map(|[w, x, y, z]| DQuat::from_xyzw(x, y, z, w)).collect()))
+    }
+}
+
 /// One recorded instant: what an MCAP frame holds.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Frame {
@@ -293,15 +311,17 @@ pub struct Frame {
     /// Permanent grain ids.
     pub id: Vec<u32>,
     /// Centre positions (m).
-    pub position: Vec<[f64; 3]>,
+    pub position: Vec<DVec3>,
     /// Radii (m).
     pub radius: Vec<f64>,
     /// Velocities (m/s).
-    pub velocity: Vec<[f64; 3]>,
+    pub velocity: Vec<DVec3>,
     /// Angular velocities (rad/s).
-    pub angular_velocity: Vec<[f64; 3]>,
-    /// Orientation quaternions (scalar first), when the scene tracks orientation.
-    pub orientation: Option<Vec<[f64; 4]>>,
+    pub angular_velocity: Vec<DVec3>,
+    /// Orientation quaternions, when the scene tracks orientation; written scalar first,
+    /// `[w, x, y, z]` ([`scalar_first`]).
+    #[serde(with = "scalar_first")]
+    pub orientation: Option<Vec<DQuat>>,
     /// Touching grain pairs with their forces, when asked for.
     pub contacts: Option<Vec<ContactRecord>>,
     /// Grain-wall contacts with their forces, when contacts are asked for.
@@ -326,14 +346,14 @@ pub struct ContactRecord {
     /// capillary, less an adhesive law's pull-off.
     pub normal_force: f64,
     /// Total force on i (N).
-    pub force: [f64; 3],
+    pub force: DVec3,
     /// Total force on j (N): `-force` except in Oquendo et al.'s rolling regime.
-    pub force_j: [f64; 3],
+    pub force_j: DVec3,
     /// Tangential spring `xi` (m), zero when the model keeps none.
-    pub tangential_spring: [f64; 3],
+    pub tangential_spring: DVec3,
     /// Rolling spring `psi` (m), zero when the model keeps none.
     #[serde(default)]
-    pub rolling_spring: [f64; 3],
+    pub rolling_spring: DVec3,
     /// Liquid in the pair's bridge (m^3), zero without one.
     #[serde(default)]
     pub bridge_volume: f64,
@@ -350,11 +370,11 @@ pub struct WallContactRecord {
     /// Overlap (m).
     pub overlap: f64,
     /// Unit normal from the wall to the grain.
-    pub normal: [f64; 3],
+    pub normal: DVec3,
     /// Distance from the grain's centre to the contact point (m).
     pub lever: f64,
     /// Force on the grain (N).
-    pub force: [f64; 3],
+    pub force: DVec3,
 }
 
 /// An engine's state as named arrays.

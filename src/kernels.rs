@@ -95,44 +95,80 @@ macro_rules! kernel {
     };
 }
 
-/// Every kernel, in the order a rebuilding step runs them.
-pub const KERNELS: &[Kernel] = &[
-    kernel!("integrate", INTEGRATE, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "residual": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "force": Read, "torque": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "wall_reaction": Read, "control": ReadWrite]),
-    kernel!("servo_move", BASE, ["params": Uniform, "phase": Phase, "walls": ReadWrite, "wall_reaction": Read, "servo": ReadWrite]),
-    kernel!("decide_rebuild", BASE, ["params": Uniform, "control": ReadWrite, "args": ReadWrite]),
-    kernel!("save_starts", BASE, ["params": Uniform, "pair_start": Read, "old_start": Write]),
-    kernel!("save_pairs", BASE, ["params": Uniform, "pair_j": Read, "hist": Read, "old_j": Write, "old_hist0": Write, "old_hist1": Write, "old_hist2": Write, "control": Read]),
-    kernel!("clear_cells", BASE, ["params": Uniform, "cell_count": Write, "cell_fill": Write]),
-    kernel!("hash_cells", GRID, ["params": Uniform, "pos": ReadWrite, "residual": ReadWrite, "image": ReadWrite, "built_at": Write, "cell_of": Write, "cell_count": ReadWrite, "control": ReadWrite, "pair_start": Write, "rev_start": Write]),
-    kernel!("scan_blocks", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": Write]),
-    kernel!("scan_add", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite]),
-    kernel!("scatter_cells", BASE, ["params": Uniform, "cell_of": Read, "cell_count": Read, "cell_fill": ReadWrite, "cell_grains": Write]),
-    kernel!("detect_count", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Write, "control": ReadWrite, "rev_fill": Write]),
-    kernel!("pairs_ready", BASE, ["params": Uniform, "pair_start": Read, "control": ReadWrite, "args": Write]),
-    kernel!("detect_fill", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Read, "pair_i": Write, "pair_j": ReadWrite]),
-    kernel!("remap_history", BASE, ["params": Uniform, "pair_i": Read, "pair_j": Read, "old_start": Read, "old_j": Read, "old_hist0": Read, "old_hist1": Read, "old_hist2": Read, "hist": Write, "control": Read]),
-    kernel!("reverse_count", BASE, ["params": Uniform, "pair_j": Read, "rev_start": ReadWrite, "control": Read]),
-    kernel!("reverse_fill", BASE, ["params": Uniform, "pair_j": Read, "rev_start": Read, "rev_fill": ReadWrite, "rev_pair": Write, "control": Read]),
-    kernel!("reverse_sort", BASE, ["params": Uniform, "rev_start": Read, "rev_pair": ReadWrite]),
-    kernel!("find_bridge_events", FORCES, ["params": Uniform, "pos": Read, "residual": Read, "pair_i": Read, "pair_j": Read, "hist": Read, "bridge_event": Write, "control": Read]),
-    kernel!("update_bridges", FORCES, ["params": Uniform, "pair_i": Read, "pair_j": Read, "bridge_event": Read, "hist": ReadWrite, "liquid": ReadWrite, "control": Read]),
-    kernel!("pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": Write, "out_fj": Write, "out_ti": Write, "out_tj": Write, "control": Read]),
-    kernel!("gather", GATHER, ["params": Uniform, "phase": Phase, "vel": ReadWrite, "omega": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "pos": ReadWrite, "residual": ReadWrite, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_partials": Write, "force": Write, "torque": Write, "built_at": Read, "quat": ReadWrite, "control": ReadWrite]),
-    kernel!("wall_reduce", PISTON, ["params": Uniform, "phase": Phase, "wall_partials": Read, "wall_reaction": ReadWrite, "walls": ReadWrite]),
-    kernel!("reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": Write]),
-    kernel!("reduce_pairs", STATS, ["params": Uniform, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_ti": Read, "control": Read, "pair_rows": Write]),
-    kernel!("reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": Write]),
-];
+/// Declares an enum of kernels and their table from one list, so that a kernel is named by a
+/// variant (a misspelt one does not compile) and its row stands at the variant's index.
+macro_rules! kernel_table {
+    ($(#[$enum_doc:meta])* $enum:ident, $(#[$table_doc:meta])* $table:ident, $($id:ident = $name:literal, $inc:expr, [$($b:literal: $a:expr),* $(,)?];)*) => {
+        $(#[$enum_doc])*
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum $enum {
+            $(
+                #[doc = concat!("`shaders/", $name, ".wgsl`.")]
+                $id,
+            )*
+        }
 
-/// Contact dynamics' sweep kernels ([`crate::gpu::GpuSweeps`]), in the order a sweep runs them.
-pub const CD_KERNELS: &[Kernel] = &[
-    kernel!("cd_sweep_colour", CD, ["cd": Uniform, "phase": Phase, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "measure": Write, "sweeps": Read]),
-    kernel!("cd_sweep_tail", CD, ["cd": Uniform, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "wall_vel": ReadWrite, "measure": Write, "sweeps": Read]),
-    kernel!("cd_measure", CD, ["cd": Uniform, "measure": Read, "blocks": Write, "sweeps": Read]),
-    kernel!("cd_decide", CD, ["cd": Uniform, "blocks": Read, "sweeps": ReadWrite]),
-];
+        $(#[$table_doc])*
+        pub const $table: &[Kernel] = &[$(kernel!($name, $inc, [$($b: $a),*])),*];
 
-/// The kernel of a name.
-pub fn kernel(name: &str) -> &'static Kernel {
-    KERNELS.iter().find(|k| k.name == name).unwrap_or_else(|| panic!("no kernel {name}"))
+        impl $enum {
+            /// Every kernel, in the order of the table.
+            pub const ALL: &[$enum] = &[$($enum::$id),*];
+
+            /// The kernel's row.
+            pub fn kernel(self) -> &'static Kernel {
+                &$table[self as usize]
+            }
+
+            /// Its entry point and file name.
+            pub fn name(self) -> &'static str {
+                self.kernel().name
+            }
+        }
+    };
 }
+
+kernel_table! {
+    /// A kernel of the step, by name: its row in [`KERNELS`].
+    StepKernel,
+    /// Every kernel of the step, in the order a rebuilding step runs them.
+    KERNELS,
+    Integrate = "integrate", INTEGRATE, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "residual": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "force": Read, "torque": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "wall_reaction": Read, "control": ReadWrite];
+    ServoMove = "servo_move", BASE, ["params": Uniform, "phase": Phase, "walls": ReadWrite, "wall_reaction": Read, "servo": ReadWrite];
+    DecideRebuild = "decide_rebuild", BASE, ["params": Uniform, "control": ReadWrite, "args": ReadWrite];
+    SaveStarts = "save_starts", BASE, ["params": Uniform, "pair_start": Read, "old_start": Write];
+    SavePairs = "save_pairs", BASE, ["params": Uniform, "pair_j": Read, "hist": Read, "old_j": Write, "old_hist0": Write, "old_hist1": Write, "old_hist2": Write, "control": Read];
+    ClearCells = "clear_cells", BASE, ["params": Uniform, "cell_count": Write, "cell_fill": Write];
+    HashCells = "hash_cells", GRID, ["params": Uniform, "pos": ReadWrite, "residual": ReadWrite, "image": ReadWrite, "built_at": Write, "cell_of": Write, "cell_count": ReadWrite, "control": ReadWrite, "pair_start": Write, "rev_start": Write];
+    ScanBlocks = "scan_blocks", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": Write];
+    ScanAdd = "scan_add", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite];
+    ScatterCells = "scatter_cells", BASE, ["params": Uniform, "cell_of": Read, "cell_count": Read, "cell_fill": ReadWrite, "cell_grains": Write];
+    DetectCount = "detect_count", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Write, "control": ReadWrite, "rev_fill": Write];
+    PairsReady = "pairs_ready", BASE, ["params": Uniform, "pair_start": Read, "control": ReadWrite, "args": Write];
+    DetectFill = "detect_fill", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Read, "pair_i": Write, "pair_j": ReadWrite];
+    RemapHistory = "remap_history", BASE, ["params": Uniform, "pair_i": Read, "pair_j": Read, "old_start": Read, "old_j": Read, "old_hist0": Read, "old_hist1": Read, "old_hist2": Read, "hist": Write, "control": Read];
+    ReverseCount = "reverse_count", BASE, ["params": Uniform, "pair_j": Read, "rev_start": ReadWrite, "control": Read];
+    ReverseFill = "reverse_fill", BASE, ["params": Uniform, "pair_j": Read, "rev_start": Read, "rev_fill": ReadWrite, "rev_pair": Write, "control": Read];
+    ReverseSort = "reverse_sort", BASE, ["params": Uniform, "rev_start": Read, "rev_pair": ReadWrite];
+    FindBridgeEvents = "find_bridge_events", FORCES, ["params": Uniform, "pos": Read, "residual": Read, "pair_i": Read, "pair_j": Read, "hist": Read, "bridge_event": Write, "control": Read];
+    UpdateBridges = "update_bridges", FORCES, ["params": Uniform, "pair_i": Read, "pair_j": Read, "bridge_event": Read, "hist": ReadWrite, "liquid": ReadWrite, "control": Read];
+    PairForce = "pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": Write, "out_fj": Write, "out_ti": Write, "out_tj": Write, "control": Read];
+    Gather = "gather", GATHER, ["params": Uniform, "phase": Phase, "vel": ReadWrite, "omega": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "pos": ReadWrite, "residual": ReadWrite, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_partials": Write, "force": Write, "torque": Write, "built_at": Read, "quat": ReadWrite, "control": ReadWrite];
+    WallReduce = "wall_reduce", PISTON, ["params": Uniform, "phase": Phase, "wall_partials": Read, "wall_reaction": ReadWrite, "walls": ReadWrite];
+    ReduceGrains = "reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": Write];
+    ReducePairs = "reduce_pairs", STATS, ["params": Uniform, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_ti": Read, "control": Read, "pair_rows": Write];
+    ReduceFinal = "reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": Write];
+}
+
+kernel_table! {
+    /// A kernel of contact dynamics' sweeps ([`crate::gpu::GpuSweeps`]), by name: its row in
+    /// [`CD_KERNELS`].
+    CdKernel,
+    /// Contact dynamics' sweep kernels, in the order a sweep runs them.
+    CD_KERNELS,
+    CdSweepColour = "cd_sweep_colour", CD, ["cd": Uniform, "phase": Phase, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "measure": Write, "sweeps": Read];
+    CdSweepTail = "cd_sweep_tail", CD, ["cd": Uniform, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "wall_vel": ReadWrite, "measure": Write, "sweeps": Read];
+    CdMeasure = "cd_measure", CD, ["cd": Uniform, "measure": Read, "blocks": Write, "sweeps": Read];
+    CdDecide = "cd_decide", CD, ["cd": Uniform, "blocks": Read, "sweeps": ReadWrite];
+}
+

@@ -30,7 +30,8 @@ pub fn two_sum<T: Real>(a: T, b: T) -> (T, T) {
 /// A position of the scene (m, f64) in this precision: the rounded position and, when
 /// compensated, what the rounding took off.
 #[inline]
-pub fn split<T: Real>(x: [f64; 3]) -> (Vec3<T>, Vec3<T>) {
+pub fn split<T: Real>(x: impl Into<glam::DVec3>) -> (Vec3<T>, Vec3<T>) {
+    let x = x.into();
     let p: Vec3<T> = Vec3::of(x);
     let r = if T::COMPENSATED { Vec3::of([x[0] - p.x.f64(), x[1] - p.y.f64(), x[2] - p.z.f64()]) } else { Vec3::ZERO };
     (p, r)
@@ -38,9 +39,9 @@ pub fn split<T: Real>(x: [f64; 3]) -> (Vec3<T>, Vec3<T>) {
 
 /// The position `pos + residual` in f64 (m): exact for f32 parts.
 #[inline]
-pub fn absolute<T: Real>(pos: Vec3<T>, residual: Vec3<T>) -> [f64; 3] {
+pub fn absolute<T: Real>(pos: Vec3<T>, residual: Vec3<T>) -> glam::DVec3 {
     if T::COMPENSATED {
-        [pos.x.f64() + residual.x.f64(), pos.y.f64() + residual.y.f64(), pos.z.f64() + residual.z.f64()]
+        glam::DVec3::new(pos.x.f64() + residual.x.f64(), pos.y.f64() + residual.y.f64(), pos.z.f64() + residual.z.f64())
     } else {
         pos.f64()
     }

@@ -139,15 +139,16 @@ impl<T: Real> Vec3<T> {
     pub fn new(x: T, y: T, z: T) -> Self {
         Vec3 { x, y, z }
     }
-    /// Converts an `[f64; 3]` (scene units) to this precision.
+    /// Converts a vector of the scene (f64: a `glam::DVec3` or `[f64; 3]`) to this precision.
     #[inline]
-    pub fn of(a: [f64; 3]) -> Self {
-        Vec3::new(T::of(a[0]), T::of(a[1]), T::of(a[2]))
+    pub fn of(a: impl Into<glam::DVec3>) -> Self {
+        let a = a.into();
+        Vec3::new(T::of(a.x), T::of(a.y), T::of(a.z))
     }
-    /// Widens to `[f64; 3]`.
+    /// Widens to the scene's f64 vector.
     #[inline]
-    pub fn f64(self) -> [f64; 3] {
-        [self.x.f64(), self.y.f64(), self.z.f64()]
+    pub fn f64(self) -> glam::DVec3 {
+        glam::DVec3::new(self.x.f64(), self.y.f64(), self.z.f64())
     }
     /// Dot product.
     #[inline(always)]

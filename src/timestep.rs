@@ -93,7 +93,7 @@ pub fn hertz_max_overlap(m_eff: f64, r_eff: f64, v_eff: f64, v: f64) -> f64 {
 
 /// Twice the largest initial speed (two grains meeting head-on), or the free-fall speed over
 /// the grains' height span plus one diameter, whichever is larger; at least 1e-3 m/s.
-pub fn default_expected_speed(grains: &Grains, gravity: [f64; 3]) -> f64 {
+pub fn default_expected_speed(grains: &Grains, gravity: glam::DVec3) -> f64 {
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let v0 = grains.velocity.iter().map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max);
     let fall = if g > 0.0 {

@@ -2,6 +2,7 @@
 //! three-grain chain, bonds by sign, percolation of a spanning chain, the pressure scale; and
 //! the maximum-likelihood tail estimator on samples of known tails.
 
+use glam::DVec3;
 use grains::analysis::contact_moments;
 use grains::analysis::network::analyze;
 use grains::engine::{ContactRecord, Frame};
@@ -15,18 +16,18 @@ const HAND: f64 = 1e-12;
 /// bond 0-1 compressive (2 N), bond 1-2 tensile (-0.5 N, a capillary pull).
 fn chain() -> Frame {
     let (r, h) = (1e-3, 1e-5);
-    let x = |k: f64| [k * (2.0 * r - h), 0.0, 0.0];
+    let x = |k: f64| DVec3::new(k * (2.0 * r - h), 0.0, 0.0);
     let rec = |i: u32, j: u32, f: f64| {
         // n from j to i; i is left of j, so n = -x; the force on i is f n.
-        ContactRecord { i, j, overlap: h, normal_force: f, force: [-f, 0.0, 0.0], force_j: [f, 0.0, 0.0], tangential_spring: [0.0; 3], rolling_spring: [0.0; 3], bridge_volume: 0.0 }
+        ContactRecord { i, j, overlap: h, normal_force: f, force: DVec3::new(-f, 0.0, 0.0), force_j: DVec3::new(f, 0.0, 0.0), tangential_spring: DVec3::ZERO, rolling_spring: DVec3::ZERO, bridge_volume: 0.0 }
     };
     Frame {
         time: 0.0,
         id: vec![0, 1, 2],
         position: vec![x(0.0), x(1.0), x(2.0)],
         radius: vec![r; 3],
-        velocity: vec![[0.0; 3]; 3],
-        angular_velocity: vec![[0.0; 3]; 3],
+        velocity: vec![DVec3::ZERO; 3],
+        angular_velocity: vec![DVec3::ZERO; 3],
         orientation: None,
         contacts: Some(vec![rec(0, 1, 2.0), rec(1, 2, -0.5)]),
         wall_contacts: Some(vec![]),

@@ -68,9 +68,9 @@ fn checkpointing_within_stages() -> String {
 
 fn bits(e: &dyn Engine) -> Vec<u64> {
     let f = e.frame(true).unwrap();
-    let mut v: Vec<u64> = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|x| x.map(f64::to_bits)).collect();
-    v.extend(f.orientation.unwrap().iter().flat_map(|q| q.map(f64::to_bits)));
-    v.extend(f.contacts.unwrap().iter().flat_map(|c| c.tangential_spring.map(f64::to_bits)));
+    let mut v: Vec<u64> = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|x| x.to_array().map(f64::to_bits)).collect();
+    v.extend(f.orientation.unwrap().iter().flat_map(|q| q.to_array().map(f64::to_bits)));
+    v.extend(f.contacts.unwrap().iter().flat_map(|c| c.tangential_spring.to_array().map(f64::to_bits)));
     v
 }
 

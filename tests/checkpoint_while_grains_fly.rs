@@ -59,7 +59,7 @@ fn a_checkpoint_taken_while_no_grain_touches_reads_back_and_resumes() {
     let mut resumed: CpuEngine<f64> = common::engine(&scene);
     resumed.restore(&state).unwrap();
     let rest = protocol::run_from(&scene, &mut resumed, &mut RunRecorder::new(None, false).unwrap(), header.progress).unwrap();
-    let bits = |e: &CpuEngine<f64>| e.frame(false).unwrap().position.iter().flat_map(|p| p.map(f64::to_bits)).collect::<Vec<_>>();
+    let bits = |e: &CpuEngine<f64>| e.frame(false).unwrap().position.iter().flat_map(|p| p.to_array().map(f64::to_bits)).collect::<Vec<_>>();
     assert_eq!(bits(&whole), bits(&resumed), "the resumed run ends where the whole one did");
     assert_eq!(rest.len(), full.len());
 }

@@ -35,7 +35,7 @@ fn mean_diameter(s: &Scene) -> f64 {
     2.0 * s.grains.radius.iter().sum::<f64>() / s.grains.len() as f64
 }
 
-fn largest(a: &[[f64; 3]], b: &[[f64; 3]]) -> f64 {
+fn largest(a: &[glam::DVec3], b: &[glam::DVec3]) -> f64 {
     a.iter().zip(b).map(|(p, q)| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()).fold(0.0, f64::max)
 }
 

@@ -195,7 +195,7 @@ fn integrate_and_the_reductions_match_the_cpu_twins() {
     let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
     let d_mean = 1.0e-3;
     let worst = fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
-    let worst_q = fg.orientation.as_ref().unwrap().iter().zip(fc.orientation.as_ref().unwrap()).map(|(a, b)| (0..4).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+    let worst_q = fg.orientation.as_ref().unwrap().iter().zip(fc.orientation.as_ref().unwrap()).map(|(a, b)| (*a - *b).to_array().iter().map(|d| d.abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
     println!("after 20 steps: positions differ by {:.3e} of a diameter, quaternions by {worst_q:.3e}", worst / d_mean);
     assert!(worst / d_mean < F32_POSITION_TOLERANCE);
     assert!(worst_q < F32_POSITION_TOLERANCE);
@@ -505,7 +505,7 @@ fn pair_records_give_the_cpus_bits_with_one_force_or_two() {
         g.advance(200).unwrap();
         c.advance(200).unwrap();
         let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
-        let bits = |f: &grains::engine::Frame| -> Vec<u64> { f.position.iter().chain(&f.velocity).flat_map(|v| v.map(f64::to_bits)).collect() };
+        let bits = |f: &grains::engine::Frame| -> Vec<u64> { f.position.iter().chain(&f.velocity).flat_map(|v| v.to_array().map(f64::to_bits)).collect() };
         let differing = bits(&fg).iter().zip(&bits(&fc)).filter(|(a, b)| a != b).count();
         let (sg, sc) = (g.stats().unwrap(), c.stats().unwrap());
         println!("{name}: {differing} position and velocity components differ; clamped gpu {} cpu {}, sliding {} / {}, rolling {} / {}", sg.clamped, sc.clamped, sg.sliding, sc.sliding, sg.rolling, sc.rolling);
@@ -524,8 +524,8 @@ fn gpu_runs_are_bitwise_reproducible() {
         let mut g = common::gpu_engine(&scene)?;
         g.advance(200).unwrap();
         let f = g.frame(true).unwrap();
-        let mut bits: Vec<u64> = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|v| v.map(f64::to_bits)).collect();
-        bits.extend(f.contacts.unwrap().iter().flat_map(|c| c.force.map(f64::to_bits)));
+        let mut bits: Vec<u64> = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|v| v.to_array().map(f64::to_bits)).collect();
+        bits.extend(f.contacts.unwrap().iter().flat_map(|c| c.force.to_array().map(f64::to_bits)));
         Some(bits)
     };
     let Some(a) = run() else { return };
@@ -585,7 +585,7 @@ fn history_survives_a_rebuild_on_the_gpu() {
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/history.rs")).unwrap();
     let scene_text = text.split("const SCENE: &str = r#\"").nth(1).unwrap().split("\"#;").next().unwrap();
     let scene = common::parse(scene_text);
-    let run = |rebuild: bool| -> Option<(Vec<[f64; 3]>, [f64; 3], u64)> {
+    let run = |rebuild: bool| -> Option<(Vec<glam::DVec3>, glam::DVec3, u64)> {
         let mut g = common::gpu_engine(&scene)?;
         g.advance(287).unwrap();
         if rebuild {
@@ -624,7 +624,7 @@ fn a_dense_start_with_a_wide_skin_fits_the_gpus_pair_buffers() {
     c.advance(100).unwrap();
     assert_eq!(g.pair_stops(), 0, "sized for the first list, no rebuild stops");
     let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
-    let bits = |f: &grains::engine::Frame| -> Vec<u64> { f.position.iter().chain(&f.velocity).flat_map(|v| v.map(f64::to_bits)).collect() };
+    let bits = |f: &grains::engine::Frame| -> Vec<u64> { f.position.iter().chain(&f.velocity).flat_map(|v| v.to_array().map(f64::to_bits)).collect() };
     let differing = bits(&fg).iter().zip(&bits(&fc)).filter(|(a, b)| a != b).count();
     let worst = fg.position.iter().zip(&fc.position).flat_map(|(a, b)| (0..3).map(move |k| (a[k] - b[k]).abs())).fold(0.0, f64::max);
     println!("after 100 steps: {differing} position and velocity components differ, largest position difference {worst:.3e} m");
@@ -654,7 +654,7 @@ fn a_pour_that_outgrows_the_pair_buffers_stops_and_goes_on_with_the_same_bits() 
     ));
     let mut c: CpuEngine<f32> = common::engine(&scene);
     let first = c.pair_list().1.len() as u64;
-    let bits = |f: &grains::engine::Frame| -> Vec<u64> { f.position.iter().chain(&f.velocity).flat_map(|v| v.map(f64::to_bits)).collect() };
+    let bits = |f: &grains::engine::Frame| -> Vec<u64> { f.position.iter().chain(&f.velocity).flat_map(|v| v.to_array().map(f64::to_bits)).collect() };
     let run = |pairs: u64, advances: u64| -> Option<(Vec<u64>, u64, f64, bool)> {
         let mut g = grains::gpu::GpuEngine::with_pair_capacity(common::gpu()?, &scene, Some(pairs)).unwrap_or_else(|e| panic!("{e}"));
         for _ in 0..advances {
@@ -712,7 +712,7 @@ fn rebuilds_that_stop_on_full_pair_buffers_keep_each_scenes_bits() {
                 g.advance(150).unwrap();
             }
             let (f, s) = (g.frame(false).unwrap(), g.stats().unwrap());
-            let bits = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|v| v.map(f64::to_bits)).collect();
+            let bits = f.position.iter().chain(&f.velocity).chain(&f.angular_velocity).flat_map(|v| v.to_array().map(f64::to_bits)).collect();
             Some((bits, s.pairs, s.bridges, g.pair_stops()))
         };
         let Some((sized, pairs, bridges, sized_stops)) = run(None) else { return };

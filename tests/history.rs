@@ -50,7 +50,7 @@ type Record = grains::engine::ContactRecord;
 
 /// Runs the collision, optionally forcing a rebuild; returns the trajectory, the contact
 /// just before the rebuild step and at mid-contact, and the rebuild count.
-fn run(rebuild: bool) -> (Vec<[f64; 3]>, Record, Record, u64) {
+fn run(rebuild: bool) -> (Vec<glam::DVec3>, Record, Record, u64) {
     let scene = common::parse(SCENE);
     let mut e: CpuEngine<f64> = common::engine(&scene);
     let (mut before, mut mid) = (None, None);

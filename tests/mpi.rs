@@ -157,9 +157,9 @@ fn grains_migrate_with_loaded_springs_and_keep_the_same_bits() {
     let grid = Grid::new(&scene, 2).unwrap();
     assert_eq!(grid.axes.clone().map(|s| s.count()), [2, 1, 1], "the cut runs across x");
     let mut e = CpuEngine::<f64>::new(&scene).unwrap();
-    let side = |f: &grains::engine::Frame, i: u32| grid.owner(f.position[i as usize]);
+    let side = |f: &grains::engine::Frame, i: u32| grid.owner(f.position[i as usize].to_array());
     let springs = |f: &grains::engine::Frame| -> std::collections::BTreeSet<(u32, u32)> {
-        f.contacts.as_ref().unwrap().iter().filter(|c| c.tangential_spring != [0.0; 3]).map(|c| (c.i, c.j)).collect()
+        f.contacts.as_ref().unwrap().iter().filter(|c| c.tangential_spring != glam::DVec3::ZERO).map(|c| (c.i, c.j)).collect()
     };
     let mut before = e.frame(true).unwrap();
     let mut migrated = 0;
@@ -296,7 +296,7 @@ fn slabs_round_a_periodic_axis_give_the_same_bits() {
         let after = e.frame(true).unwrap();
         let side = |f: &grains::engine::Frame, i: usize| slabs.owner(f.position[i][a]);
         crossed += (0..after.position.len()).filter(|&i| [side(&before, i), side(&after, i)] == [0, last] || [side(&before, i), side(&after, i)] == [last, 0]).count();
-        straddling += after.contacts.as_ref().unwrap().iter().filter(|c| c.tangential_spring != [0.0; 3] && (after.position[c.i as usize][a] - after.position[c.j as usize][a]).abs() > 7.0e-3).count();
+        straddling += after.contacts.as_ref().unwrap().iter().filter(|c| c.tangential_spring != glam::DVec3::ZERO && (after.position[c.i as usize][a] - after.position[c.j as usize][a]).abs() > 7.0e-3).count();
         before = after;
     }
     println!("grains crossing between the last slab and the first: {crossed}; loaded contacts across the period's ends, summed over 40 frames: {straddling}");
@@ -352,7 +352,7 @@ fn liquid_bridges_across_the_cuts_give_the_same_bits() {
     let mut e = CpuEngine::<f64>::new(&scene).unwrap();
     e.wet(scene.stages[0].wet_volume.unwrap()).unwrap();
     let bridges = |f: &grains::engine::Frame| -> std::collections::BTreeSet<(u32, u32)> {
-        let side = |i: u32| grid.owner(f.position[i as usize]);
+        let side = |i: u32| grid.owner(f.position[i as usize].to_array());
         f.contacts.as_ref().unwrap().iter().filter(|c| c.bridge_volume > 0.0 && side(c.i) != side(c.j)).map(|c| (c.i, c.j)).collect()
     };
     let (mut formed, mut ruptured) = (0, 0);
@@ -383,7 +383,7 @@ fn two_bridges_formed_in_one_step_on_two_processes_take_their_liquid_in_id_order
     std::fs::write(&path, text).unwrap();
     let scene = grains::scene::load(&path).unwrap();
     let grid = Grid::new(&scene, 2).unwrap();
-    let owners: Vec<usize> = scene.grains.position.iter().map(|&p| grid.owner(p)).collect();
+    let owners: Vec<usize> = scene.grains.position.iter().map(|p| grid.owner(p.to_array())).collect();
     assert_eq!(owners, vec![1, 0, 1], "the left grain alone on process 0");
     let stats = same_bits_on(&[2], &path, "f64");
     let bridges = |row: &str| row.split(',').nth(20).unwrap().parse::<u32>().unwrap();

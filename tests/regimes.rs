@@ -187,14 +187,14 @@ fn largest_energy_rise(rolling_friction: &str) -> (f64, u64, u64) {
     scene.grains.radius.iter_mut().for_each(|r| *r *= 1.05);
     for (i, w) in scene.grains.angular_velocity.iter_mut().enumerate() {
         let a = i as f64;
-        *w = [300.0 * (1.3 * a).sin(), 300.0 * (2.1 * a).cos(), 300.0 * (0.7 * a).sin()];
+        *w = glam::DVec3::new(300.0 * (1.3 * a).sin(), 300.0 * (2.1 * a).cos(), 300.0 * (0.7 * a).sin());
     }
     let k_t = 0.3 * 2000.0;
     let mut e: CpuEngine<f64> = common::engine(&scene);
     let energy = |e: &mut CpuEngine<f64>| {
         let s = e.stats().unwrap();
         // The rolling spring has the static spring's stiffness.
-        let norm2 = |v: [f64; 3]| v.iter().map(|x| x * x).sum::<f64>();
+        let norm2 = |v: glam::DVec3| v.to_array().iter().map(|x| x * x).sum::<f64>();
         let springs: f64 = e.frame(true).unwrap().contacts.unwrap().iter().map(|c| 0.5 * k_t * (norm2(c.tangential_spring) + norm2(c.rolling_spring))).sum();
         (s.kinetic_energy() + s.elastic_energy + springs, s)
     };

@@ -217,7 +217,7 @@ fn contact_dynamics_mirrors_match_the_wgsl_structures() {
 /// The laws' codes in the shaders are the Rust side's, name for name.
 #[test]
 fn law_codes_match_the_rust_side() {
-    let src = grains::kernels::kernel("pair_force").wgsl();
+    let src = grains::kernels::StepKernel::PairForce.kernel().wgsl();
     let m = module(&src, "pair_force");
     for (name, code) in grains::model::code::ALL {
         let (_, c) = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some(*name)).unwrap_or_else(|| panic!("no WGSL const {name}"));

@@ -146,9 +146,12 @@ fn vtk_reads_back_every_frame_and_the_values_written() {
         }
     };
     per_grain("radius", &|i| vec![f.radius[i]]);
-    per_grain("velocity", &|i| f.velocity[i].to_vec());
-    per_grain("angular_velocity", &|i| f.angular_velocity[i].to_vec());
-    per_grain("orientation", &|i| f.orientation.as_ref().unwrap()[i].to_vec());
+    per_grain("velocity", &|i| f.velocity[i].to_array().to_vec());
+    per_grain("angular_velocity", &|i| f.angular_velocity[i].to_array().to_vec());
+    per_grain("orientation", &|i| {
+        let q = f.orientation.as_ref().unwrap()[i];
+        vec![q.w, q.x, q.y, q.z]
+    });
     let contacts = f.contacts.as_deref().unwrap();
     per_grain("coordination", &|i| vec![contacts.iter().filter(|c| c.overlap > 0.0 && (c.i as usize == i || c.j as usize == i)).count() as f64]);
     let scene = grains::scene::load(&scene_file).unwrap();
@@ -169,7 +172,7 @@ fn vtk_reads_back_every_frame_and_the_values_written() {
         close(tuples(&cd["overlap"])[k][0], r.overlap, "overlap");
         let ends: Vec<usize> = lines[k].as_array().unwrap().iter().map(|x| x.as_u64().unwrap() as usize).collect();
         for (end, grain) in ends.iter().zip([r.i, r.j]) {
-            for (p, q) in cpoints[*end].as_array().unwrap().iter().zip(f.position[grain as usize]) {
+            for (p, q) in cpoints[*end].as_array().unwrap().iter().zip(f.position[grain as usize].to_array()) {
                 close(p.as_f64().unwrap(), q, "contact line end");
             }
         }
@@ -177,7 +180,7 @@ fn vtk_reads_back_every_frame_and_the_values_written() {
         let t = &tuples(&cd["tangential_force"])[k];
         let d: Vec<f64> = (0..3).map(|a| f.position[r.j as usize][a] - f.position[r.i as usize][a]).collect();
         let len = d.iter().map(|x| x * x).sum::<f64>().sqrt();
-        let fmag = r.force.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let fmag = r.force.to_array().iter().map(|x| x * x).sum::<f64>().sqrt();
         let along: f64 = (0..3).map(|a| t[a] * d[a] / len).sum();
         assert!(along.abs() <= 1e-5 * fmag, "tangential force along the line: {along:e} N of {fmag:e} N");
         let normal_part: f64 = (0..3).map(|a| r.force[a] * d[a] / len).sum();

@@ -35,22 +35,22 @@ pub fn packing_fraction(scene: &Scene, frame: &Frame, piston_z: Option<f64>) -> 
             .iter()
             .zip(&scene.walls)
             .map(|(now, w)| match now {
-                crate::walls::WallGeom::Plane { point, normal } => WallShape::Plane { point: [point.x, point.y, point.z], normal: [normal.x, normal.y, normal.z] },
+                crate::walls::WallGeom::Plane { point, normal } => WallShape::Plane { point: DVec3::new(point.x, point.y, point.z), normal: DVec3::new(normal.x, normal.y, normal.z) },
                 _ => w.shape.clone(),
             })
             .collect()
     } else {
         scene.walls.iter().map(|w| w.shape.clone()).collect()
     };
-    let plane_at = |facing: [f64; 3]| {
+    let plane_at = |facing: DVec3| {
         shapes.iter().find_map(|s| match *s {
             WallShape::Plane { point, normal } if normal == facing => Some(point[2]),
             _ => None,
         })
     };
     let area = cross_section(shapes.iter(), &scene.periodic)?;
-    let floor = plane_at([0.0, 0.0, 1.0])?;
-    let piston_z = piston_z.or_else(|| scene.servo.and_then(|_| plane_at([0.0, 0.0, -1.0])));
+    let floor = plane_at(DVec3::Z)?;
+    let piston_z = piston_z.or_else(|| scene.servo.and_then(|_| plane_at(DVec3::NEG_Z)));
     let n = frame.radius.len();
     if n == 0 {
         return None;
@@ -116,7 +116,7 @@ pub fn void_ratio(solid_volume: f64, total_volume: f64) -> f64 {
 pub fn container_volume(scene: &Scene, piston_z: f64) -> Option<f64> {
     let area = cross_section(scene.walls.iter().map(|w| &w.shape), &scene.periodic)?;
     let floor = scene.walls.iter().find_map(|w| match w.shape {
-        WallShape::Plane { point, normal: [0.0, 0.0, 1.0] } => Some(point[2]),
+        WallShape::Plane { point, normal } if normal == DVec3::Z => Some(point[2]),
         _ => None,
     })?;
     Some(area * (piston_z - floor))
@@ -128,7 +128,7 @@ pub fn container_volume(scene: &Scene, piston_z: f64) -> Option<f64> {
 /// must have been taken with contacts. Indexed like the frame's grains (slot = permanent id).
 pub fn contact_moments(frame: &Frame, periodic: &Periodic<f64>) -> Vec<Tensor> {
     let mut m = vec![DMat3::ZERO; frame.radius.len()];
-    let add = |t: &mut Tensor, f: [f64; 3], c: [f64; 3]| *t += outer(DVec3::from(f), DVec3::from(c));
+    let add = |t: &mut Tensor, f: DVec3, c: DVec3| *t += outer(f, c);
     for r in frame.contacts.as_deref().unwrap_or(&[]) {
         let (i, j) = (r.i as usize, r.j as usize);
         let d = periodic.min_image(Vec3::of(frame.position[i]) - Vec3::of(frame.position[j]));
@@ -140,7 +140,7 @@ pub fn contact_moments(frame: &Frame, periodic: &Periodic<f64>) -> Vec<Tensor> {
         add(&mut m[j], r.force_j, (n * rp_j).f64());
     }
     for w in frame.wall_contacts.as_deref().unwrap_or(&[]) {
-        let c = [-w.lever * w.normal[0], -w.lever * w.normal[1], -w.lever * w.normal[2]];
+        let c = DVec3::new(-w.lever * w.normal[0], -w.lever * w.normal[1], -w.lever * w.normal[2]);
         add(&mut m[w.grain as usize], w.force, c);
     }
     m

@@ -4,7 +4,7 @@
 
 use super::tail::{fit_tail, TailFit};
 use super::{contact_moments, outer, trace, Tensor};
-use glam::{DMat3, DVec3};
+use glam::DMat3;
 use crate::engine::Frame;
 use crate::periodic::Periodic;
 use crate::real::Vec3;
@@ -229,7 +229,6 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
     for c in contacts.iter().filter(|c| c.normal_force != 0.0) {
         let d = periodic.min_image(Vec3::of(frame.position[c.i as usize]) - Vec3::of(frame.position[c.j as usize]));
         let u = (d * (1.0 / d.norm())).f64();
-        let u = DVec3::from(u);
         fabric += outer(u, u);
         n_bonds += 1.0;
     }

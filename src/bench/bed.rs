@@ -3,6 +3,7 @@
 //! in x-y for larger sizes. Tiling is instant, so a 10^6-grain dense start costs only the
 //! one-off pour of the 10^4-grain bed.
 
+use glam::DVec3;
 use crate::checkpoint::{self, EngineState};
 use crate::cpu::CpuEngine;
 use crate::output::RunRecorder;
@@ -67,7 +68,7 @@ pub fn settled_bed(cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedIn
     if path.exists() {
         let (info, state): (BedInfo, EngineState) = checkpoint::read(&path)?;
         let n = scene.grains.len();
-        let triples = |name: &str| -> anyhow::Result<Vec<[f64; 3]>> { Ok(state.reals(name, 3 * n)?.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()) };
+        let triples = |name: &str| -> anyhow::Result<Vec<DVec3>> { Ok(state.reals(name, 3 * n)?.chunks_exact(3).map(DVec3::from_slice).collect()) };
         scene.grains.position = triples("position").with_context(|| format!("{}: a damaged bed; fix: delete it and run again", path.display()))?;
         scene.grains.velocity = triples("velocity")?;
         scene.grains.angular_velocity = triples("angular_velocity")?;
@@ -98,7 +99,7 @@ pub fn settled_bed(cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedIn
     scene.grains.velocity = body.iter().map(|b| b.vel.f64()).collect();
     scene.grains.angular_velocity = body.iter().map(|b| b.omega.f64()).collect();
     let mut state = EngineState::default();
-    let flat = |v: &[[f64; 3]]| v.iter().flatten().copied().collect::<Vec<f64>>();
+    let flat = |v: &[DVec3]| v.iter().flat_map(|p| p.to_array()).collect::<Vec<f64>>();
     state.put_reals("position", flat(&scene.grains.position));
     state.put_reals("velocity", flat(&scene.grains.velocity));
     state.put_reals("angular_velocity", flat(&scene.grains.angular_velocity));
@@ -141,7 +142,7 @@ pub fn tile(bed: &Scene, nx: usize, ny: usize) -> anyhow::Result<Scene> {
             out.material.extend_from_slice(&g.material);
             out.velocity.extend_from_slice(&g.velocity);
             out.angular_velocity.extend_from_slice(&g.angular_velocity);
-            out.position.extend(g.position.iter().map(|p| [p[0] + shift[0], p[1] + shift[1], p[2] + shift[2]]));
+            out.position.extend(g.position.iter().map(|p| DVec3::new(p[0] + shift[0], p[1] + shift[1], p[2] + shift[2])));
         }
     }
     let mut scene = bed.clone();

@@ -8,6 +8,7 @@
 //!   velocity per grain): the RMS position error over the mean diameter and the RMS contact
 //!   force error over the RMS contact force, after a fixed time.
 
+use glam::DVec3;
 use crate::cpu::CpuEngine;
 use crate::engine::{Engine, Frame, SimError};
 use crate::periodic::Periodic;
@@ -101,7 +102,7 @@ pub fn shaken(bed: &Scene) -> Scene {
                 break [d[0] / n, d[1] / n, d[2] / n];
             }
         };
-        *v = [v[0] + BED_SHAKE * dir[0], v[1] + BED_SHAKE * dir[1], v[2] + BED_SHAKE * dir[2]];
+        *v = DVec3::new(v[0] + BED_SHAKE * dir[0], v[1] + BED_SHAKE * dir[1], v[2] + BED_SHAKE * dir[2]);
     }
     s.name = "dense_bed".into();
     s
@@ -158,11 +159,11 @@ fn position_error(a: &Frame, b: &Frame, periodic: &Periodic<f64>, d_mean: f64) -
 fn force_error(a: &Frame, reference: &Frame) -> f64 {
     let index = |f: &Frame| f.contacts.as_deref().unwrap_or(&[]).iter().map(|c| ((c.i, c.j), c.force)).collect::<HashMap<_, _>>();
     let (ia, ir) = (index(a), index(reference));
-    let norm2 = |f: [f64; 3]| f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
+    let norm2 = |f: DVec3| f[0] * f[0] + f[1] * f[1] + f[2] * f[2];
     let mut diff = 0.0;
     for (k, fr) in &ir {
-        let fa = ia.get(k).copied().unwrap_or([0.0; 3]);
-        diff += norm2([fa[0] - fr[0], fa[1] - fr[1], fa[2] - fr[2]]);
+        let fa = ia.get(k).copied().unwrap_or(DVec3::ZERO);
+        diff += norm2(DVec3::new(fa[0] - fr[0], fa[1] - fr[1], fa[2] - fr[2]));
     }
     diff += ia.iter().filter(|(k, _)| !ir.contains_key(k)).map(|(_, f)| norm2(*f)).sum::<f64>();
     let scale: f64 = ir.values().map(|f| norm2(*f)).sum();

@@ -141,10 +141,10 @@ impl<T: Real> Engine for ContactDynamics<T> {
             let (mut pairs, mut walls) = (Vec::new(), Vec::new());
             for c in loaded {
                 let (force_b, normal_force) = self.forces(c.r, c.n);
-                let on_a = [-force_b[0], -force_b[1], -force_b[2]];
+                let on_a = glam::DVec3::new(-force_b[0], -force_b[1], -force_b[2]);
                 let overlap = (-c.gap).f64().max(0.0);
                 match c.b {
-                    Partner::Grain(j) => pairs.push(ContactRecord { i: self.id[c.a as usize], j: self.id[j as usize], overlap, normal_force, force: on_a, force_j: force_b, ..Default::default() }),
+                    Partner::Grain(j) => pairs.push(ContactRecord { i: self.id[c.a as usize], j: self.id[j as usize], overlap, normal_force, force: on_a, force_j: force_b.into(), ..Default::default() }),
                     Partner::Wall(w) => {
                         let n = (-c.n).f64();
                         walls.push(WallContactRecord { grain: self.id[c.a as usize], wall: w, overlap, normal: n, lever: self.prop[c.a as usize].radius.f64(), force: on_a });

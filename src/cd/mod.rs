@@ -324,7 +324,7 @@ impl<T: Real> ContactDynamics<T> {
     }
 
     /// Grain `i`'s position (m, f64, residual included).
-    pub fn position(&self, i: usize) -> [f64; 3] {
+    pub fn position(&self, i: usize) -> glam::DVec3 {
         position::absolute(self.body[i].pos, position::residual_at(&self.residual, i))
     }
 

@@ -468,7 +468,7 @@ mod tests {
         let text = text.replace("z = [0.0, 14.0e-3]\n", "").replace("[model]", "[[wall]]\ntype = \"plane\"\nmaterial = \"sand\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n\n[model]");
         let mut scene = crate::scene::parse(std::path::Path::new("lanes_test.toml"), &text).unwrap();
         scene.grains.radius.iter_mut().for_each(|r| *r *= 1.1);
-        scene.gravity = [0.0, 0.0, -9.81];
+        scene.gravity = glam::DVec3::new(0.0, 0.0, -9.81);
         let mut e = CpuEngine::<T>::new(&scene).unwrap();
         e.advance(400).unwrap();
         let elapsed = T::of(1.0e-7);

@@ -203,7 +203,7 @@ impl<T: Real> CpuEngine<T> {
     }
 
     /// Grain positions in permanent-id order (m, f64): `pos + residual` where compensated.
-    pub fn positions(&self) -> Vec<[f64; 3]> {
+    pub fn positions(&self) -> Vec<glam::DVec3> {
         self.slots().iter().map(|&s| position::absolute(self.body[s as usize].pos, position::residual_at(&self.residual, s as usize))).collect()
     }
 

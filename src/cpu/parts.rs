@@ -242,10 +242,10 @@ impl<T: Real> CpuEngine<T> {
             let s = self.slot[i as usize] as usize;
             let b = &self.body[s];
             for v in [b.pos, b.vel, b.omega] {
-                out.extend(v.f64());
+                out.extend(v.f64().to_array());
             }
             if T::COMPENSATED {
-                out.extend(self.residual[s].f64());
+                out.extend(self.residual[s].f64().to_array());
             }
             if let Some(q) = &self.orientation {
                 out.extend(q[s].map(T::f64));

@@ -15,7 +15,7 @@ impl<T: Real> CpuEngine<T> {
             radius: self.by_id(&self.prop).iter().map(|p| p.radius.f64()).collect(),
             velocity: body.iter().map(|b| b.vel.f64()).collect(),
             angular_velocity: body.iter().map(|b| b.omega.f64()).collect(),
-            orientation: self.orientation.as_ref().map(|q| self.by_id(q).iter().map(|q| [q[0].f64(), q[1].f64(), q[2].f64(), q[3].f64()]).collect()),
+            orientation: self.orientation.as_ref().map(|q| self.by_id(q).iter().map(|q| glam::DQuat::from_xyzw(q[1].f64(), q[2].f64(), q[3].f64(), q[0].f64())).collect()),
             contacts: contacts.then(|| {
                 self.pairs
                     .in_id_order(&self.slots())
@@ -62,7 +62,7 @@ impl<T: Real> CpuEngine<T> {
         if T::COMPENSATED {
             s.put_reals("residual", self.residual.iter().flat_map(v3));
         }
-        s.put_reals("built_at", self.built_at.iter().flat_map(|v| v.f64()));
+        s.put_reals("built_at", self.built_at.iter().flat_map(|v| v.f64().to_array()));
         s.put_reals("built_margin", [self.built_margin.f64()]);
         // Three counts a grain where any axis wraps, as before they were kept for those alone.
         let with_images = if self.image.width() > 0 { self.body.len() } else { 0 };

@@ -165,7 +165,7 @@ impl<T: Real> CpuEngine<T> {
                 let servo = self.servo.and_then(|s| s.walls.iter().position(|&x| x == w).map(|k| (s, k)));
                 WallStats {
                     name: self.wall_names[w].clone(),
-                    force: self.wall_reaction[w].f64(),
+                    force: self.wall_reaction[w].f64().to_array(),
                     contacts: self.wall_count[w],
                     position: servo.map(|(_, k)| {
                         let p = self.plane(w).0;

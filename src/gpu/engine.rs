@@ -12,11 +12,12 @@ mod readback;
 mod snapshot;
 mod traffic;
 
+use glam::{UVec4, Vec4};
 use super::device::Gpu;
 use encode::Size;
 use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, SCAN_BLOCK, STAT_ROW};
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
-use crate::kernels::KERNELS;
+use crate::kernels::StepKernel;
 use crate::model::{HistoryLayout, NormalSetup, PairCoeffs, RollingFriction, TangentialLaw};
 use super::plan::{Dispatch, Entry, Plans};
 use crate::schedule::{Op, Schedule, Trace};
@@ -119,8 +120,9 @@ pub struct GpuEngine {
     /// The operations encoded, when tracing.
     trace: Trace,
     dt: f64,
-    layouts: HashMap<&'static str, wgpu::BindGroupLayout>,
-    pipelines: HashMap<&'static str, wgpu::ComputePipeline>,
+    /// Each kernel's bind group layout and pipeline, indexed by [`StepKernel`].
+    layouts: Vec<wgpu::BindGroupLayout>,
+    pipelines: Vec<wgpu::ComputePipeline>,
     buffers: HashMap<&'static str, wgpu::Buffer>,
     bind_groups: HashMap<String, wgpu::BindGroup>,
     phase_stride: u64,
@@ -221,8 +223,8 @@ impl GpuEngine {
             max_neighbours: scene.max_neighbours as u32,
             piston: NONE,
             hist_blocks: hist_blocks as u32,
-            gravity: [scene.gravity[0] as f32, scene.gravity[1] as f32, scene.gravity[2] as f32, 0.0],
-            cell: [cutoff as f32; 4],
+            gravity: Vec4::new(scene.gravity[0] as f32, scene.gravity[1] as f32, scene.gravity[2] as f32, 0.0),
+            cell: Vec4::splat(cutoff as f32),
             skin: scene.skin as f32,
             reach: reach as f32,
             ..Default::default()
@@ -261,18 +263,18 @@ impl GpuEngine {
                 match wall.shape {
                     WallShape::Plane { point, normal } => {
                         g.kind = layout::wall_kind::PLANE;
-                        g.point = [point[0] as f32, point[1] as f32, point[2] as f32, 0.0];
-                        g.normal = [normal[0] as f32, normal[1] as f32, normal[2] as f32, 0.0];
+                        g.point = Vec4::new(point[0] as f32, point[1] as f32, point[2] as f32, 0.0);
+                        g.normal = Vec4::new(normal[0] as f32, normal[1] as f32, normal[2] as f32, 0.0);
                     }
                     WallShape::Cylinder { center, radius } => {
                         g.kind = layout::wall_kind::CYLINDER;
-                        g.point = [center[0] as f32, center[1] as f32, 0.0, 0.0];
-                        g.normal = [0.0, 0.0, 0.0, radius as f32];
+                        g.point = Vec4::new(center[0] as f32, center[1] as f32, 0.0, 0.0);
+                        g.normal = Vec4::new(0.0, 0.0, 0.0, radius as f32);
                     }
                     WallShape::Piston { z, pressure, mass, area } => {
                         g.kind = layout::wall_kind::PISTON;
-                        g.point = [0.0, 0.0, z as f32, 0.0];
-                        g.piston = [mass as f32, area as f32, pressure as f32, 0.0];
+                        g.point = Vec4::new(0.0, 0.0, z as f32, 0.0);
+                        g.piston = Vec4::new(mass as f32, area as f32, pressure as f32, 0.0);
                         piston = Some(w);
                     }
                 }
@@ -294,7 +296,7 @@ impl GpuEngine {
             .collect();
 
         let g = &scene.grains;
-        let v4 = |a: [f64; 3], w: f64| [a[0] as f32, a[1] as f32, a[2] as f32, w as f32];
+        let v4 = |a: glam::DVec3, w: f64| [a[0] as f32, a[1] as f32, a[2] as f32, w as f32];
         let pos: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.position[i], g.radius[i])).collect();
         // What rounding took off each position (src/position.rs), as the CPU's f32 engine keeps it.
         let residual: Vec<[f32; 4]> = g.position.iter().map(|&x| { let (_, r) = crate::position::split::<f32>(x); [r.x, r.y, r.z, 0.0] }).collect();
@@ -336,8 +338,8 @@ impl GpuEngine {
         let servo = scene.servo.map_or(layout::Servo::default(), |s| {
             let w = s.walls.map(|w| w as u32);
             layout::Servo {
-                walls_lo: [w[0], w[1], w[2], w[3]],
-                walls_hi: [w[4], w[5], 0, 0],
+                walls_lo: UVec4::new(w[0], w[1], w[2], w[3]),
+                walls_hi: UVec4::new(w[4], w[5], 0, 0),
                 pressure: s.pressure as f32,
                 gain: s.gain as f32,
                 max_speed: s.max_speed as f32,
@@ -403,8 +405,8 @@ impl GpuEngine {
             phases,
             trace: Trace::default(),
             dt,
-            layouts: HashMap::new(),
-            pipelines: HashMap::new(),
+            layouts: Vec::new(),
+            pipelines: Vec::new(),
             buffers,
             bind_groups: HashMap::new(),
             phase_stride,

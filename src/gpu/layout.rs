@@ -3,6 +3,7 @@
 //! reflection of the WGSL.
 
 use bytemuck::{Pod, Zeroable};
+use glam::{UVec4, Vec4};
 
 /// Scene-wide constants (WGSL `Params`, a uniform).
 #[repr(C)]
@@ -25,26 +26,26 @@ pub struct Params {
     /// vec4 history blocks per contact.
     pub hist_blocks: u32,
     /// Gravity (m/s^2).
-    pub gravity: [f32; 4],
+    pub gravity: Vec4,
     /// Cell edge per axis (m).
-    pub cell: [f32; 4],
+    pub cell: Vec4,
     /// Lower bound of each periodic axis (m).
-    pub periodic_lo: [f32; 4],
+    pub periodic_lo: Vec4,
     /// Period per axis (m), 0 where it does not wrap.
-    pub periodic_len: [f32; 4],
+    pub periodic_len: Vec4,
     /// Cells per periodic axis, 0 where it does not wrap.
-    pub periodic_dims: [u32; 4],
+    pub periodic_dims: UVec4,
     /// The normal law's constants ([`crate::model::NormalSetup::gpu_block`]).
-    pub normal: [f32; 4],
+    pub normal: Vec4,
     /// The damping law's ([`crate::model::DampingLaw::gpu_block`]).
-    pub damping: [f32; 4],
+    pub damping: Vec4,
     /// The tangential law's ([`crate::model::TangentialLaw::gpu_block`]).
-    pub tangential: [f32; 4],
+    pub tangential: Vec4,
     /// The rolling law's ([`crate::model::RollingLaw::gpu_block`]).
-    pub rolling: [f32; 4],
+    pub rolling: Vec4,
     /// The cohesion law's ([`crate::model::CohesionLaw::gpu_block`]), the largest bridge
     /// volume (m^3) in `w`.
-    pub cohesion: [f32; 4],
+    pub cohesion: Vec4,
     /// Verlet skin (m).
     pub skin: f32,
     /// Distance beyond contact that pair detection reaches (m): the skin, plus the rupture
@@ -157,13 +158,13 @@ pub struct Wall {
     /// Padding.
     pub _pad1: u32,
     /// Plane point; cylinder axis (x, y); piston (0, 0, z).
-    pub point: [f32; 4],
+    pub point: Vec4,
     /// Plane unit normal; cylinder w = radius.
-    pub normal: [f32; 4],
+    pub normal: Vec4,
     /// Velocity (m/s).
-    pub velocity: [f32; 4],
+    pub velocity: Vec4,
     /// Piston: mass (kg), area (m^2), target pressure (Pa), external work (J).
-    pub piston: [f32; 4],
+    pub piston: Vec4,
 }
 
 /// The servo box's control state (WGSL `Servo`).
@@ -171,9 +172,9 @@ pub struct Wall {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Servo {
     /// Wall indices of the x_min, x_max, y_min, y_max planes.
-    pub walls_lo: [u32; 4],
+    pub walls_lo: UVec4,
     /// Wall indices of the z_min, z_max planes (z, w unused).
-    pub walls_hi: [u32; 4],
+    pub walls_hi: UVec4,
     /// Target pressure (Pa).
     pub pressure: f32,
     /// Wall speed per pressure error (m/(s Pa)).
@@ -347,7 +348,7 @@ pub struct CdContact {
     /// Padding.
     pub _pad0: u32,
     /// Unit normal from `a` to `b` (xyz); w: `u_min` (m/s).
-    pub n: [f32; 4],
+    pub n: Vec4,
     /// m.
     pub radius_a: f32,
     /// m (0 for a wall).

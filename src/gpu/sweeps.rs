@@ -16,7 +16,7 @@ use super::pipeline::{bind_group, compute_pipeline, read_back};
 use crate::cd::{Contact, Partner, Schedule, Solved, Sweeps, WallMotion, MAX_COLOURS, MEASURE_BLOCK};
 use crate::state::Body;
 use crate::engine::SimError;
-use crate::kernels::CD_KERNELS;
+use crate::kernels::{CdKernel, CD_KERNELS};
 use crate::real::Vec3;
 use std::collections::HashMap;
 
@@ -26,9 +26,11 @@ pub const MAX_SWEEPS_PER_SUBMIT: u32 = 32;
 /// The sweeps on a GPU (f32).
 pub struct GpuSweeps {
     gpu: Gpu,
-    pipelines: HashMap<&'static str, (wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
+    /// Each kernel's bind group layout and pipeline, indexed by [`CdKernel`].
+    pipelines: Vec<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
     buffers: HashMap<&'static str, wgpu::Buffer>,
-    bind_groups: HashMap<&'static str, wgpu::BindGroup>,
+    /// Each kernel's bind group, indexed by [`CdKernel`].
+    bind_groups: Vec<wgpu::BindGroup>,
     /// Contacts the contact buffers hold.
     capacity: u64,
     /// Bytes between colours in the `phase` uniform (the device's uniform offset alignment).
@@ -38,9 +40,9 @@ pub struct GpuSweeps {
 impl GpuSweeps {
     /// The sweeps of a system of `grains` grains and `walls` walls on an opened device.
     pub fn new(gpu: Gpu, grains: usize, walls: usize) -> Self {
-        let pipelines = CD_KERNELS.iter().map(|k| (k.name, compute_pipeline(&gpu.device, k, &[]))).collect();
+        let pipelines = CD_KERNELS.iter().map(|k| compute_pipeline(&gpu.device, k, &[])).collect();
         let colour_stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<CdColour>() as u64);
-        let mut sweeps = GpuSweeps { gpu, pipelines, buffers: HashMap::new(), bind_groups: HashMap::new(), capacity: 0, colour_stride };
+        let mut sweeps = GpuSweeps { gpu, pipelines, buffers: HashMap::new(), bind_groups: Vec::new(), capacity: 0, colour_stride };
         let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
         sweeps.buffer("cd", std::mem::size_of::<CdParams>() as u64, uniform);
         sweeps.buffer("phase", MAX_COLOURS as u64 * colour_stride, uniform);
@@ -66,10 +68,10 @@ impl GpuSweeps {
         self.buffer("impulse", 16 * capacity, Self::STORAGE);
         self.buffer("measure", 8 * capacity, Self::STORAGE);
         self.buffer("blocks", 8 * capacity.div_ceil(MEASURE_BLOCK as u64), Self::STORAGE);
-        for k in CD_KERNELS {
-            let bg = bind_group(&self.gpu.device, k.name, k, &self.pipelines[k.name].0, |name| &self.buffers[name], std::mem::size_of::<CdColour>() as u64);
-            self.bind_groups.insert(k.name, bg);
-        }
+        self.bind_groups = CdKernel::ALL
+            .iter()
+            .map(|&id| bind_group(&self.gpu.device, id.name(), id.kernel(), &self.pipelines[id as usize].0, |name| &self.buffers[name], std::mem::size_of::<CdColour>() as u64))
+            .collect();
     }
 
     fn write<T: bytemuck::NoUninit>(&self, name: &str, offset: u64, data: &[T]) {
@@ -83,23 +85,23 @@ impl GpuSweeps {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            let mut dispatch = |name: &str, items: u64, offset: Option<u32>| {
+            let mut dispatch = |kernel: CdKernel, items: u64, offset: Option<u32>| {
                 let (x, y) = crate::workgroup::groups(items);
-                pass.set_pipeline(&self.pipelines[name].1);
-                pass.set_bind_group(0, &self.bind_groups[name], offset.as_slice());
+                pass.set_pipeline(&self.pipelines[kernel as usize].1);
+                pass.set_bind_group(0, &self.bind_groups[kernel as usize], offset.as_slice());
                 pass.dispatch_workgroups(x, y, 1);
             };
             for _ in 0..sweeps {
                 for (k, &size) in colour_sizes.iter().enumerate() {
-                    dispatch("cd_sweep_colour", size as u64, Some((k as u64 * self.colour_stride) as u32));
+                    dispatch(CdKernel::CdSweepColour, size as u64, Some((k as u64 * self.colour_stride) as u32));
                 }
                 if tail {
-                    dispatch("cd_sweep_tail", 1, None);
+                    dispatch(CdKernel::CdSweepTail, 1, None);
                 }
                 if blocks > 0 {
-                    dispatch("cd_measure", blocks, None);
+                    dispatch(CdKernel::CdMeasure, blocks, None);
                 }
-                dispatch("cd_decide", 1, None);
+                dispatch(CdKernel::CdDecide, 1, None);
             }
         }
         self.gpu.queue.submit([encoder.finish()]);
@@ -121,7 +123,7 @@ fn pack(c: &Contact<f32>) -> CdContact {
         a: c.a,
         b,
         to_wall,
-        n: [c.n.x, c.n.y, c.n.z, c.u_min],
+        n: glam::Vec4::new(c.n.x, c.n.y, c.n.z, c.u_min),
         radius_a: c.radius_a,
         radius_b: c.radius_b,
         mu: c.mu,

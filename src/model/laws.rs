@@ -251,35 +251,35 @@ impl RollingFriction {
 
 impl DampingLaw<f64> {
     /// `[c_n, 0, 0, 0]` for the viscous dashpot (N s/m).
-    pub fn gpu_block(&self) -> [f32; 4] {
+    pub fn gpu_block(&self) -> glam::Vec4 {
         match *self {
-            DampingLaw::Viscous { c_n } => [c_n as f32, 0.0, 0.0, 0.0],
-            _ => [0.0; 4],
+            DampingLaw::Viscous { c_n } => glam::Vec4::new(c_n as f32, 0.0, 0.0, 0.0),
+            _ => glam::Vec4::ZERO,
         }
     }
 }
 
 impl TangentialLaw<f64> {
     /// `[k_t ratio, Hertz-Mindlin damping ratio, Oquendo et al.'s spring damping, 0]`.
-    pub fn gpu_block(&self) -> [f32; 4] {
+    pub fn gpu_block(&self) -> glam::Vec4 {
         let ratio = |s: TangentialStiffness<f64>| match s {
             TangentialStiffness::RatioToNormal(r) => r as f32,
             TangentialStiffness::Mindlin => 0.0,
         };
         match *self {
-            TangentialLaw::None => [0.0; 4],
-            TangentialLaw::Oquendo(l) => [ratio(l.stiffness), 0.0, l.static_damping as f32, 0.0],
-            TangentialLaw::Mindlin { damping_ratio, stiffness } => [ratio(stiffness), damping_ratio as f32, 0.0, 0.0],
+            TangentialLaw::None => glam::Vec4::ZERO,
+            TangentialLaw::Oquendo(l) => glam::Vec4::new(ratio(l.stiffness), 0.0, l.static_damping as f32, 0.0),
+            TangentialLaw::Mindlin { damping_ratio, stiffness } => glam::Vec4::new(ratio(stiffness), damping_ratio as f32, 0.0, 0.0),
         }
     }
 }
 
 impl RollingLaw<f64> {
     /// `[k_r, gamma_r, mu_r, 0]` of the sds law.
-    pub fn gpu_block(&self) -> [f32; 4] {
+    pub fn gpu_block(&self) -> glam::Vec4 {
         match *self {
-            RollingLaw::None => [0.0; 4],
-            RollingLaw::Sds { k_r, gamma_r, mu_r } => [k_r as f32, gamma_r as f32, mu_r as f32, 0.0],
+            RollingLaw::None => glam::Vec4::ZERO,
+            RollingLaw::Sds { k_r, gamma_r, mu_r } => glam::Vec4::new(k_r as f32, gamma_r as f32, mu_r as f32, 0.0),
         }
     }
 }
@@ -287,10 +287,10 @@ impl RollingLaw<f64> {
 impl CohesionLaw<f64> {
     /// `[kappa, theta, c, volume_cap]` of capillary bridges, `volume_cap` (m^3) the largest
     /// bridge's volume (the scene's).
-    pub fn gpu_block(&self, volume_cap: f64) -> [f32; 4] {
+    pub fn gpu_block(&self, volume_cap: f64) -> glam::Vec4 {
         match *self {
-            CohesionLaw::None => [0.0, 0.0, 0.0, volume_cap as f32],
-            CohesionLaw::Capillary { kappa, theta, c } => [kappa as f32, theta as f32, c as f32, volume_cap as f32],
+            CohesionLaw::None => glam::Vec4::new(0.0, 0.0, 0.0, volume_cap as f32),
+            CohesionLaw::Capillary { kappa, theta, c } => glam::Vec4::new(kappa as f32, theta as f32, c as f32, volume_cap as f32),
         }
     }
 }

@@ -62,7 +62,7 @@ impl McapRecorder {
 /// A `foxglove.SceneUpdate` with one sphere per grain, coloured by speed (blue at rest, red
 /// at the frame's fastest).
 fn scene_update(f: &Frame) -> serde_json::Value {
-    let speed = |v: &[f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let speed = |v: &glam::DVec3| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     let v_max = f.velocity.iter().map(speed).fold(0.0, f64::max).max(1e-30);
     let spheres: Vec<_> = (0..f.position.len())
         .map(|i| {

@@ -116,7 +116,7 @@ impl PlacementGrid {
 /// The lower and upper corners of a box holding `region` and every grain of `grains` (m).
 fn bounds_of(region: &RegionSpec, grains: &Grains) -> [[f64; 3]; 2] {
     let mut b = match *region {
-        RegionSpec::Box { min, max } => [min, max],
+        RegionSpec::Box { min, max } => [min.to_array(), max.to_array()],
         RegionSpec::Cylinder { center, radius, z_min, z_max } => [[center[0] - radius, center[1] - radius, z_min], [center[0] + radius, center[1] + radius, z_max]],
     };
     for p in &grains.position {
@@ -155,8 +155,8 @@ pub(super) fn place(
     }
     let r_max_all = grains.radius.iter().copied().fold(0.5 * d.max, f64::max);
     let mut grid = PlacementGrid::new(bounds_of(&spec.region, grains), 2.0 * r_max_all, grains.len() + spec.count);
-    for &p in &grains.position {
-        grid.insert(p);
+    for p in &grains.position {
+        grid.insert(p.to_array());
     }
     // One stream per generator so that adding a generator leaves the others unchanged.
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (0x9E37_79B9_7F4A_7C15u64.wrapping_mul(k as u64 + 1)));
@@ -189,7 +189,7 @@ pub(super) fn place(
             }
         }
         grid.insert(p);
-        grains.push(r, sphere_mass(r, density), p, v, [0.0; 3], material);
+        grains.push(r, sphere_mass(r, density), p.into(), v, glam::DVec3::ZERO, material);
         solid += 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
     }
     Ok(())
@@ -270,7 +270,7 @@ mod tests {
         for _ in 0..150 {
             let p = [rng.random_range(0.0..side), rng.random_range(0.0..side), rng.random_range(0.0..height)];
             grid.insert(p);
-            grains.push(r, 1.0, p, [0.0; 3], [0.0; 3], 0);
+            grains.push(r, 1.0, p.into(), glam::DVec3::ZERO, glam::DVec3::ZERO, 0);
         }
         let brute = |p: [f64; 3], rq: f64| {
             grains.position.iter().zip(&grains.radius).any(|(q, &rj)| {

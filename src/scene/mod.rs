@@ -15,6 +15,7 @@ pub use error::SceneError;
 pub use stage_specs::pressure_label;
 pub use types::*;
 pub use wall_specs::{cross_section, wall_distance};
+use glam::DVec3;
 use model_specs::{bridge_limits, validate_method, validate_model};
 use periodic_specs::{check_periodic, validate_periodic};
 use stage_specs::validate_stages;
@@ -51,11 +52,11 @@ fn non_negative(c: &Complainer, key: &str, v: f64, fix: &str) -> Result<f64, Sce
     if v.is_finite() && v >= 0.0 { Ok(v) } else { Err(c.invalid(key, v, "must be zero or positive", fix)) }
 }
 
-fn finite3(c: &Complainer, key: &str, v: [f64; 3]) -> Result<[f64; 3], SceneError> {
-    if v.iter().all(|x| x.is_finite()) {
+fn finite3(c: &Complainer, key: &str, v: DVec3) -> Result<DVec3, SceneError> {
+    if v.is_finite() {
         Ok(v)
     } else {
-        Err(c.invalid(key, format!("{v:?}"), "must be three finite numbers", "give finite values in SI units"))
+        Err(c.invalid(key, format!("{:?}", v.to_array()), "must be three finite numbers", "give finite values in SI units"))
     }
 }
 
@@ -254,7 +255,7 @@ fn choose_time_step(
     grains: &Grains,
     walls: &[Wall],
     model: &ContactModel<f64>,
-    gravity: [f64; 3],
+    gravity: DVec3,
     warnings: &mut Vec<String>,
 ) -> Result<TimeStep, SceneError> {
     let expected_speed = match sim.expected_speed {

@@ -69,7 +69,7 @@ pub(super) fn grains(
                 return Err(c.invalid(key("types"), format!("\"{}\"", materials[m as usize].name), "the file gives no masses and the material no density", "add `density` (kg/m^3) to that [[material]]"));
             }
         };
-        grains.push(r, mass, atoms.position[i], atoms.velocity[i], atoms.angular_velocity[i], m);
+        grains.push(r, mass, atoms.position[i].into(), atoms.velocity[i].into(), atoms.angular_velocity[i].into(), m);
     }
     if let Some((file_rho, own, name)) = mismatch {
         warnings.push(format!("{}: read[{k}]: the file's density {file_rho} kg/m^3 differs from material \"{name}\"'s {own} kg/m^3; the masses follow the file", c.file.display()));

@@ -3,6 +3,7 @@
 //!
 //! docs/scene-reference.md documents every key; tests/docs.rs checks it against this schema.
 
+use glam::DVec3;
 use serde::Deserialize;
 
 /// A whole scene file.
@@ -106,13 +107,13 @@ pub struct GrainSpec {
     /// Radius (m).
     pub radius: f64,
     /// Centre position (m).
-    pub position: [f64; 3],
+    pub position: DVec3,
     /// Velocity (m/s). Default 0.
     #[serde(default)]
-    pub velocity: [f64; 3],
+    pub velocity: DVec3,
     /// Angular velocity (rad/s). Default 0.
     #[serde(default)]
-    pub angular_velocity: [f64; 3],
+    pub angular_velocity: DVec3,
 }
 
 /// `[[read]]`: grains from a LAMMPS data file (`atom_style sphere`) or a LAMMPS / LIGGGHTS
@@ -144,7 +145,7 @@ pub struct GeneratorSpec {
     pub region: RegionSpec,
     /// Velocity of every grain (m/s). Default 0.
     #[serde(default)]
-    pub velocity: [f64; 3],
+    pub velocity: DVec3,
     /// Speed (m/s) added in a random direction per grain (a gas). Default 0.
     #[serde(default)]
     pub random_speed: f64,
@@ -167,9 +168,9 @@ pub enum RegionSpec {
     /// Axis-aligned box.
     Box {
         /// Lower corner (m).
-        min: [f64; 3],
+        min: DVec3,
         /// Upper corner (m).
-        max: [f64; 3],
+        max: DVec3,
     },
     /// Vertical cylinder (axis along z).
     Cylinder {
@@ -193,18 +194,18 @@ pub enum WallSpec {
         /// Material name.
         material: String,
         /// A point on the plane (m).
-        point: [f64; 3],
+        point: DVec3,
         /// Normal pointing into the domain (any length).
-        normal: [f64; 3],
+        normal: DVec3,
     },
     /// Five or six planes bounding an axis-aligned box; grains live inside.
     Box {
         /// Material name.
         material: String,
         /// Lower corner (m).
-        min: [f64; 3],
+        min: DVec3,
         /// Upper corner (m).
-        max: [f64; 3],
+        max: DVec3,
         /// Leave out the top (z = max) plane. Default false.
         #[serde(default)]
         open_top: bool,
@@ -226,9 +227,9 @@ pub enum WallSpec {
         /// Material name.
         material: String,
         /// Lower corner (m).
-        min: [f64; 3],
+        min: DVec3,
         /// Upper corner (m).
-        max: [f64; 3],
+        max: DVec3,
         /// Target pressure (Pa). Default 0 (the walls back off until nothing pushes them).
         #[serde(default)]
         pressure: f64,
@@ -367,7 +368,7 @@ impl<'de> Deserialize<'de> for DtSpec {
 pub struct SimulationSpec {
     /// Gravity (m/s^2). Default [0, 0, -9.81].
     #[serde(default = "default_gravity")]
-    pub gravity: [f64; 3],
+    pub gravity: DVec3,
     /// "velocity_verlet" (default; one force evaluation per step) or "optimized_verlet"
     /// (Oquendo et al. eqs. 11-15, two evaluations per step).
     pub integrator: Option<String>,
@@ -397,8 +398,8 @@ pub struct SimulationSpec {
     pub method: Option<String>,
 }
 
-fn default_gravity() -> [f64; 3] {
-    [0.0, 0.0, -9.81]
+fn default_gravity() -> DVec3 {
+    DVec3::new(0.0, 0.0, -9.81)
 }
 
 impl Default for SimulationSpec {

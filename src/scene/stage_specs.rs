@@ -7,7 +7,7 @@ pub(super) fn validate_stages(
     c: &Complainer,
     specs: &[StageSpec],
     grains: &Grains,
-    gravity: [f64; 3],
+    gravity: glam::DVec3,
     d_mean: f64,
     walls: &[Wall],
     has_servo: bool,

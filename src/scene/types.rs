@@ -2,6 +2,7 @@
 //! the analysis read. Plain data: the checks that make them live in [`super`] (validation),
 //! [`crate::timestep`] (the time step) and [`crate::walls`] (wall geometry).
 
+use glam::DVec3;
 use crate::model::{ContactModel, MaterialConstants};
 use serde::Serialize;
 use std::path::PathBuf;
@@ -27,11 +28,11 @@ pub struct Grains {
     /// Mass (kg).
     pub mass: Vec<f64>,
     /// Centre position (m).
-    pub position: Vec<[f64; 3]>,
+    pub position: Vec<DVec3>,
     /// Velocity (m/s).
-    pub velocity: Vec<[f64; 3]>,
+    pub velocity: Vec<DVec3>,
     /// Angular velocity (rad/s).
-    pub angular_velocity: Vec<[f64; 3]>,
+    pub angular_velocity: Vec<DVec3>,
     /// Index into [`Scene::materials`].
     pub material: Vec<u16>,
 }
@@ -39,7 +40,7 @@ pub struct Grains {
 impl Grains {
     /// The same grains renumbered: grain `k` of the result is grain `order[k]` of `self`.
     pub fn permuted(&self, order: &[usize]) -> Grains {
-        let pick = |v: &[[f64; 3]]| order.iter().map(|&i| v[i]).collect();
+        let pick = |v: &[DVec3]| order.iter().map(|&i| v[i]).collect();
         Grains {
             radius: order.iter().map(|&i| self.radius[i]).collect(),
             mass: order.iter().map(|&i| self.mass[i]).collect(),
@@ -58,7 +59,7 @@ impl Grains {
     pub fn is_empty(&self) -> bool {
         self.radius.is_empty()
     }
-    pub(super) fn push(&mut self, radius: f64, mass: f64, position: [f64; 3], velocity: [f64; 3], angular_velocity: [f64; 3], material: u16) {
+    pub(super) fn push(&mut self, radius: f64, mass: f64, position: DVec3, velocity: DVec3, angular_velocity: DVec3, material: u16) {
         self.radius.push(radius);
         self.mass.push(mass);
         self.position.push(position);
@@ -74,9 +75,9 @@ pub enum WallShape {
     /// Fixed plane through `point` with unit `normal` pointing into the domain.
     Plane {
         /// A point on the plane (m).
-        point: [f64; 3],
+        point: DVec3,
         /// Unit normal into the domain.
-        normal: [f64; 3],
+        normal: DVec3,
     },
     /// Fixed vertical cylinder, grains inside.
     Cylinder {
@@ -274,7 +275,7 @@ pub struct Scene {
     /// Wrapping interval `[lo, hi)` (m) of each periodic axis.
     pub periodic: [Option<[f64; 2]>; 3],
     /// Gravity (m/s^2).
-    pub gravity: [f64; 3],
+    pub gravity: DVec3,
     /// Contact law per slot.
     pub model: ContactModel<f64>,
     /// DEM or contact dynamics.

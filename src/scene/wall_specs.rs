@@ -29,24 +29,24 @@ pub(super) fn validate_walls(
                 let normal = finite3(c, &key("normal"), *normal)?;
                 let len = (normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]).sqrt();
                 if len == 0.0 {
-                    return Err(c.invalid(key("normal"), format!("{normal:?}"), "is the zero vector", "give the direction into the domain, e.g. [0, 0, 1]"));
+                    return Err(c.invalid(key("normal"), format!("{:?}", normal.to_array()), "is the zero vector", "give the direction into the domain, e.g. [0, 0, 1]"));
                 }
-                let normal = [normal[0] / len, normal[1] / len, normal[2] / len];
+                let normal = DVec3::new(normal[0] / len, normal[1] / len, normal[2] / len);
                 out.push(plain(format!("wall[{i}]"), WallShape::Plane { point, normal }, m));
             }
             WallSpec::Box { material, min, max, open_top } => {
                 let m = material_of(key("material"), material)?;
                 let (lo, hi) = (finite3(c, &key("min"), *min)?, finite3(c, &key("max"), *max)?);
                 if (0..3).any(|k| hi[k] <= lo[k]) {
-                    return Err(c.invalid(key("max"), format!("{hi:?}"), format!("must exceed min {lo:?} on every axis"), "give the upper corner above the lower one"));
+                    return Err(c.invalid(key("max"), format!("{:?}", hi.to_array()), format!("must exceed min {:?} on every axis", lo.to_array()), "give the upper corner above the lower one"));
                 }
-                let faces: [(&str, [f64; 3], [f64; 3]); 6] = [
-                    ("bottom", lo, [0.0, 0.0, 1.0]),
-                    ("top", hi, [0.0, 0.0, -1.0]),
-                    ("x_min", lo, [1.0, 0.0, 0.0]),
-                    ("x_max", hi, [-1.0, 0.0, 0.0]),
-                    ("y_min", lo, [0.0, 1.0, 0.0]),
-                    ("y_max", hi, [0.0, -1.0, 0.0]),
+                let faces: [(&str, DVec3, DVec3); 6] = [
+                    ("bottom", lo, DVec3::new(0.0, 0.0, 1.0)),
+                    ("top", hi, DVec3::new(0.0, 0.0, -1.0)),
+                    ("x_min", lo, DVec3::new(1.0, 0.0, 0.0)),
+                    ("x_max", hi, DVec3::new(-1.0, 0.0, 0.0)),
+                    ("y_min", lo, DVec3::new(0.0, 1.0, 0.0)),
+                    ("y_max", hi, DVec3::new(0.0, -1.0, 0.0)),
                 ];
                 for (face, point, normal) in faces {
                     if *open_top && face == "top" {
@@ -59,7 +59,7 @@ pub(super) fn validate_walls(
                 let m = material_of(key("material"), material)?;
                 let (lo, hi) = (finite3(c, &key("min"), *min)?, finite3(c, &key("max"), *max)?);
                 if (0..3).any(|k| hi[k] <= lo[k]) {
-                    return Err(c.invalid(key("max"), format!("{hi:?}"), format!("must exceed min {lo:?} on every axis"), "give the upper corner above the lower one"));
+                    return Err(c.invalid(key("max"), format!("{:?}", hi.to_array()), format!("must exceed min {:?} on every axis", lo.to_array()), "give the upper corner above the lower one"));
                 }
                 if out.iter().any(|p: &PendingWall| p.servo.is_some()) {
                     return Err(c.invalid(key("type"), "\"servo_box\"", "a scene has at most one servo box", "remove the extra one"));
@@ -67,13 +67,13 @@ pub(super) fn validate_walls(
                 let pressure = non_negative(c, &key("pressure"), *pressure, "give the target pressure in Pa")?;
                 let max_speed = positive(c, &key("max_speed"), max_speed.unwrap_or(DEFAULT_SERVO_SPEED), "give the largest wall speed in m/s")?;
                 let gain = positive(c, &key("gain"), gain.unwrap_or(max_speed / pressure.max(SERVO_PRESSURE_FLOOR)), "give the wall speed per pressure error in m/(s Pa)")?;
-                let faces: [(&str, [f64; 3], [f64; 3]); 6] = [
-                    ("x_min", lo, [1.0, 0.0, 0.0]),
-                    ("x_max", hi, [-1.0, 0.0, 0.0]),
-                    ("y_min", lo, [0.0, 1.0, 0.0]),
-                    ("y_max", hi, [0.0, -1.0, 0.0]),
-                    ("z_min", lo, [0.0, 0.0, 1.0]),
-                    ("z_max", hi, [0.0, 0.0, -1.0]),
+                let faces: [(&str, DVec3, DVec3); 6] = [
+                    ("x_min", lo, DVec3::new(1.0, 0.0, 0.0)),
+                    ("x_max", hi, DVec3::new(-1.0, 0.0, 0.0)),
+                    ("y_min", lo, DVec3::new(0.0, 1.0, 0.0)),
+                    ("y_max", hi, DVec3::new(0.0, -1.0, 0.0)),
+                    ("z_min", lo, DVec3::new(0.0, 0.0, 1.0)),
+                    ("z_max", hi, DVec3::new(0.0, 0.0, -1.0)),
                 ];
                 for (face, point, normal) in faces {
                     let mut w = plain(format!("wall[{i}].{face}"), WallShape::Plane { point, normal }, m);
@@ -146,13 +146,13 @@ pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone, pe
         _ => None,
     });
     cylinder.or_else(|| {
-        let side = |n: [f64; 3]| {
+        let side = |n: DVec3| {
             shapes.clone().find_map(|s| match *s {
                 WallShape::Plane { point, normal } if normal == n => Some(point),
                 _ => None,
             })
         };
-        let span = |a: usize, n: [f64; 3]| match periodic[a] {
+        let span = |a: usize, n: DVec3| match periodic[a] {
             Some([lo, hi]) => Some(hi - lo),
             None => {
                 let mut m = n;
@@ -160,13 +160,13 @@ pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone, pe
                 Some(side(m)?[a] - side(n)?[a])
             }
         };
-        Some(span(0, [1.0, 0.0, 0.0])? * span(1, [0.0, 1.0, 0.0])?)
+        Some(span(0, DVec3::new(1.0, 0.0, 0.0))? * span(1, DVec3::new(0.0, 1.0, 0.0))?)
     })
 }
 
 /// Signed distance (m) from a point to a wall's surface at its initial position, positive on
 /// the grains' side.
-pub fn wall_distance(shape: &WallShape, p: [f64; 3]) -> f64 {
+pub fn wall_distance(shape: &WallShape, p: DVec3) -> f64 {
     crate::walls::WallGeom::<f64>::of(shape).frame(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).1
 }
 

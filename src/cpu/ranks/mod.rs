@@ -220,7 +220,7 @@ impl<T: Real> Net<T> {
         let mut grains = self.grains.permuted(&order);
         // Where the grains are now, for the list the new engine builds before the restore.
         for (p, b) in grains.position.iter_mut().zip(state.reals["body"].chunks_exact(9)) {
-            *p = [b[0], b[1], b[2]];
+            *p = glam::DVec3::new(b[0], b[1], b[2]);
         }
         let scene = Scene { grains, ..self.template.clone() };
         let mut local = CpuEngine::<T>::new(&scene)?;

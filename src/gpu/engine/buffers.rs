@@ -78,18 +78,20 @@ impl GpuEngine {
         let orientation = ("TRACK_ORIENTATION", self.track_orientation as u8 as f64);
         let wall_response = ("WALL_RESPONSE", self.servo.is_some() as u8 as f64);
         let partner_force = ("PARTNER_FORCE_STORED", m.keeps_both_forces() as u8 as f64);
-        for k in KERNELS {
-            let mut constants: Vec<(&str, f64)> = if k.includes.contains(&"model") { model_constants.to_vec() } else { Vec::new() };
-            match k.name {
-                "integrate" => constants.push(orientation),
-                "pair_force" => constants.push(partner_force),
-                "gather" => constants.extend([partner_force, wall_response, orientation]),
-                _ => {}
-            }
-            let (layout, pipeline) = crate::gpu::pipeline::compute_pipeline(&self.gpu.device, k, &constants);
-            self.layouts.insert(k.name, layout);
-            self.pipelines.insert(k.name, pipeline);
-        }
+        (self.layouts, self.pipelines) = StepKernel::ALL
+            .iter()
+            .map(|&id| {
+                let k = id.kernel();
+                let mut constants: Vec<(&str, f64)> = if k.includes.contains(&"model") { model_constants.to_vec() } else { Vec::new() };
+                match id {
+                    StepKernel::Integrate => constants.push(orientation),
+                    StepKernel::PairForce => constants.push(partner_force),
+                    StepKernel::Gather => constants.extend([partner_force, wall_response, orientation]),
+                    _ => {}
+                }
+                crate::gpu::pipeline::compute_pipeline(&self.gpu.device, k, &constants)
+            })
+            .unzip();
     }
 
     /// Bind groups: one per kernel, and one per scanned array for the scan kernels.
@@ -104,8 +106,9 @@ impl GpuEngine {
             ("rev", "rev_start", "grain_sums"),
             ("grain_sums", "grain_sums", "spare_sum"),
         ];
-        for k in KERNELS {
-            let instances: Vec<(String, Vec<(&str, &str)>)> = if k.name.starts_with("scan_") {
+        for &id in StepKernel::ALL {
+            let k = id.kernel();
+            let instances: Vec<(String, Vec<(&str, &str)>)> = if matches!(id, StepKernel::ScanBlocks | StepKernel::ScanAdd) {
                 scans.iter().map(|(tag, data, sums)| (format!("{}:{tag}", k.name), vec![("scan_data", *data), ("block_sums", *sums)])).collect()
             } else {
                 vec![(k.name.to_string(), vec![])]
@@ -115,7 +118,7 @@ impl GpuEngine {
                     let buffer_name = aliases.iter().chain(&REBUILD_SCRATCH).find(|(a, _)| *a == name).map_or(name, |(_, b)| *b);
                     self.buffers.get(buffer_name).unwrap_or_else(|| panic!("kernel {} binds {buffer_name}, which the engine lacks", k.name))
                 };
-                let bg = crate::gpu::pipeline::bind_group(&self.gpu.device, &key, k, &self.layouts[k.name], buffer, std::mem::size_of::<Phase>() as u64);
+                let bg = crate::gpu::pipeline::bind_group(&self.gpu.device, &key, k, &self.layouts[id as usize], buffer, std::mem::size_of::<Phase>() as u64);
                 self.bind_groups.insert(key, bg);
             }
         }

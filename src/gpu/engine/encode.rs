@@ -19,8 +19,8 @@ pub(super) enum Size {
 }
 
 impl GpuEngine {
-    pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass, name: &str, group: &str, size: Size, phase: Option<Phase>) {
-        pass.set_pipeline(&self.pipelines[name]);
+    pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass, kernel: StepKernel, group: &str, size: Size, phase: Option<Phase>) {
+        pass.set_pipeline(&self.pipelines[kernel as usize]);
         // A kernel with a phase binding is given its phase; the others none.
         let slot = |p: Phase| self.phases.iter().position(|q| *q == p).expect("every phase of the plans has a uniform slot");
         let offsets: Vec<u32> = phase.map(|p| (slot(p) as u64 * self.phase_stride) as u32).into_iter().collect();
@@ -36,29 +36,29 @@ impl GpuEngine {
         }
     }
 
-    pub(super) fn run(&self, pass: &mut wgpu::ComputePass, name: &str, size: Size, phase: Option<Phase>) {
-        self.dispatch(pass, name, name, size, phase);
+    pub(super) fn run(&self, pass: &mut wgpu::ComputePass, kernel: StepKernel, size: Size, phase: Option<Phase>) {
+        self.dispatch(pass, kernel, kernel.name(), size, phase);
     }
 
     /// Exclusive scan of an array of `elements`: blocks, the blocks' totals, then the offsets
     /// added back (the last two only when there is more than one block).
     pub(super) fn scan(&self, pass: &mut wgpu::ComputePass, tag: &str, sums_tag: &str, blocks: u64, elements: u64) {
-        self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{tag}"), Size::Indirect(blocks), None);
+        self.dispatch(pass, StepKernel::ScanBlocks, &format!("scan_blocks:{tag}"), Size::Indirect(blocks), None);
         // An array of one block is scanned by then: its offset would be 0.
         if elements <= SCAN_BLOCK {
             return;
         }
-        self.dispatch(pass, "scan_blocks", &format!("scan_blocks:{sums_tag}"), Size::Indirect(args::ONE), None);
-        self.dispatch(pass, "scan_add", &format!("scan_add:{tag}"), Size::Indirect(blocks), None);
+        self.dispatch(pass, StepKernel::ScanBlocks, &format!("scan_blocks:{sums_tag}"), Size::Indirect(args::ONE), None);
+        self.dispatch(pass, StepKernel::ScanAdd, &format!("scan_add:{tag}"), Size::Indirect(blocks), None);
     }
 
     /// `decide_rebuild` and the rebuild kernels, which run with zero workgroups when the
     /// list is still good.
     pub(super) fn encode_rebuild_if_needed(&self, pass: &mut wgpu::ComputePass) {
-        self.run(pass, "decide_rebuild", Size::One, None);
+        self.run(pass, StepKernel::DecideRebuild, Size::One, None);
         if self.params.hist_blocks > 0 {
-            self.run(pass, "save_starts", Size::Indirect(args::GRAIN_STARTS), None);
-            self.run(pass, "save_pairs", Size::Indirect(args::OLD_PAIRS), None);
+            self.run(pass, StepKernel::SaveStarts, Size::Indirect(args::GRAIN_STARTS), None);
+            self.run(pass, StepKernel::SavePairs, Size::Indirect(args::OLD_PAIRS), None);
         }
         self.encode_pair_count(pass);
         self.encode_list_fill(pass);
@@ -68,25 +68,25 @@ impl GpuEngine {
     /// the new list outgrows the pair buffers), the new list, its history and its reverse
     /// lists. A rebuild stopped there goes on from here once the buffers have grown.
     pub(super) fn encode_list_fill(&self, pass: &mut wgpu::ComputePass) {
-        self.run(pass, "pairs_ready", Size::One, None);
-        self.run(pass, "detect_fill", Size::Indirect(args::GRAINS), None);
+        self.run(pass, StepKernel::PairsReady, Size::One, None);
+        self.run(pass, StepKernel::DetectFill, Size::Indirect(args::GRAINS), None);
         if self.params.hist_blocks > 0 {
-            self.run(pass, "remap_history", Size::Indirect(args::NEW_PAIRS), None);
+            self.run(pass, StepKernel::RemapHistory, Size::Indirect(args::NEW_PAIRS), None);
         }
-        self.run(pass, "reverse_count", Size::Indirect(args::NEW_PAIRS), None);
+        self.run(pass, StepKernel::ReverseCount, Size::Indirect(args::NEW_PAIRS), None);
         self.scan(pass, "rev", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
-        self.run(pass, "reverse_fill", Size::Indirect(args::NEW_PAIRS), None);
-        self.run(pass, "reverse_sort", Size::Indirect(args::GRAINS), None);
+        self.run(pass, StepKernel::ReverseFill, Size::Indirect(args::NEW_PAIRS), None);
+        self.run(pass, StepKernel::ReverseSort, Size::Indirect(args::GRAINS), None);
     }
 
     /// The rebuild's hashing and pair count, at the sizes `decide_rebuild` wrote: then
     /// `pair_start` holds each grain's first pair and, last, the number of pairs.
     pub(super) fn encode_pair_count(&self, pass: &mut wgpu::ComputePass) {
-        self.run(pass, "clear_cells", Size::Indirect(args::HASH), None);
-        self.run(pass, "hash_cells", Size::Indirect(args::GRAINS), None);
+        self.run(pass, StepKernel::ClearCells, Size::Indirect(args::HASH), None);
+        self.run(pass, StepKernel::HashCells, Size::Indirect(args::GRAINS), None);
         self.scan(pass, "cell", "cell_sums", args::HASH_BLOCKS, self.params.hash_size as u64);
-        self.run(pass, "scatter_cells", Size::Indirect(args::GRAINS), None);
-        self.run(pass, "detect_count", Size::Indirect(args::GRAINS), None);
+        self.run(pass, StepKernel::ScatterCells, Size::Indirect(args::GRAINS), None);
+        self.run(pass, StepKernel::DetectCount, Size::Indirect(args::GRAINS), None);
         self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
     }
 
@@ -97,29 +97,29 @@ impl GpuEngine {
     /// `gather` (with the wall contacts, and the kick after it), `wall_reduce` (and the
     /// piston's kick) where there are walls, then `servo_move` where they carry a drift in
     /// servo scenes; nothing for a carried entry.
-    pub(super) fn kernels_of(&self, e: &Entry) -> Vec<(&'static str, Size, Option<Phase>)> {
+    pub(super) fn kernels_of(&self, e: &Entry) -> Vec<(StepKernel, Size, Option<Phase>)> {
         let phase = Some(e.phase);
         let mut k = Vec::new();
         match e.dispatch {
             Dispatch::Integrate => {
-                k.push(("integrate", STEP_GRAINS, phase));
+                k.push((StepKernel::Integrate, STEP_GRAINS, phase));
                 if self.servo.is_some() && e.phase.drift > 0.0 {
-                    k.push(("servo_move", STEP_ONE, phase));
+                    k.push((StepKernel::ServoMove, STEP_ONE, phase));
                 }
             }
             Dispatch::RebuildIfNeeded | Dispatch::Carried => {}
             Dispatch::Forces => {
                 if self.history.bridge {
-                    k.push(("find_bridge_events", Size::Indirect(args::PAIRS), None));
-                    k.push(("update_bridges", STEP_ONE, None));
+                    k.push((StepKernel::FindBridgeEvents, Size::Indirect(args::PAIRS), None));
+                    k.push((StepKernel::UpdateBridges, STEP_ONE, None));
                 }
-                k.push(("pair_force", Size::Indirect(args::PAIRS), phase));
-                k.push(("gather", STEP_GRAINS, phase));
+                k.push((StepKernel::PairForce, Size::Indirect(args::PAIRS), phase));
+                k.push((StepKernel::Gather, STEP_GRAINS, phase));
                 if self.has_walls {
-                    k.push(("wall_reduce", STEP_ONE, phase));
+                    k.push((StepKernel::WallReduce, STEP_ONE, phase));
                 }
                 if self.servo.is_some() && e.phase.drift > 0.0 {
-                    k.push(("servo_move", STEP_ONE, phase));
+                    k.push((StepKernel::ServoMove, STEP_ONE, phase));
                 }
             }
         }
@@ -131,8 +131,8 @@ impl GpuEngine {
         if e.dispatch == Dispatch::RebuildIfNeeded {
             return self.encode_rebuild_if_needed(pass);
         }
-        for (name, size, phase) in self.kernels_of(e) {
-            self.run(pass, name, size, phase);
+        for (kernel, size, phase) in self.kernels_of(e) {
+            self.run(pass, kernel, size, phase);
         }
     }
 

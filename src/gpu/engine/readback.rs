@@ -138,7 +138,7 @@ impl GpuEngine {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.run(&mut pass, "decide_rebuild", Size::One, None);
+            self.run(&mut pass, StepKernel::DecideRebuild, Size::One, None);
             self.encode_pair_count(&mut pass);
         }
         self.gpu.queue.submit([encoder.finish()]);
@@ -207,9 +207,9 @@ impl GpuEngine {
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.run(&mut pass, "reduce_grains", Size::Grains, None);
-            self.run(&mut pass, "reduce_pairs", Size::Indirect(args::PAIRS), None);
-            self.run(&mut pass, "reduce_final", Size::One, None);
+            self.run(&mut pass, StepKernel::ReduceGrains, Size::Grains, None);
+            self.run(&mut pass, StepKernel::ReducePairs, Size::Indirect(args::PAIRS), None);
+            self.run(&mut pass, StepKernel::ReduceFinal, Size::One, None);
         }
         self.gpu.queue.submit([encoder.finish()]);
         let n_walls = self.wall_names.len();
@@ -225,7 +225,8 @@ impl GpuEngine {
         self.control = control;
         let s: &[f32] = bytemuck::cast_slice(&parts[1]);
         let reaction: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
-        let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[3]);
+        // Copied out: a wall's vectors are 16-byte aligned, the words read back 4.
+        let walls: Vec<layout::Wall> = bytemuck::pod_collect_to_vec(&parts[3]);
         use layout::stat::{grain as gr, pair as pr};
         let g = |f: usize| s[f] as f64;
         let p = |f: usize| s[STAT_ROW + f] as f64;
@@ -292,7 +293,7 @@ impl GpuEngine {
                         force: [reaction[w][0] as f64, reaction[w][1] as f64, reaction[w][2] as f64],
                         contacts: reaction[w][3].to_bits() as u64,
                         position: servo_plane.map(|k| walls[w].point[k / 2] as f64),
-                        pressure: servo_plane.map(|k| servo_pressure(walls, reaction, self.servo.expect("a servo plane"), k)),
+                        pressure: servo_plane.map(|k| servo_pressure(&walls, reaction, self.servo.expect("a servo plane"), k)),
                     }
                 })
                 .collect(),

@@ -47,7 +47,7 @@ fn cpu_history(blocks: &[[f32; 4]], slots: &crate::state::HistorySlots) -> Vec<f
 
 /// A wall's surface as the GPU holds it.
 fn wall_geom(w: &layout::Wall) -> crate::walls::WallGeom<f32> {
-    let v3 = |a: [f32; 4]| crate::real::Vec3::new(a[0], a[1], a[2]);
+    let v3 = |a: glam::Vec4| crate::real::Vec3::new(a.x, a.y, a.z);
     match w.kind {
         layout::wall_kind::PLANE => crate::walls::WallGeom::Plane { point: v3(w.point), normal: v3(w.normal) },
         layout::wall_kind::CYLINDER => crate::walls::WallGeom::Cylinder { cx: w.point[0], cy: w.point[1], radius: w.normal[3] },
@@ -68,7 +68,8 @@ impl GpuEngine {
             ("walls", 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64),
             ("wall_hist", 0, if blocks > 0 { 16 * (self.n as usize * n_walls * blocks) as u64 } else { 0 }),
         ])?;
-        let walls: &[layout::Wall] = bytemuck::cast_slice(&parts[1]);
+        // Copied out: a wall's vectors are 16-byte aligned, the words read back 4.
+        let walls: Vec<layout::Wall> = bytemuck::pod_collect_to_vec(&parts[1]);
         let gpu_hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
         let v3 = |a: [f32; 4]| Vec3::new(a[0], a[1], a[2]);
         let body: Vec<Body<f32>> = (0..self.n as usize).map(|i| Body { pos: v3(arrays[0][i]), vel: v3(arrays[1][i]), omega: v3(arrays[2][i]) }).collect();
@@ -79,7 +80,7 @@ impl GpuEngine {
             .iter()
             .map(|w| WallState {
                 geom: wall_geom(w),
-                velocity: v3(w.velocity),
+                velocity: Vec3::new(w.velocity.x, w.velocity.y, w.velocity.z),
                 material: w.material,
             })
             .collect();
@@ -109,7 +110,7 @@ impl GpuEngine {
         let arrays = self.read_vec4s(&names)?;
         let (pos, residual) = (&arrays[0], &arrays[3]);
         let v3 = |p: &[f32; 4]| crate::real::Vec3::new(p[0], p[1], p[2]);
-        let xyz = |v: &[f32; 4]| [v[0] as f64, v[1] as f64, v[2] as f64];
+        let xyz = |v: &[f32; 4]| glam::DVec3::new(v[0] as f64, v[1] as f64, v[2] as f64);
         let contact_records = contacts.then(|| -> Result<Vec<ContactRecord>, SimError> {
             let np = self.control.n_pairs as u64;
             let blocks = self.params.hist_blocks as u64;
@@ -135,9 +136,9 @@ impl GpuEngine {
                         overlap: h,
                         normal_force: (fi[k][3] + f_c[k]) as f64,
                         force: xyz(&fi[k]),
-                        force_j: if both { xyz(&fj[k]) } else { xyz(&fi[k]).map(|f| -f) },
-                        tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { [0.0; 3] },
-                        rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + rolling_block]) } else { [0.0; 3] },
+                        force_j: if both { xyz(&fj[k]) } else { -xyz(&fi[k]) },
+                        tangential_spring: if self.history.tangential { xyz(&hist[k * blocks as usize]) } else { glam::DVec3::ZERO },
+                        rolling_spring: if self.history.rolling { xyz(&hist[k * blocks as usize + rolling_block]) } else { glam::DVec3::ZERO },
                         bridge_volume: if self.history.bridge { hist[k * blocks as usize + blocks as usize - 1][0] as f64 } else { 0.0 },
                     })
                 })
@@ -158,7 +159,7 @@ impl GpuEngine {
             radius: arrays[0].iter().map(|v| v[3] as f64).collect(),
             velocity: arrays[1].iter().map(xyz).collect(),
             angular_velocity: arrays[2].iter().map(xyz).collect(),
-            orientation: self.track_orientation.then(|| arrays[4].iter().map(|q| [q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]).collect()),
+            orientation: self.track_orientation.then(|| arrays[4].iter().map(|q| glam::DQuat::from_xyzw(q[1] as f64, q[2] as f64, q[3] as f64, q[0] as f64)).collect()),
             contacts: contact_records,
             wall_contacts: wall_records,
             walls: self.walls_now()?,
@@ -172,7 +173,7 @@ impl GpuEngine {
             return Ok(Vec::new());
         }
         let parts = self.read(&[("walls", 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64)])?;
-        Ok(bytemuck::cast_slice::<u32, layout::Wall>(&parts[0]).iter().map(|w| wall_geom(w).f64()).collect())
+        Ok(bytemuck::pod_collect_to_vec::<u32, layout::Wall>(&parts[0]).iter().map(|w| wall_geom(w).f64()).collect())
     }
 
     /// Wets the sample with `volume` (m^3) of liquid, as the CPU twin does.

@@ -5,7 +5,7 @@
 //! stores to ([`Access::Write`]) written; the per-pair buffers at the live pair count.
 
 use super::*;
-use crate::kernels::{kernel, Access};
+use crate::kernels::Access;
 
 impl GpuEngine {
     /// Bytes each kernel of a later step moves, by kernel, in dispatch order.
@@ -16,8 +16,9 @@ impl GpuEngine {
             Some(&(_, bytes)) => bytes * pairs,
             None => self.buffers.get(name).map_or(0, wgpu::Buffer::size),
         };
-        let moved = |name: &str| -> u64 {
-            kernel(name)
+        let moved = |kernel: StepKernel| -> u64 {
+            kernel
+                .kernel()
                 .bindings
                 .iter()
                 .map(|&(buffer, access)| match access {
@@ -30,11 +31,11 @@ impl GpuEngine {
         let mut out: Vec<(&'static str, u64)> = Vec::new();
         // A later step inside a run of steps.
         for e in &self.plans.step_in_run(1, true, true) {
-            let names: Vec<&'static str> = if e.dispatch == Dispatch::RebuildIfNeeded { vec!["decide_rebuild"] } else { self.kernels_of(e).into_iter().map(|k| k.0).collect() };
-            for name in names {
-                match out.iter_mut().find(|x| x.0 == name) {
-                    Some(x) => x.1 += moved(name),
-                    None => out.push((name, moved(name))),
+            let kernels: Vec<StepKernel> = if e.dispatch == Dispatch::RebuildIfNeeded { vec![StepKernel::DecideRebuild] } else { self.kernels_of(e).into_iter().map(|k| k.0).collect() };
+            for kernel in kernels {
+                match out.iter_mut().find(|x| x.0 == kernel.name()) {
+                    Some(x) => x.1 += moved(kernel),
+                    None => out.push((kernel.name(), moved(kernel))),
                 }
             }
         }

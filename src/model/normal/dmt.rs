@@ -105,7 +105,7 @@ impl NormalSetup for Dmt<f64> {
         true
     }
 
-    fn gpu_block(&self) -> [f32; 4] {
-        [self.surface_energy as f32, 0.0, 0.0, 0.0]
+    fn gpu_block(&self) -> glam::Vec4 {
+        glam::Vec4::new(self.surface_energy as f32, 0.0, 0.0, 0.0)
     }
 }

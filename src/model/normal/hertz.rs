@@ -71,8 +71,8 @@ impl NormalSetup for Hertz {
         TangentialStiffness::Mindlin
     }
 
-    fn gpu_block(&self) -> [f32; 4] {
-        [0.0; 4]
+    fn gpu_block(&self) -> glam::Vec4 {
+        glam::Vec4::ZERO
     }
 }
 

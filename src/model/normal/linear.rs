@@ -80,7 +80,7 @@ impl NormalSetup for Linear<f64> {
         TangentialStiffness::RatioToNormal(DEFAULT_KT_RATIO)
     }
 
-    fn gpu_block(&self) -> [f32; 4] {
-        [self.k_n as f32, 0.0, 0.0, 0.0]
+    fn gpu_block(&self) -> glam::Vec4 {
+        glam::Vec4::new(self.k_n as f32, 0.0, 0.0, 0.0)
     }
 }

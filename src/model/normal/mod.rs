@@ -64,7 +64,7 @@ pub trait NormalSetup {
     }
     /// The law's constants as the kernels read them, `params.normal` (WGSL): a block of fixed
     /// size, so that a law's parameters never move the uniform's layout.
-    fn gpu_block(&self) -> [f32; 4];
+    fn gpu_block(&self) -> glam::Vec4;
 }
 
 /// A registry row: the law's name in scenes, the `[model]` keys it owns, and how it reads them.
@@ -140,7 +140,7 @@ macro_rules! normal_laws {
             fn adhesive(&self) -> bool {
                 match self { $(NormalLaw::$variant(l) => l.adhesive()),* }
             }
-            fn gpu_block(&self) -> [f32; 4] {
+            fn gpu_block(&self) -> glam::Vec4 {
                 match self { $(NormalLaw::$variant(l) => l.gpu_block()),* }
             }
         }

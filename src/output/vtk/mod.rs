@@ -113,17 +113,17 @@ impl VtkRecorder {
         let mut coordination = vec![0i64; n];
         let add = |acc: &mut [f64; 3], v: [f64; 3]| (0..3).for_each(|a| acc[a] += v[a]);
         for c in f.contacts.as_deref().unwrap_or(&[]) {
-            add(&mut force[c.i as usize], c.force);
-            add(&mut force[c.j as usize], c.force_j);
+            add(&mut force[c.i as usize], c.force.to_array());
+            add(&mut force[c.j as usize], c.force_j.to_array());
             if c.overlap > 0.0 {
                 coordination[c.i as usize] += 1;
                 coordination[c.j as usize] += 1;
             }
         }
         for w in f.wall_contacts.as_deref().unwrap_or(&[]) {
-            add(&mut force[w.grain as usize], w.force);
+            add(&mut force[w.grain as usize], w.force.to_array());
         }
-        let mut piece = PolyData { points: f.position.clone(), ..PolyData::default() };
+        let mut piece = PolyData { points: f.position.iter().map(|p| p.to_array()).collect(), ..PolyData::default() };
         for i in 0..n {
             piece.verts.push([i]);
         }
@@ -132,8 +132,8 @@ impl VtkRecorder {
             Array::integers("id", f.id.iter().map(|&i| i as i64)),
             Array::scalars("radius", f.radius.iter().copied()),
             Array::integers("material", f.id.iter().map(|&i| material(i))),
-            Array::vectors("velocity", f.velocity.iter().copied()),
-            Array::vectors("angular_velocity", f.angular_velocity.iter().copied()),
+            Array::vectors("velocity", f.velocity.iter().map(|v| v.to_array())),
+            Array::vectors("angular_velocity", f.angular_velocity.iter().map(|w| w.to_array())),
             Array::vectors("force", force),
             Array::integers("coordination", coordination),
         ];
@@ -143,7 +143,7 @@ impl VtkRecorder {
             data.push(Array::scalars("particle_pressure", p.pressures));
         }
         if let Some(q) = &f.orientation {
-            data.push(Array::vectors("orientation", q.iter().copied()));
+            data.push(Array::vectors("orientation", q.iter().map(|q| [q.w, q.x, q.y, q.z])));
         }
         piece.point_data = data;
         piece
@@ -158,11 +158,11 @@ impl VtkRecorder {
             let (pi, pj) = (Vec3::of(f.position[c.i as usize]), Vec3::of(f.position[c.j as usize]));
             let branch = periodic.min_image(pj - pi);
             let k = piece.points.len();
-            piece.points.extend([pi.f64(), (pi + branch).f64()]);
+            piece.points.extend([pi.f64().to_array(), (pi + branch).f64().to_array()]);
             piece.lines.push([k, k + 1]);
             let n = branch * (1.0 / branch.norm());
             let fi = Vec3::of(c.force);
-            tangential.push((fi - n * fi.dot(n)).f64());
+            tangential.push((fi - n * fi.dot(n)).f64().to_array());
         }
         piece.cell_data = vec![
             Array::integers("id_i", contacts.iter().map(|c| c.i as i64)),

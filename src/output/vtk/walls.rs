@@ -20,7 +20,7 @@ pub fn domain(scene: &Scene, f: &Frame) -> ([f64; 3], [f64; 3]) {
         hi[a] = hi[a].max(x);
     };
     for (p, r) in f.position.iter().zip(&f.radius) {
-        for (a, x) in p.iter().enumerate() {
+        for (a, x) in p.to_array().iter().enumerate() {
             include(a, x - r);
             include(a, x + r);
         }
@@ -34,7 +34,7 @@ pub fn domain(scene: &Scene, f: &Frame) -> ([f64; 3], [f64; 3]) {
     for w in &f.walls {
         match *w {
             WallGeom::Plane { point, normal } => {
-                if let Some(a) = axis_of(normal.f64()) {
+                if let Some(a) = axis_of(normal.f64().to_array()) {
                     include(a, point.f64()[a]);
                 }
             }
@@ -73,7 +73,7 @@ pub fn piece(scene: &Scene, f: &Frame) -> PolyData {
     };
     for (w, geom) in f.walls.iter().enumerate() {
         match *geom {
-            WallGeom::Plane { point, normal } => polygon(&mut piece, plane_quad(point.f64(), normal.f64(), lo, hi), w),
+            WallGeom::Plane { point, normal } => polygon(&mut piece, plane_quad(point.f64().to_array(), normal.f64().to_array(), lo, hi), w),
             WallGeom::Piston { z } => match cylinder {
                 Some((cx, cy, radius)) => polygon(&mut piece, circle(cx, cy, radius).map(|(x, y)| [x, y, z]).collect(), w),
                 None => polygon(&mut piece, vec![[lo[0], lo[1], z], [hi[0], lo[1], z], [hi[0], hi[1], z], [lo[0], hi[1], z]], w),
@@ -90,7 +90,7 @@ pub fn piece(scene: &Scene, f: &Frame) -> PolyData {
     // The force on each wall: the opposite of its contacts' forces on the grains.
     let mut on_wall = vec![[0.0f64; 3]; f.walls.len()];
     for c in f.wall_contacts.as_deref().unwrap_or(&[]) {
-        for (total, part) in on_wall[c.wall as usize].iter_mut().zip(c.force) {
+        for (total, part) in on_wall[c.wall as usize].iter_mut().zip(c.force.to_array()) {
             *total -= part;
         }
     }
@@ -130,5 +130,5 @@ fn plane_quad(point: [f64; 3], normal: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> 
     let u = n.cross(Vec3::of(e));
     let u = u * (half / u.norm());
     let v = n.cross(u);
-    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].iter().map(|&(s, t)| (on_plane + u * s + v * t).f64()).collect()
+    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].iter().map(|&(s, t)| (on_plane + u * s + v * t).f64().to_array()).collect()
 }
