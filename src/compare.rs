@@ -96,8 +96,13 @@ impl Comparison {
     }
 }
 
+/// The largest difference of one component between two lists of vectors, pair by pair
+/// (m for positions, m/s for velocities).
+pub fn largest_component_difference(a: &[glam::DVec3], b: &[glam::DVec3]) -> f64 {
+    a.iter().zip(b).map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max)
+}
+
 fn difference(a: &Frame, b: &Frame, sa: &Stats, sb: &Stats, d_mean: f64) -> Difference {
-    let max_abs = |x: &[glam::DVec3], y: &[glam::DVec3]| x.iter().zip(y).map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
     let v_max = b.velocity.iter().map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max).max(1e-30);
     let index = |c: &[ContactRecord]| c.iter().map(|r| ((r.i, r.j), r.normal_force)).collect::<HashMap<_, _>>();
     let (ca, cb) = (index(a.contacts.as_deref().unwrap_or(&[])), index(b.contacts.as_deref().unwrap_or(&[])));
@@ -112,8 +117,8 @@ fn difference(a: &Frame, b: &Frame, sa: &Stats, sb: &Stats, d_mean: f64) -> Diff
     }
     unmatched += ca.keys().filter(|k| !cb.contains_key(k)).count();
     Difference {
-        position: max_abs(&a.position, &b.position) / d_mean,
-        velocity: max_abs(&a.velocity, &b.velocity) / v_max,
+        position: largest_component_difference(&a.position, &b.position) / d_mean,
+        velocity: largest_component_difference(&a.velocity, &b.velocity) / v_max,
         contact_force: if f_mean > 0.0 { worst / f_mean } else { 0.0 },
         contacts_unmatched: unmatched,
         kinetic_energy: (sa.kinetic_energy() - sb.kinetic_energy()).abs() / sb.kinetic_energy().max(1e-300),

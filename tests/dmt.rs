@@ -4,6 +4,7 @@
 
 mod common;
 
+use grains::compare::largest_component_difference;
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
 use std::path::Path;
@@ -203,7 +204,7 @@ fn dmt_runs_on_the_gpu_as_on_the_cpu() {
     g.advance(300).unwrap();
     c.advance(300).unwrap();
     let (fg, fc) = (g.frame(true).unwrap(), c.frame(true).unwrap());
-    let worst = fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+    let worst = largest_component_difference(&fg.position, &fc.position);
     let (sg, sc) = (g.stats().unwrap(), c.stats().unwrap());
     println!(
         "positions differ by {:.2e} of a diameter; contacts {} / {}, pulled {} / {}, sliding {} / {}; elastic energy {:.6e} / {:.6e} J",

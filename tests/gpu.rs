@@ -5,6 +5,7 @@
 
 mod common;
 
+use grains::compare::largest_component_difference;
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
 use grains::schedule::{Op, Schedule};
@@ -194,7 +195,7 @@ fn integrate_and_the_reductions_match_the_cpu_twins() {
     c.advance(20).unwrap();
     let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
     let d_mean = 1.0e-3;
-    let worst = fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+    let worst = largest_component_difference(&fg.position, &fc.position);
     let worst_q = fg.orientation.as_ref().unwrap().iter().zip(fc.orientation.as_ref().unwrap()).map(|(a, b)| (*a - *b).to_array().iter().map(|d| d.abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
     println!("after 20 steps: positions differ by {:.3e} of a diameter, quaternions by {worst_q:.3e}", worst / d_mean);
     assert!(worst / d_mean < F32_POSITION_TOLERANCE);
@@ -244,7 +245,7 @@ fn every_shipped_scene_agrees_with_the_cpu_for_300_steps() {
         c.advance(300).unwrap();
         let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
         let d_mean = 2.0 * scene.grains.radius.iter().sum::<f64>() / scene.grains.len() as f64;
-        let worst = fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+        let worst = largest_component_difference(&fg.position, &fc.position);
         let (sg, sc) = (g.stats().unwrap(), c.stats().unwrap());
         println!("{name}: positions differ by {:.2e} of a diameter; KE gpu {:.6e} cpu {:.6e}", worst / d_mean, sg.kinetic_energy(), sc.kinetic_energy());
         assert!(worst / d_mean < F32_POSITION_TOLERANCE, "{name}");
@@ -265,7 +266,7 @@ fn the_no_pull_clamp_and_its_absence_run_on_the_gpu_as_on_the_cpu() {
         g.advance(300).unwrap();
         c.advance(300).unwrap();
         let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
-        let worst = fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max);
+        let worst = largest_component_difference(&fg.position, &fc.position);
         let (sg, sc) = (g.stats().unwrap(), c.stats().unwrap());
         println!("clamp {clamp}: positions differ by {:.2e} of a diameter; contacts {} / {}, clamped {} / {}, sliding {} / {}", worst / 1.0e-3, sg.contacts, sc.contacts, sg.clamped, sc.clamped, sg.sliding, sc.sliding);
         assert!(worst / 1.0e-3 < F32_POSITION_TOLERANCE, "clamp {clamp}");
@@ -416,7 +417,7 @@ fn bridges_follow_the_cpu(scene: &grains::scene::Scene) {
         last = sg.bridges;
         worst_liquid = worst_liquid.max(((sg.liquid_in_bridges + sg.liquid_on_grains) / total - 1.0).abs());
         let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
-        worst_x = worst_x.max(fg.position.iter().zip(&fc.position).map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max)).fold(0.0, f64::max));
+        worst_x = worst_x.max(largest_component_difference(&fg.position, &fc.position));
     }
     println!("{last} bridges at the end, {changes} net changes seen; liquid conserved to {worst_liquid:.2e}; positions differ by {:.2e} of a diameter", worst_x / d_mean);
     assert!(changes > 5, "bridges must break and form");
