@@ -12,7 +12,7 @@ mod linear;
 
 pub use dmt::Dmt;
 pub use hertz::{hertz_collision_time, Hertz};
-pub use linear::{Linear, DEFAULT_KT_RATIO};
+pub use linear::Linear;
 
 use super::keys::{KeyProblem, LawKeys};
 use super::{restitution, Geometry, PairCoeffs, TangentialStiffness};
@@ -198,11 +198,6 @@ pub fn names() -> String {
         Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
         _ => quoted.concat(),
     }
-}
-
-/// Every `[model]` key a normal law owns.
-pub fn keys() -> impl Iterator<Item = &'static str> {
-    REGISTRY.iter().flat_map(|e| e.keys.iter().copied())
 }
 
 /// The WGSL constants naming each law's code, `const NORMAL_<NAME>: u32 = <row>u;`, written
