@@ -45,6 +45,11 @@ pub fn shared(name: &str) -> &'static str {
         "grid" => include_str!("../shaders/shared/grid.wgsl"),
         "model" => include_str!("../shaders/shared/model.wgsl"),
         "model/normal" => include_str!("../shaders/shared/model/normal.wgsl"),
+        "model/damping" => include_str!("../shaders/shared/model/damping.wgsl"),
+        "model/tangential" => include_str!("../shaders/shared/model/tangential.wgsl"),
+        "model/rolling" => include_str!("../shaders/shared/model/rolling.wgsl"),
+        "model/twisting" => include_str!("../shaders/shared/model/twisting.wgsl"),
+        "model/cohesion" => include_str!("../shaders/shared/model/cohesion.wgsl"),
         "neighbours" => include_str!("../shaders/shared/neighbours.wgsl"),
         "walls" => include_str!("../shaders/shared/walls.wgsl"),
         "reduce" => include_str!("../shaders/shared/reduce.wgsl"),
@@ -57,17 +62,24 @@ pub fn shared(name: &str) -> &'static str {
     }
 }
 
+/// The contact model's files, one per slot, mirroring `src/model/<slot>/`.
+pub const MODEL_SLOTS: &[&str] = &["model/normal", "model/damping", "model/tangential", "model/rolling", "model/twisting", "model/cohesion"];
+
 impl Kernel {
-    /// The full WGSL of the kernel: its includes, then its own file. The contact model's
-    /// files (`model`) come after the normal slot's law codes, written from its registry, and
-    /// its file (`shaders/shared/model/normal.wgsl`).
+    /// The full WGSL of the kernel: its includes, then its own file. The contact model
+    /// (`model`) is every slot's law codes, written from the registries
+    /// ([`crate::model::wgsl_codes`]), each slot's file ([`MODEL_SLOTS`],
+    /// `shaders/shared/model/<slot>.wgsl`), then `shaders/shared/model.wgsl`, which composes
+    /// them.
     pub fn wgsl(&self) -> String {
         let mut s = String::new();
         for inc in self.includes {
             if *inc == "model" {
-                s.push_str(&crate::model::normal::wgsl_codes());
-                s.push_str(shared("model/normal"));
-                s.push('\n');
+                s.push_str(&crate::model::wgsl_codes());
+                for slot in MODEL_SLOTS {
+                    s.push_str(shared(slot));
+                    s.push('\n');
+                }
             }
             s.push_str(shared(inc));
             s.push('\n');

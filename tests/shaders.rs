@@ -214,16 +214,24 @@ fn contact_dynamics_mirrors_match_the_wgsl_structures() {
     }
 }
 
-/// The laws' codes in the shaders are the Rust side's, name for name.
+/// The laws' codes reach the kernels from the registries, name for name, and every law a
+/// registry lists has WGSL that names it: a law added in Rust alone would run on the GPU as
+/// another.
 #[test]
-fn law_codes_match_the_rust_side() {
+fn every_registered_law_has_its_code_and_a_branch_in_the_shaders() {
     let src = grains::kernels::StepKernel::PairForce.kernel().wgsl();
     let m = module(&src, "pair_force");
-    for (name, code) in grains::model::code::ALL {
-        let (_, c) = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some(*name)).unwrap_or_else(|| panic!("no WGSL const {name}"));
+    let prelude = grains::model::wgsl_codes();
+    // The model's WGSL without the prelude and without comments: where a law must be named.
+    let own: String = src.replace(&prelude, "").lines().map(|l| l.split("//").next().unwrap_or("")).collect::<Vec<_>>().join("\n");
+    let codes = grains::model::law_codes();
+    assert!(codes.len() >= 17, "{} codes", codes.len());
+    for (name, code) in &codes {
+        let (_, c) = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name.as_str())).unwrap_or_else(|| panic!("no WGSL const {name}"));
         match m.global_expressions[c.init] {
             naga::Expression::Literal(naga::Literal::U32(v)) => assert_eq!(v, *code, "{name}"),
             ref e => panic!("{name}: {e:?}"),
         }
+        assert!(own.contains(name.as_str()), "{name} has a registry row but no WGSL names it");
     }
 }

@@ -51,7 +51,7 @@ pub struct Params {
     /// Distance beyond contact that pair detection reaches (m): the skin, plus the rupture
     /// distance of the largest liquid bridge in capillary scenes.
     pub reach: f32,
-    /// Tangential stiffness: [`crate::model::code::STIFFNESS_MINDLIN`] or `STIFFNESS_RATIO`
+    /// Tangential stiffness: [`crate::model::tangential::STIFFNESS_CODES`]: `STIFFNESS_MINDLIN` or `STIFFNESS_RATIO`
     /// (`tangential[0]` times the normal secant stiffness).
     pub kt_law: u32,
     /// Oquendo et al.'s rolling friction: 0 a torque pair, 1 eqs. 8-9 on each grain as written.

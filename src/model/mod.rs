@@ -10,30 +10,28 @@
 //! A scene picks one law per slot ([`ContactModel`]); a slot set to `None` is skipped before
 //! any arithmetic, and its history is not allocated (see [`HistoryLayout`]).
 
-mod capillary;
 mod coeffs;
+pub mod cohesion;
 mod contact;
-mod damping;
+pub mod damping;
 mod geometry;
 pub mod keys;
-mod laws;
 pub mod normal;
-pub mod restitution;
-mod rolling;
-mod tangential;
-mod twisting;
+pub mod registry;
+pub mod rolling;
+pub mod tangential;
+pub mod twisting;
 pub mod window;
 
 pub use coeffs::{History, HistoryLayout, MaterialConstants, PairCoeffs};
+pub use cohesion::{capillary_force, capillary_potential, decay_length, rupture_distance, share_liquid, within_rupture, CohesionLaw};
 pub use contact::{contact_force, ContactForce, Regime};
-pub use laws::{code, CohesionLaw, DampingLaw, OquendoLaw, RollingFriction, RollingLaw, TangentialLaw, TangentialStiffness, TwistingLaw};
-pub use capillary::{capillary_force, capillary_potential, decay_length, rupture_distance, share_liquid, within_rupture};
+pub use damping::{normal_damping, normal_force, restitution, DampingLaw};
 pub use geometry::{Bodies, Geometry, Kinematics};
-pub use damping::{normal_damping, normal_force};
 pub use normal::{hertz_collision_time, Hertz, Linear, NormalLaw, NormalModel, NormalSetup};
-pub use rolling::rolling_sds;
-pub use tangential::{contact_tangential_velocity, mindlin_tangential, oquendo_tangential, rotate_into_plane, since_touch, TangentialOut};
-pub use twisting::twisting_torque;
+pub use rolling::{rolling_sds, RollingLaw};
+pub use tangential::{contact_tangential_velocity, mindlin_tangential, oquendo_tangential, rotate_into_plane, since_touch, OquendoLaw, RollingFriction, TangentialLaw, TangentialOut, TangentialStiffness};
+pub use twisting::{twisting_torque, TwistingLaw};
 pub use window::{at_edge, driven_normal_velocity, parted_normal_force, windowed_normal_force, KickWindow};
 
 use crate::real::{Real, Vec3};
@@ -84,70 +82,49 @@ impl<T: Real> ContactModel<T> {
 impl ContactModel<f64> {
     /// The same model in another precision.
     pub fn cast<U: Real>(&self) -> ContactModel<U> {
-        let u = U::of;
-        let stiffness = |s: TangentialStiffness<f64>| match s {
-            TangentialStiffness::Mindlin => TangentialStiffness::Mindlin,
-            TangentialStiffness::RatioToNormal(r) => TangentialStiffness::RatioToNormal(u(r)),
-        };
         ContactModel {
             normal: self.normal.cast(),
-            damping: match self.damping {
-                DampingLaw::None => DampingLaw::None,
-                DampingLaw::Papers => DampingLaw::Papers,
-                DampingLaw::Restitution => DampingLaw::Restitution,
-                DampingLaw::Viscous { c_n } => DampingLaw::Viscous { c_n: u(c_n) },
-            },
-            tangential: match self.tangential {
-                TangentialLaw::None => TangentialLaw::None,
-                TangentialLaw::Oquendo(l) => TangentialLaw::Oquendo(OquendoLaw { static_damping: u(l.static_damping), stiffness: stiffness(l.stiffness), rolling_friction: l.rolling_friction }),
-                TangentialLaw::Mindlin { damping_ratio, stiffness: s } => TangentialLaw::Mindlin { damping_ratio: u(damping_ratio), stiffness: stiffness(s) },
-            },
-            rolling: match self.rolling {
-                RollingLaw::None => RollingLaw::None,
-                RollingLaw::Sds { k_r, gamma_r, mu_r } => RollingLaw::Sds { k_r: u(k_r), gamma_r: u(gamma_r), mu_r: u(mu_r) },
-            },
+            damping: self.damping.cast(),
+            tangential: self.tangential.cast(),
+            rolling: self.rolling.cast(),
             twisting: self.twisting,
-            cohesion: match self.cohesion {
-                CohesionLaw::None => CohesionLaw::None,
-                CohesionLaw::Capillary { kappa, theta, c } => CohesionLaw::Capillary { kappa: u(kappa), theta: u(theta), c: u(c) },
-            },
+            cohesion: self.cohesion.cast(),
             limit_damping: self.limit_damping,
         }
     }
 
     /// One line naming the law in each slot, for reports.
     pub fn describe(&self) -> String {
-        let normal = self.normal.describe();
-        let damping = match self.damping {
-            DampingLaw::None => "none".to_string(),
-            DampingLaw::Papers => "papers(gamma_n)".to_string(),
-            DampingLaw::Restitution => "restitution(e)".to_string(),
-            DampingLaw::Viscous { c_n } => format!("viscous(c_n={c_n:e} N s/m)"),
-        };
-        let stiff = |s: TangentialStiffness<f64>| match s {
-            TangentialStiffness::Mindlin => "k_t=mindlin".to_string(),
-            TangentialStiffness::RatioToNormal(r) => format!("k_t={r}*k_n"),
-        };
-        let tangential = match self.tangential {
-            TangentialLaw::None => "none".to_string(),
-            TangentialLaw::Oquendo(l) => format!("oquendo(static_damping={}, rolling_friction={}, {})", l.static_damping, l.rolling_friction.name(), stiff(l.stiffness)),
-            TangentialLaw::Mindlin { damping_ratio, stiffness } => format!("mindlin(damping_ratio={damping_ratio}, {})", stiff(stiffness)),
-        };
-        let rolling = match self.rolling {
-            RollingLaw::None => "none".to_string(),
-            RollingLaw::Sds { k_r, gamma_r, mu_r } => format!("sds(k_r={k_r:e}, gamma_r={gamma_r:e}, mu_r={mu_r})"),
-        };
-        let twisting = match self.twisting {
-            TwistingLaw::None => "none",
-            TwistingLaw::Oquendo => "oquendo(gamma_nt)",
-        };
-        let cohesion = match self.cohesion {
-            CohesionLaw::None => "none".to_string(),
-            CohesionLaw::Capillary { kappa, theta, c } => format!("capillary(kappa={kappa:e} N/m, theta={:.1} deg, c={c})", theta.to_degrees()),
-        };
         let clamp = if self.limit_damping { "on" } else { "off" };
-        format!("normal={normal} damping={damping} no-pull clamp={clamp} tangential={tangential} rolling={rolling} twisting={twisting} cohesion={cohesion}")
+        format!(
+            "normal={} damping={} no-pull clamp={clamp} tangential={} rolling={} twisting={} cohesion={}",
+            self.normal.describe(),
+            self.damping.describe(),
+            self.tangential.describe(),
+            self.rolling.describe(),
+            self.twisting.describe(),
+            self.cohesion.describe()
+        )
     }
+}
+
+/// Every WGSL constant naming a law or a tangential stiffness, with its code: each slot's
+/// registry rows ([`registry::Slot::codes`]) and [`tangential::STIFFNESS_CODES`].
+pub fn law_codes() -> Vec<(String, u32)> {
+    let mut codes: Vec<(String, u32)> = normal::SLOT.codes().collect();
+    codes.extend(damping::SLOT.codes());
+    codes.extend(tangential::SLOT.codes());
+    codes.extend(rolling::SLOT.codes());
+    codes.extend(twisting::SLOT.codes());
+    codes.extend(cohesion::SLOT.codes());
+    codes.extend(tangential::STIFFNESS_CODES.iter().map(|&(name, code)| (name.to_string(), code)));
+    codes
+}
+
+/// [`law_codes`] as WGSL, `const <NAME>: u32 = <code>u;`, written into the kernels' prelude
+/// before the contact model's files.
+pub fn wgsl_codes() -> String {
+    law_codes().iter().map(|(name, code)| format!("const {name}: u32 = {code}u;\n")).collect()
 }
 
 #[cfg(test)]

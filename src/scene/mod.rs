@@ -21,11 +21,8 @@ use periodic_specs::{check_periodic, validate_periodic};
 use stage_specs::validate_stages;
 use wall_specs::{check_overlaps, finish_walls, servo_box, validate_walls};
 
-use crate::model::restitution::MIN_RESTITUTION;
-use crate::model::{
-    CohesionLaw, ContactModel, DampingLaw, MaterialConstants, NormalSetup, OquendoLaw, RollingFriction, RollingLaw, TangentialLaw,
-    TangentialStiffness, TwistingLaw,
-};
+use crate::model::cohesion::DEFAULT_LIQUID_DENSITY;
+use crate::model::{CohesionLaw, ContactModel, DampingLaw, MaterialConstants};
 use crate::timestep;
 use error::Complainer;
 use schema::{ContactDynamicsSpec, DtSpec, ModelSpec, SceneFile, SimulationSpec, StageSpec, WallSpec};

@@ -2,66 +2,11 @@
 //! the liquid bridges' limits, and contact dynamics' settings.
 
 use super::*;
+use crate::model::keys::{LawInput, MaterialUse};
+use crate::model::registry::Slot;
+use crate::model::{cohesion, damping, normal, rolling, tangential, twisting};
 
 pub(super) fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains: &Grains, walls: &[Wall]) -> Result<ContactModel<f64>, SceneError> {
-    let law = |v: &Option<String>, default: &str| v.clone().unwrap_or_else(|| default.to_string());
-    let unused = |key: &str, set: bool, law: &str| -> Result<(), SceneError> {
-        if set {
-            Err(c.invalid(format!("model.{key}"), "(set)", format!("is not used by the chosen laws ({law})"), format!("remove `{key}` or choose the law that uses it")))
-        } else {
-            Ok(())
-        }
-    };
-    let need = |key: &str, v: Option<f64>, why: &str| -> Result<f64, SceneError> {
-        match v {
-            Some(x) => positive(c, &format!("model.{key}"), x, why),
-            None => Err(c.invalid(format!("model.{key}"), "(missing)", "is required by the chosen law", why.to_string())),
-        }
-    };
-    let normal_name = law(&m.normal, "hertz");
-    let normal = crate::model::normal::parse(&normal_name, m).map_err(|problem| match problem {
-        Some(p) => c.invalid(format!("model.{}", p.key), p.value, p.problem, p.fix),
-        None => c.invalid("model.normal", format!("\"{normal_name}\""), "unknown normal law", format!("use {}", crate::model::normal::names())),
-    })?;
-    let damping_name = law(&m.damping, "none");
-    let damping = match damping_name.as_str() {
-        "none" => DampingLaw::None,
-        "papers" => DampingLaw::Papers,
-        "restitution" => {
-            // Every material in contact needs its restitution coefficient.
-            let used: Vec<u16> = grains.material.iter().copied().chain(walls.iter().map(|w| w.material)).collect();
-            if let Some((i, _)) = materials.iter().enumerate().find(|(i, mat)| used.contains(&(*i as u16)) && mat.restitution.is_none()) {
-                return Err(c.invalid(format!("material[{i}].restitution"), "(missing)", "damping = \"restitution\" needs it", "add `restitution` in (0, 1] to the material"));
-            }
-            // Every material, used or not: the dashpot is sized for each pair of them.
-            if let Some((i, e)) = materials.iter().enumerate().find_map(|(i, mat)| mat.restitution.filter(|&e| e < MIN_RESTITUTION).map(|e| (i, e))) {
-                return Err(c.invalid(
-                    format!("material[{i}].restitution"),
-                    e,
-                    format!("is below {MIN_RESTITUTION}, where the dashpot would set the contact's time scale and the time step, picked from the elastic contact time, would not resolve it"),
-                    format!("give a restitution of at least {MIN_RESTITUTION}"),
-                ));
-            }
-            DampingLaw::Restitution
-        }
-        "viscous" => DampingLaw::Viscous { c_n: need("c_n", m.c_n, "give the dashpot coefficient c_n in N s/m")? },
-        other => return Err(c.invalid("model.damping", format!("\"{other}\""), "unknown damping law", "use \"none\", \"papers\", \"restitution\" or \"viscous\"")),
-    };
-    if !matches!(damping, DampingLaw::Viscous { .. }) {
-        unused("c_n", m.c_n.is_some(), &format!("damping = \"{damping_name}\""))?;
-    }
-    if matches!(damping, DampingLaw::None) {
-        unused("limit_damping", m.limit_damping.is_some(), "damping = \"none\" (an elastic force never pulls)")?;
-    }
-    if matches!(damping, DampingLaw::Papers) && materials.iter().all(|x| x.constants.gamma_n == 0.0) {
-        return Err(c.invalid("model.damping", "\"papers\"", "no material sets gamma_n, so it would not damp", "set `gamma_n` (s^-1 m^-1/2) in the [[material]] tables or use damping = \"none\""));
-    }
-    let stiffness = |kt: Option<f64>| -> Result<TangentialStiffness<f64>, SceneError> {
-        match kt {
-            Some(r) => Ok(TangentialStiffness::RatioToNormal(positive(c, "model.kt_ratio", r, "give a ratio such as 2/7")?)),
-            None => Ok(normal.default_tangential_stiffness()),
-        }
-    };
     for (key, v, why) in [
         ("v_slip", m.v_slip, "Oquendo et al.'s contacts slide when their static spring fails its Coulomb test (mu_s), not above a speed"),
         ("v_roll", m.v_roll, "Oquendo et al.'s contacts roll when their rolling spring reaches the rolling friction, not above a speed"),
@@ -70,82 +15,35 @@ pub(super) fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Materia
             return Err(c.invalid(format!("model.{key}"), v, format!("is no longer used: {why}"), format!("remove `{key}` (docs/physics.md, \"Oquendo et al.'s contact law\")")));
         }
     }
-    let tangential_name = law(&m.tangential, "none");
-    let tangential = match tangential_name.as_str() {
-        "none" => {
-            for (k, set) in [("static_damping", m.static_damping.is_some()), ("rolling_friction", m.rolling_friction.is_some()), ("kt_ratio", m.kt_ratio.is_some()), ("tangential_damping_ratio", m.tangential_damping_ratio.is_some())] {
-                unused(k, set, "tangential = \"none\"")?;
-            }
-            TangentialLaw::None
-        }
-        "oquendo" => {
-            unused("tangential_damping_ratio", m.tangential_damping_ratio.is_some(), "tangential = \"oquendo\" (its static spring is damped by static_damping)")?;
-            TangentialLaw::Oquendo(OquendoLaw {
-                static_damping: non_negative(c, "model.static_damping", m.static_damping.unwrap_or(DEFAULT_STATIC_DAMPING), "give a fraction of critical damping such as 0.3")?,
-                stiffness: stiffness(m.kt_ratio)?,
-                rolling_friction: match m.rolling_friction.as_deref().unwrap_or("torque") {
-                    "torque" => RollingFriction::Torque,
-                    "as_written" => RollingFriction::AsWritten,
-                    other => return Err(c.invalid("model.rolling_friction", format!("\"{other}\""), "unknown rolling friction", "use \"torque\" (momentum-conserving) or \"as_written\" (eqs. 8-9 on each grain)")),
-                },
-            })
-        }
-        "mindlin" => {
-            unused("static_damping", m.static_damping.is_some(), "tangential = \"mindlin\"")?;
-            unused("rolling_friction", m.rolling_friction.is_some(), "tangential = \"mindlin\"")?;
-            for (i, mat) in materials.iter().enumerate() {
-                if mat.constants.mu_k != mat.constants.mu_s {
-                    return Err(c.invalid(format!("material[{i}].mu_k"), mat.constants.mu_k, "the Hertz-Mindlin law has one friction coefficient (mu_s)", "remove mu_k or set it equal to mu_s"));
-                }
-            }
-            TangentialLaw::Mindlin {
-                damping_ratio: non_negative(c, "model.tangential_damping_ratio", m.tangential_damping_ratio.unwrap_or(0.0), "give a fraction such as 0.9075")?,
-                stiffness: stiffness(m.kt_ratio)?,
-            }
-        }
-        other => return Err(c.invalid("model.tangential", format!("\"{other}\""), "unknown tangential law", "use \"none\", \"oquendo\" or \"mindlin\"")),
-    };
-    let rolling_name = law(&m.rolling, "none");
-    let rolling = match rolling_name.as_str() {
-        "none" => {
-            for (k, set) in [("rolling_k", m.rolling_k.is_some()), ("rolling_gamma", m.rolling_gamma.is_some()), ("rolling_mu", m.rolling_mu.is_some())] {
-                unused(k, set, "rolling = \"none\"")?;
-            }
-            RollingLaw::None
-        }
-        "sds" => RollingLaw::Sds {
-            k_r: need("rolling_k", m.rolling_k, "give the rolling stiffness in N/m")?,
-            gamma_r: non_negative(c, "model.rolling_gamma", m.rolling_gamma.unwrap_or(0.0), "give the rolling damping in N s/m")?,
-            mu_r: need("rolling_mu", m.rolling_mu, "give the rolling friction coefficient, e.g. 0.05")?,
-        },
-        other => return Err(c.invalid("model.rolling", format!("\"{other}\""), "unknown rolling law", "use \"none\" or \"sds\"")),
-    };
-    let twisting_name = law(&m.twisting, "none");
-    let twisting = match twisting_name.as_str() {
-        "none" => TwistingLaw::None,
-        "oquendo" => TwistingLaw::Oquendo,
-        other => return Err(c.invalid("model.twisting", format!("\"{other}\""), "unknown twisting law", "use \"none\" or \"oquendo\"")),
-    };
-    let cohesion_name = law(&m.cohesion, "none");
-    let cohesion = match cohesion_name.as_str() {
-        "none" => {
-            for (k, set) in [("surface_tension", m.surface_tension.is_some()), ("contact_angle", m.contact_angle.is_some()), ("liquid_density", m.liquid_density.is_some())] {
-                unused(k, set, "cohesion = \"none\"")?;
-            }
-            CohesionLaw::None
-        }
-        "capillary" => {
-            let gamma_s = positive(c, "model.surface_tension", m.surface_tension.unwrap_or(DEFAULT_SURFACE_TENSION), "give the surface tension in N/m, e.g. 0.0728 for water")?;
-            let theta = m.contact_angle.unwrap_or(0.0);
-            if !(0.0..90.0).contains(&theta) {
-                return Err(c.invalid("model.contact_angle", theta, "must lie in [0, 90) degrees for an attractive bridge", "give the contact angle in degrees, e.g. 0"));
-            }
-            let theta = theta.to_radians();
-            CohesionLaw::Capillary { kappa: 2.0 * std::f64::consts::PI * gamma_s * theta.cos(), theta, c: CAPILLARY_C }
-        }
-        other => return Err(c.invalid("model.cohesion", format!("\"{other}\""), "unknown cohesion law", "use \"none\" or \"capillary\"")),
-    };
-    Ok(ContactModel { normal, damping, tangential, rolling, twisting, cohesion, limit_damping: m.limit_damping.unwrap_or(true) })
+    let used: Vec<u16> = grains.material.iter().copied().chain(walls.iter().map(|w| w.material)).collect();
+    let uses: Vec<MaterialUse> =
+        materials.iter().enumerate().map(|(i, mat)| MaterialUse { constants: mat.constants, restitution: mat.restitution, in_contact: used.contains(&(i as u16)) }).collect();
+    let mut input = LawInput { keys: m, materials: &uses, normal: None };
+    let normal = choose(c, &normal::SLOT, &m.normal, "hertz", &input)?;
+    input.normal = Some(&normal);
+    let damping = choose(c, &damping::SLOT, &m.damping, "none", &input)?;
+    if matches!(damping, DampingLaw::None) && m.limit_damping.is_some() {
+        return Err(c.invalid("model.limit_damping", "(set)", "is not used by the chosen laws (damping = \"none\": an elastic force never pulls)", "remove `limit_damping` or choose a damping law"));
+    }
+    Ok(ContactModel {
+        normal,
+        damping,
+        tangential: choose(c, &tangential::SLOT, &m.tangential, "none", &input)?,
+        rolling: choose(c, &rolling::SLOT, &m.rolling, "none", &input)?,
+        twisting: choose(c, &twisting::SLOT, &m.twisting, "none", &input)?,
+        cohesion: choose(c, &cohesion::SLOT, &m.cohesion, "none", &input)?,
+        limit_damping: m.limit_damping.unwrap_or(true),
+    })
+}
+
+/// The law a slot's key names (`default` when the scene leaves it out), read from its registry;
+/// a law's refusal of a key becomes the scene's error.
+fn choose<L>(c: &Complainer, slot: &Slot<L>, name: &Option<String>, default: &str, input: &LawInput) -> Result<L, SceneError> {
+    let name = name.as_deref().unwrap_or(default);
+    slot.parse(name, input).map_err(|problem| match problem {
+        Some(p) => c.invalid(p.key, p.value, p.problem, p.fix),
+        None => c.invalid(format!("model.{}", slot.name), format!("\"{name}\""), format!("unknown {} law", slot.name), format!("use {}", slot.names())),
+    })
 }
 
 /// Sizes the largest bridge from the most liquid a stage adds: the mean bridge holds the
@@ -202,5 +100,36 @@ pub(super) fn validate_method(c: &Complainer, sim: &SimulationSpec, spec: Option
             Ok(Method::ContactDynamics(CdParams { theta, tolerance, max_iterations, gap_allowance, wall_mass }))
         }
         other => Err(c.invalid("simulation.method", format!("\"{other}\""), "unknown method", "use \"dem\" or \"contact_dynamics\"")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::keys::LawKeys;
+
+    /// Every `[model]` key a registry row names, with its slot.
+    fn registry_keys() -> Vec<(&'static str, &'static str)> {
+        let mut keys = Vec::new();
+        let mut add = |slot: &'static str, rows: Vec<&'static [&'static str]>| keys.extend(rows.into_iter().flatten().map(|k| (slot, *k)));
+        add(normal::SLOT.name, normal::SLOT.laws.iter().map(|e| e.keys).collect());
+        add(damping::SLOT.name, damping::SLOT.laws.iter().map(|e| e.keys).collect());
+        add(tangential::SLOT.name, tangential::SLOT.laws.iter().map(|e| e.keys).collect());
+        add(rolling::SLOT.name, rolling::SLOT.laws.iter().map(|e| e.keys).collect());
+        add(twisting::SLOT.name, twisting::SLOT.laws.iter().map(|e| e.keys).collect());
+        add(cohesion::SLOT.name, cohesion::SLOT.laws.iter().map(|e| e.keys).collect());
+        keys
+    }
+
+    /// A key a law owns but `ModelSpec` does not hand it would read as never set: the law
+    /// would take its default and the key would be silently ignored.
+    #[test]
+    fn every_key_a_law_owns_reaches_it_from_the_scene() {
+        let keys = registry_keys();
+        assert!(keys.len() >= 12, "{keys:?}");
+        for (slot, key) in keys {
+            let spec: ModelSpec = toml::from_str(&format!("{key} = 0.25")).or_else(|_| toml::from_str(&format!("{key} = \"as_written\""))).unwrap_or_else(|e| panic!("{slot} key {key}: {e}"));
+            assert!(spec.is_set(key), "the {slot} slot's key `{key}` is accepted under [model] but not handed to its law");
+        }
     }
 }

@@ -495,11 +495,30 @@ pub struct OutputSpec {
 }
 
 impl crate::model::keys::LawKeys for ModelSpec {
-    /// The laws' own keys by name (the normal slot's registry reads them through this).
+    /// The laws' numeric keys by name (each slot's registry reads them through this; a test
+    /// checks that every key a registry row names has its arm here).
     fn number(&self, key: &str) -> Option<f64> {
         match key {
             "k_n" => self.k_n,
             "surface_energy" => self.surface_energy,
+            "c_n" => self.c_n,
+            "static_damping" => self.static_damping,
+            "kt_ratio" => self.kt_ratio,
+            "tangential_damping_ratio" => self.tangential_damping_ratio,
+            "rolling_k" => self.rolling_k,
+            "rolling_gamma" => self.rolling_gamma,
+            "rolling_mu" => self.rolling_mu,
+            "surface_tension" => self.surface_tension,
+            "contact_angle" => self.contact_angle,
+            "liquid_density" => self.liquid_density,
+            _ => None,
+        }
+    }
+
+    /// The laws' text keys by name.
+    fn text(&self, key: &str) -> Option<&str> {
+        match key {
+            "rolling_friction" => self.rolling_friction.as_deref(),
             _ => None,
         }
     }

@@ -347,16 +347,8 @@ pub struct BridgeLimits {
     pub reach: f64,
 }
 
-/// Default damping of Oquendo et al.'s static and rolling springs, as a fraction of critical (-).
-pub const DEFAULT_STATIC_DAMPING: f64 = 0.3;
 /// Default settle criterion on the unbalanced-force ratio.
 pub const DEFAULT_UNBALANCED_FORCE: f64 = 0.01;
-/// Water's surface tension (N/m), the default of `model.surface_tension`.
-pub const DEFAULT_SURFACE_TENSION: f64 = 0.0728;
-/// Richefeu et al.'s decay-length constant `c` (its eq. 6).
-pub const CAPILLARY_C: f64 = 0.9;
-/// Default liquid density (kg/m^3).
-pub const DEFAULT_LIQUID_DENSITY: f64 = 1000.0;
 /// Bridges per grain assumed when sizing the largest bridge: the mean bridge holds the
 /// liquid over `BRIDGES_PER_GRAIN / 2` pairs per grain...
 pub const BRIDGES_PER_GRAIN: f64 = 6.0;

@@ -12,8 +12,8 @@
 //! would pull, and the pull-off is added after it, as a capillary bridge's pull is. Without
 //! the clamp the two agree.
 
-use super::{Entry, Hertz, LawKeys, NormalLaw, NormalModel, NormalSetup};
-use crate::model::keys::required_positive;
+use super::{Entry, Hertz, NormalLaw, NormalModel, NormalSetup};
+use crate::model::keys::{required_positive, LawInput};
 use crate::model::{restitution, Geometry, PairCoeffs, TangentialStiffness};
 use crate::real::Real;
 
@@ -25,10 +25,10 @@ pub struct Dmt<T> {
 }
 
 /// The registry's row.
-pub(super) const ENTRY: Entry = Entry {
+pub(super) const ENTRY: Entry<NormalLaw<f64>> = Entry {
     name: "dmt",
     keys: &["surface_energy"],
-    parse: |keys: &dyn LawKeys| Ok(NormalLaw::Dmt(Dmt { surface_energy: required_positive(keys, "surface_energy", "give the surface energy gamma in J/m^2, e.g. 0.05")? })),
+    parse: |input: &LawInput| Ok(NormalLaw::Dmt(Dmt { surface_energy: required_positive(input.keys, "surface_energy", "give the surface energy gamma in J/m^2, e.g. 0.05")? })),
 };
 
 impl Dmt<f64> {

@@ -2,7 +2,8 @@
 //! the materials' `V = E / (1 - nu^2)` mixed as docs/physics.md rules. Scene: `normal = "hertz"`
 //! (the default), no keys of its own.
 
-use super::{Entry, LawKeys, NormalLaw, NormalModel, NormalSetup};
+use super::{Entry, NormalLaw, NormalModel, NormalSetup};
+use crate::model::keys::LawInput;
 use crate::model::{restitution, Geometry, PairCoeffs, TangentialStiffness};
 use crate::real::Real;
 
@@ -11,7 +12,7 @@ use crate::real::Real;
 pub struct Hertz;
 
 /// The registry's row.
-pub(super) const ENTRY: Entry = Entry { name: "hertz", keys: &[], parse: |_: &dyn LawKeys| Ok(NormalLaw::Hertz(Hertz)) };
+pub(super) const ENTRY: Entry<NormalLaw<f64>> = Entry { name: "hertz", keys: &[], parse: |_: &LawInput| Ok(NormalLaw::Hertz(Hertz)) };
 
 impl Hertz {
     /// The same law in another precision (it has no constants of its own).

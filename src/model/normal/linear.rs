@@ -1,8 +1,8 @@
 //! A linear spring: `F_el = k_n h`, `k_n` (N/m) from the scene. Scene: `normal = "linear"`,
 //! `k_n` required.
 
-use super::{Entry, LawKeys, NormalLaw, NormalModel, NormalSetup};
-use crate::model::keys::required_positive;
+use super::{Entry, NormalLaw, NormalModel, NormalSetup};
+use crate::model::keys::{required_positive, LawInput};
 use crate::model::{restitution, Geometry, PairCoeffs, TangentialStiffness};
 use crate::real::Real;
 
@@ -18,10 +18,10 @@ pub struct Linear<T> {
 }
 
 /// The registry's row.
-pub(super) const ENTRY: Entry = Entry {
+pub(super) const ENTRY: Entry<NormalLaw<f64>> = Entry {
     name: "linear",
     keys: &["k_n"],
-    parse: |keys: &dyn LawKeys| Ok(NormalLaw::Linear(Linear { k_n: required_positive(keys, "k_n", "give the linear stiffness k_n in N/m")? })),
+    parse: |input: &LawInput| Ok(NormalLaw::Linear(Linear { k_n: required_positive(input.keys, "k_n", "give the linear stiffness k_n in N/m")? })),
 };
 
 impl Linear<f64> {

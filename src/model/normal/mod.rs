@@ -1,10 +1,11 @@
 //! The normal slot: a contact's elastic normal force, one module per law. Each law's module owns
-//! its scene keys and their checks (its [`Entry`]), its physics ([`NormalModel`], generic over
+//! its scene keys and their checks (its registry [`Entry`]), its physics ([`NormalModel`], generic over
 //! the precision), what the scene's setup asks of it ([`NormalSetup`]: its description, time
 //! scale, dashpot shape, GPU parameter block) and its WGSL (`shaders/shared/model/normal.wgsl`,
-//! which mirrors this folder). The registry below, one row per law, builds [`NormalLaw`] and
-//! its dispatch; a law's WGSL code is its row's index, written into the kernels' prelude by
-//! [`wgsl_codes`]. Adding a law: docs/architecture.md, "Adding a contact law".
+//! which mirrors this folder). The registry below, one row per law, builds [`NormalLaw`], its
+//! dispatch and [`SLOT`]; a law's WGSL code is its row's index, written into the kernels'
+//! prelude ([`crate::model::wgsl_codes`]). Adding a law: docs/architecture.md, "Adding a
+//! contact law".
 
 mod dmt;
 mod hertz;
@@ -14,7 +15,7 @@ pub use dmt::Dmt;
 pub use hertz::{hertz_collision_time, Hertz};
 pub use linear::Linear;
 
-use super::keys::{KeyProblem, LawKeys};
+use super::registry::{Entry, Slot};
 use super::{restitution, Geometry, PairCoeffs, TangentialStiffness};
 use crate::real::Real;
 
@@ -67,18 +68,8 @@ pub trait NormalSetup {
     fn gpu_block(&self) -> glam::Vec4;
 }
 
-/// A registry row: the law's name in scenes, the `[model]` keys it owns, and how it reads them.
-pub struct Entry {
-    /// `normal = "<name>"`.
-    pub name: &'static str,
-    /// The `[model]` keys the law reads; setting one under another law is an error.
-    pub keys: &'static [&'static str],
-    /// The law from the scene's keys.
-    pub parse: fn(&dyn LawKeys) -> Result<NormalLaw<f64>, KeyProblem>,
-}
-
 /// The registry: one row per law, `Variant(Type) in module`. It declares [`NormalLaw`], its
-/// dispatch to the law's traits, its cast between precisions and [`REGISTRY`], in this order
+/// dispatch to the law's traits, its cast between precisions and [`SLOT`], in this order
 /// (a law's WGSL code is its index).
 macro_rules! normal_laws {
     ($($variant:ident($ty:ty) in $module:ident),* $(,)?) => {
@@ -91,8 +82,8 @@ macro_rules! normal_laws {
             )*
         }
 
-        /// Every law, in the order of their WGSL codes.
-        pub const REGISTRY: &[Entry] = &[$($module::ENTRY),*];
+        /// The normal laws, in the order of their WGSL codes (`NORMAL_<NAME>`).
+        pub const SLOT: Slot<NormalLaw<f64>> = Slot { name: "normal", laws: &[$($module::ENTRY),*] };
 
         impl<T: Real> NormalModel<T> for NormalLaw<T> {
             #[inline(always)]
@@ -151,7 +142,7 @@ macro_rules! normal_laws {
                 match self { $(NormalLaw::$variant(l) => NormalLaw::$variant(l.cast())),* }
             }
 
-            /// The law's row in [`REGISTRY`]: its WGSL code.
+            /// The law's row in [`SLOT`]: its WGSL code.
             pub fn code(&self) -> u32 {
                 let mut code = 0u32;
                 $(
@@ -170,38 +161,4 @@ normal_laws! {
     Hertz(Hertz) in hertz,
     Linear(Linear<T>) in linear,
     Dmt(Dmt<T>) in dmt,
-}
-
-/// The law `name` reads from `keys`, refusing a key that only another normal law reads.
-/// `Err(None)`: no law has that name ([`names`] lists them).
-pub fn parse(name: &str, keys: &dyn LawKeys) -> Result<NormalLaw<f64>, Option<KeyProblem>> {
-    let chosen = REGISTRY.iter().find(|e| e.name == name).ok_or(None)?;
-    for other in REGISTRY.iter().filter(|e| e.name != name) {
-        for &key in other.keys.iter().filter(|k| !chosen.keys.contains(k)) {
-            if keys.number(key).is_some() {
-                return Err(Some(KeyProblem {
-                    key,
-                    value: "(set)".to_string(),
-                    problem: format!("is not used by the chosen laws (normal = \"{name}\")"),
-                    fix: format!("remove `{key}` or choose the law that uses it (normal = \"{}\")", other.name),
-                }));
-            }
-        }
-    }
-    (chosen.parse)(keys).map_err(Some)
-}
-
-/// The laws' names, quoted, as a scene's error lists them: `"hertz", "linear" or "dmt"`.
-pub fn names() -> String {
-    let quoted: Vec<String> = REGISTRY.iter().map(|e| format!("\"{}\"", e.name)).collect();
-    match quoted.split_last() {
-        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
-        _ => quoted.concat(),
-    }
-}
-
-/// The WGSL constants naming each law's code, `const NORMAL_<NAME>: u32 = <row>u;`, written
-/// before the kernels' model files.
-pub fn wgsl_codes() -> String {
-    REGISTRY.iter().enumerate().map(|(i, e)| format!("const NORMAL_{}: u32 = {i}u;\n", e.name.to_uppercase())).collect()
 }

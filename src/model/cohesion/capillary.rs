@@ -1,8 +1,37 @@
 //! Capillary cohesion of a liquid bridge (Richefeu et al. (2009) eqs. 1-8, docs/physics.md), derived from the
 //! paper: the force is `f0 = -kappa R` while the grains touch, decays as `f0 exp(-delta/lambda)`
 //! across the gap `delta`, and vanishes beyond the rupture distance `delta_max`.
+//!
+//! Scene: `cohesion = "capillary"`, with `surface_tension`, `contact_angle` and
+//! `liquid_density` (the last read by the stages' `water_content`).
 
+use super::CohesionLaw;
+use crate::model::keys::{positive_or, KeyProblem, LawInput};
+use crate::model::registry::Entry;
 use crate::real::Real;
+
+/// Water's surface tension (N/m), the default of `model.surface_tension`.
+pub const DEFAULT_SURFACE_TENSION: f64 = 0.0728;
+/// Richefeu et al.'s decay-length constant `c` (its eq. 6).
+pub const CAPILLARY_C: f64 = 0.9;
+/// Default liquid density (kg/m^3).
+pub const DEFAULT_LIQUID_DENSITY: f64 = 1000.0;
+
+/// The registry's row: `kappa = 2 pi gamma_s cos(theta)` from the surface tension and the
+/// contact angle (degrees in the scene, in [0, 90) for an attractive bridge).
+pub(super) const ENTRY: Entry<CohesionLaw<f64>> = Entry {
+    name: "capillary",
+    keys: &["surface_tension", "contact_angle", "liquid_density"],
+    parse: |input: &LawInput| {
+        let gamma_s = positive_or(input.keys, "surface_tension", DEFAULT_SURFACE_TENSION, "give the surface tension in N/m, e.g. 0.0728 for water")?;
+        let theta = input.keys.number("contact_angle").unwrap_or(0.0);
+        if !(0.0..90.0).contains(&theta) {
+            return Err(KeyProblem::new("model.contact_angle", theta, "must lie in [0, 90) degrees for an attractive bridge", "give the contact angle in degrees, e.g. 0"));
+        }
+        let theta = theta.to_radians();
+        Ok(CohesionLaw::Capillary { kappa: 2.0 * std::f64::consts::PI * gamma_s * theta.cos(), theta, c: CAPILLARY_C })
+    },
+};
 
 /// `delta_max = (1 + theta/2) V_b^(1/3)` (m), `theta` the contact angle (rad), `V_b` the
 /// bridge volume (m^3) (Richefeu et al. (2009) eq. 5).

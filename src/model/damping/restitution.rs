@@ -23,8 +23,36 @@
 //!
 //! The linear spring without the clamp is the damped oscillator whose closed form
 //! [`oscillator_beta`] is; the tests check the integration against it.
+//!
+//! Scene: `damping = "restitution"`, no keys of its own; every material in contact gives its
+//! `restitution`.
 
 use std::sync::Mutex;
+
+use super::DampingLaw;
+use crate::model::keys::{KeyProblem, LawInput};
+use crate::model::registry::Entry;
+
+/// The registry's row: every material in contact needs its restitution coefficient, and every
+/// material one of at least [`MIN_RESTITUTION`] (the dashpot is sized for each pair of them).
+pub(super) const ENTRY: Entry<DampingLaw<f64>> = Entry {
+    name: "restitution",
+    keys: &[],
+    parse: |input: &LawInput| {
+        if let Some(i) = input.materials.iter().position(|m| m.in_contact && m.restitution.is_none()) {
+            return Err(KeyProblem::new(format!("material[{i}].restitution"), "(missing)", "damping = \"restitution\" needs it", "add `restitution` in (0, 1] to the material"));
+        }
+        if let Some((i, e)) = input.materials.iter().enumerate().find_map(|(i, m)| m.restitution.filter(|&e| e < MIN_RESTITUTION).map(|e| (i, e))) {
+            return Err(KeyProblem::new(
+                format!("material[{i}].restitution"),
+                e,
+                format!("is below {MIN_RESTITUTION}, where the dashpot would set the contact's time scale and the time step, picked from the elastic contact time, would not resolve it"),
+                format!("give a restitution of at least {MIN_RESTITUTION}"),
+            ));
+        }
+        Ok(DampingLaw::Restitution)
+    },
+};
 
 /// Steps of the classical Runge-Kutta integration per unit of scaled time (the undamped
 /// contact lasts 3.22 units for Hertz, `pi` for the linear spring): the restitution comes out

@@ -1,8 +1,76 @@
-//! Tangential laws: Oquendo et al.'s sliding / rolling / static regimes and the standard
-//! Hertz-Mindlin history law.
+//! Oquendo et al.'s tangential law: static, sliding and rolling regimes (docs/physics.md
+//! "Tangential force"). Scene: `tangential = "oquendo"`, with `static_damping`,
+//! `rolling_friction` and `kt_ratio`.
 
-use super::{Bodies, Geometry, History, Kinematics, OquendoLaw, PairCoeffs, Regime, RollingFriction};
+use super::{contact_tangential_velocity, rotate_into_plane, TangentialLaw, TangentialStiffness};
+use crate::model::keys::{non_negative_or, KeyProblem, LawInput};
+use crate::model::registry::Entry;
+use crate::model::{Bodies, Geometry, History, Kinematics, PairCoeffs, Regime};
 use crate::real::{Real, Vec3};
+
+/// Damping of the static and rolling springs as a fraction of their critical damping when the
+/// scene gives no `static_damping` (-).
+pub const DEFAULT_STATIC_DAMPING: f64 = 0.3;
+
+/// The registry's row.
+pub(super) const ENTRY: Entry<TangentialLaw<f64>> = Entry {
+    name: "oquendo",
+    keys: &["static_damping", "rolling_friction", "kt_ratio"],
+    parse: |input: &LawInput| {
+        let rolling_friction = match input.keys.text("rolling_friction").unwrap_or("torque") {
+            "torque" => RollingFriction::Torque,
+            "as_written" => RollingFriction::AsWritten,
+            other => {
+                return Err(KeyProblem::new("model.rolling_friction", format!("\"{other}\""), "unknown rolling friction", "use \"torque\" (momentum-conserving) or \"as_written\" (eqs. 8-9 on each grain)"));
+            }
+        };
+        Ok(TangentialLaw::Oquendo(OquendoLaw {
+            static_damping: non_negative_or(input.keys, "static_damping", DEFAULT_STATIC_DAMPING, "give a fraction of critical damping such as 0.3")?,
+            stiffness: input.tangential_stiffness()?,
+            rolling_friction,
+        }))
+    },
+};
+
+/// The parameters of Oquendo et al.'s tangential regimes (see [`oquendo_tangential`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OquendoLaw<T> {
+    /// Damping of the static and rolling springs as a fraction of their critical damping (-).
+    pub static_damping: T,
+    /// Static spring stiffness (the rolling spring's too).
+    pub stiffness: TangentialStiffness<T>,
+    /// How rolling friction acts.
+    pub rolling_friction: RollingFriction,
+}
+
+impl OquendoLaw<f64> {
+    /// The same law in another precision.
+    pub fn cast<U: Real>(&self) -> OquendoLaw<U> {
+        OquendoLaw { static_damping: U::of(self.static_damping), stiffness: self.stiffness.cast(), rolling_friction: self.rolling_friction }
+    }
+}
+
+/// How Oquendo et al.'s rolling friction (eqs. 8-9) is applied (see [`oquendo_tangential`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RollingFriction {
+    /// A torque pair of magnitude `R'_eff |F_n| tan(theta_r)` when rolling: eqs. 8-9 for a
+    /// grain rolling on a wall, with the static spring supplying eq. 8's force;
+    /// momentum-conserving.
+    #[default]
+    Torque,
+    /// Eqs. 8-9 on each grain as the paper writes them (force and torque per grain).
+    AsWritten,
+}
+
+impl RollingFriction {
+    /// Name as written in scenes.
+    pub fn name(self) -> &'static str {
+        match self {
+            RollingFriction::Torque => "torque",
+            RollingFriction::AsWritten => "as_written",
+        }
+    }
+}
 
 /// Forces and torques of Oquendo et al.'s tangential regimes on both partners.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -18,42 +86,6 @@ pub struct TangentialOut<T> {
     /// The regime the contact was in.
     pub regime: Regime,
 }
-
-/// Rotates a world-frame spring into the tangent plane of `n`, keeping its length (LAMMPS'
-/// and DEM-Engine's convention: the stored displacement follows the contact as it rolls).
-#[inline(always)]
-pub fn rotate_into_plane<T: Real>(s: Vec3<T>, n: Vec3<T>) -> Vec3<T> {
-    let len2 = s.norm2();
-    if len2 == T::ZERO {
-        return s;
-    }
-    let p = s - n * s.dot(n);
-    let p2 = p.norm2();
-    if p2 == T::ZERO { Vec3::ZERO } else { p * (len2 / p2).sqrt() }
-}
-
-/// The time (s) the springs of a contact advance by at this evaluation: `elapsed`, the time
-/// since the previous one, unless the contact is new (its springs all zero, as a contact that
-/// was open at the previous evaluation has them) and its surfaces met within `elapsed`: then
-/// the time since they met, the overlap `h` over the approach speed `-v_n` (m/s, `v_n < 0`
-/// approaching), so that a contact that starts late in a step does not count a whole step of
-/// slip (LAMMPS does). A contact whose springs are zero for another reason (no tangential
-/// motion yet) has an overlap of more than a step's approach, and keeps `elapsed`.
-#[inline(always)]
-pub fn since_touch<T: Real>(hist: &History<T>, h: T, v_n: T, elapsed: T) -> T {
-    let approach = -v_n;
-    let new = hist.tangential == Vec3::ZERO && hist.rolling == Vec3::ZERO;
-    if new && approach * elapsed > h { h / approach } else { elapsed }
-}
-
-/// Tangential velocity of the contact points, `v_t = v_p - (v_p.n) n` with Oquendo et al. eq. 4
-/// `v_p = v_i - v_j - (R'_i w_i + R'_j w_j) x n`.
-#[inline(always)]
-pub fn contact_tangential_velocity<T: Real>(g: &Geometry<T>, k: &Kinematics<T>) -> Vec3<T> {
-    let v_p = k.v_i - k.v_j - (k.w_i * g.rp_i + k.w_j * g.rp_j).cross(g.n);
-    v_p - g.n * v_p.dot(g.n)
-}
-
 /// Oquendo et al.'s three regimes (docs/physics.md "Tangential force"), realised so that a loaded
 /// contact that should stick does stick at any `F_n dt / m*`:
 ///
@@ -189,33 +221,4 @@ fn rolling_regime<T: Real>(fr: Vec3<T>, m: T, inertia: T, rp: T, n: Vec3<T>) -> 
     let force = fr * (-T::ONE / (T::ONE + inertia / mr2));
     let torque = fr.cross(n) * (rp / (T::ONE + mr2 / inertia));
     (force, torque)
-}
-
-/// Hertz-Mindlin tangential force on i with history and one Coulomb coefficient `mu`:
-/// `F_t = -k_t xi - eta_t v_t`, capped at `mu F_n`; on the cap the spring is set to
-/// `-(F_t + eta_t v_t) / k_t` (LAMMPS `tangential mindlin`). Returns the force and whether
-/// the contact slid (was on the cap).
-#[inline(always)]
-pub fn mindlin_tangential<T: Real>(
-    mu: T,
-    g: &Geometry<T>,
-    k: &Kinematics<T>,
-    f_n: T,
-    k_t: T,
-    eta_t: T,
-    xi: &mut Vec3<T>,
-    elapsed: T,
-) -> (Vec3<T>, bool) {
-    let v_t = contact_tangential_velocity(g, k);
-    *xi = rotate_into_plane(*xi, g.n) + v_t * elapsed;
-    let damp = v_t * eta_t;
-    let mut f_t = -(*xi * k_t) - damp;
-    let limit = mu * f_n;
-    let mag2 = f_t.norm2();
-    let slips = mag2 > limit * limit;
-    if slips {
-        f_t = f_t * (limit / mag2.sqrt());
-        *xi = if k_t > T::ZERO { (f_t + damp) * (-T::ONE / k_t) } else { Vec3::ZERO };
-    }
-    (f_t, slips)
 }

@@ -1,9 +1,26 @@
 //! Elastic-plastic spring-dashpot rolling resistance (the momentum-conserving alternative to
-//! Oquendo et al.'s rolling regime; as LAMMPS `rolling sds`).
+//! Oquendo et al.'s rolling regime; as LAMMPS `rolling sds`). Scene: `rolling = "sds"`, with
+//! `rolling_k` and `rolling_mu` required, `rolling_gamma` optional.
 
-use super::tangential::rotate_into_plane;
-use super::{Geometry, Kinematics};
+use super::RollingLaw;
+use crate::model::keys::{non_negative_or, required_positive, LawInput};
+use crate::model::registry::Entry;
+use crate::model::tangential::rotate_into_plane;
+use crate::model::{Geometry, Kinematics};
 use crate::real::{Real, Vec3};
+
+/// The registry's row.
+pub(super) const ENTRY: Entry<RollingLaw<f64>> = Entry {
+    name: "sds",
+    keys: &["rolling_k", "rolling_gamma", "rolling_mu"],
+    parse: |input: &LawInput| {
+        Ok(RollingLaw::Sds {
+            k_r: required_positive(input.keys, "rolling_k", "give the rolling stiffness in N/m")?,
+            gamma_r: non_negative_or(input.keys, "rolling_gamma", 0.0, "give the rolling damping in N s/m")?,
+            mu_r: required_positive(input.keys, "rolling_mu", "give the rolling friction coefficient, e.g. 0.05")?,
+        })
+    },
+};
 
 /// Rolling torque on i (N m); the torque on j is its opposite, so linear and angular
 /// momentum are conserved.
