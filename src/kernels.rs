@@ -8,6 +8,98 @@
 //! the GPU-only kernels (scans, scatter, reverse list, reductions) are what a CPU does
 //! serially in a loop.
 
+/// Declares the buffers the kernels bind, each named as their WGSL names it.
+macro_rules! buffers {
+    ($($id:ident = $name:literal,)*) => {
+        /// A buffer a kernel binds, named by its WGSL binding (`var ... <name>`) and the
+        /// engines' buffer of that name, so that a misspelt buffer does not compile; the
+        /// step's and the sweeps' solvers each hold one buffer per name they use (a rebuild's
+        /// scratch and a scan's arrays are bound to another's buffer, `gpu/engine.rs`).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum Buf {
+            $(
+                #[doc = concat!("`", $name, "`.")]
+                $id,
+            )*
+        }
+
+        impl Buf {
+            /// Every buffer name.
+            pub const ALL: &[Buf] = &[$(Buf::$id),*];
+
+            /// The name as the WGSL binds it (and as checkpoints store the buffer).
+            pub fn name(self) -> &'static str {
+                match self { $(Buf::$id => $name),* }
+            }
+
+            /// The buffer of that name, if there is one.
+            pub fn of_name(name: &str) -> Option<Buf> {
+                Buf::ALL.iter().copied().find(|b| b.name() == name)
+            }
+        }
+    };
+}
+
+buffers! {
+    Params = "params",
+    Phase = "phase",
+    Pos = "pos",
+    Residual = "residual",
+    Vel = "vel",
+    Omega = "omega",
+    Force = "force",
+    Torque = "torque",
+    BuiltAt = "built_at",
+    Quat = "quat",
+    Walls = "walls",
+    WallReaction = "wall_reaction",
+    Control = "control",
+    Servo = "servo",
+    Args = "args",
+    PairStart = "pair_start",
+    OldStart = "old_start",
+    PairJ = "pair_j",
+    Hist = "hist",
+    OldJ = "old_j",
+    OldHist0 = "old_hist0",
+    OldHist1 = "old_hist1",
+    OldHist2 = "old_hist2",
+    CellCount = "cell_count",
+    CellFill = "cell_fill",
+    Image = "image",
+    CellOf = "cell_of",
+    RevStart = "rev_start",
+    ScanData = "scan_data",
+    BlockSums = "block_sums",
+    CellGrains = "cell_grains",
+    RevFill = "rev_fill",
+    PairI = "pair_i",
+    RevPair = "rev_pair",
+    BridgeEvent = "bridge_event",
+    Liquid = "liquid",
+    Material = "material",
+    Coeffs = "coeffs",
+    OutFi = "out_fi",
+    OutFj = "out_fj",
+    OutTi = "out_ti",
+    OutTj = "out_tj",
+    WallHist = "wall_hist",
+    WallPartials = "wall_partials",
+    GrainRows = "grain_rows",
+    PairRows = "pair_rows",
+    Stats = "stats",
+    Cd = "cd",
+    Contacts = "contacts",
+    Impulse = "impulse",
+    Measure = "measure",
+    Sweeps = "sweeps",
+    WallVel = "wall_vel",
+    Blocks = "blocks",
+    HashSums = "hash_sums",
+    GrainSums = "grain_sums",
+    SpareSum = "spare_sum",
+}
+
 /// How a kernel uses a binding.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Access {
@@ -34,7 +126,7 @@ pub struct Kernel {
     /// Shared files prepended, in order (`shaders/shared/<name>.wgsl`).
     pub includes: &'static [&'static str],
     /// Bindings of group 0, in binding order.
-    pub bindings: &'static [(&'static str, Access)],
+    pub bindings: &'static [(Buf, Access)],
 }
 
 /// A shared WGSL file by name.
@@ -102,15 +194,15 @@ const CD: &[&str] = &["types", "dispatch", "cd"];
 const STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "reduce"];
 
 macro_rules! kernel {
-    ($name:literal, $inc:expr, [$($b:literal: $a:expr),* $(,)?]) => {
-        Kernel { name: $name, source: include_str!(concat!("../shaders/", $name, ".wgsl")), includes: $inc, bindings: &[$(($b, $a)),*] }
+    ($name:literal, $inc:expr, [$($b:ident: $a:expr),* $(,)?]) => {
+        Kernel { name: $name, source: include_str!(concat!("../shaders/", $name, ".wgsl")), includes: $inc, bindings: &[$((Buf::$b, $a)),*] }
     };
 }
 
 /// Declares an enum of kernels and their table from one list, so that a kernel is named by a
 /// variant (a misspelt one does not compile) and its row stands at the variant's index.
 macro_rules! kernel_table {
-    ($(#[$enum_doc:meta])* $enum:ident, $(#[$table_doc:meta])* $table:ident, $($id:ident = $name:literal, $inc:expr, [$($b:literal: $a:expr),* $(,)?];)*) => {
+    ($(#[$enum_doc:meta])* $enum:ident, $(#[$table_doc:meta])* $table:ident, $($id:ident = $name:literal, $inc:expr, [$($b:ident: $a:expr),* $(,)?];)*) => {
         $(#[$enum_doc])*
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
         pub enum $enum {
@@ -145,31 +237,31 @@ kernel_table! {
     StepKernel,
     /// Every kernel of the step, in the order a rebuilding step runs them.
     KERNELS,
-    Integrate = "integrate", INTEGRATE, ["params": Uniform, "phase": Phase, "pos": ReadWrite, "residual": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "force": Read, "torque": Read, "built_at": Read, "quat": ReadWrite, "walls": ReadWrite, "wall_reaction": Read, "control": ReadWrite];
-    ServoMove = "servo_move", BASE, ["params": Uniform, "phase": Phase, "walls": ReadWrite, "wall_reaction": Read, "servo": ReadWrite];
-    DecideRebuild = "decide_rebuild", BASE, ["params": Uniform, "control": ReadWrite, "args": ReadWrite];
-    SaveStarts = "save_starts", BASE, ["params": Uniform, "pair_start": Read, "old_start": Write];
-    SavePairs = "save_pairs", BASE, ["params": Uniform, "pair_j": Read, "hist": Read, "old_j": Write, "old_hist0": Write, "old_hist1": Write, "old_hist2": Write, "control": Read];
-    ClearCells = "clear_cells", BASE, ["params": Uniform, "cell_count": Write, "cell_fill": Write];
-    HashCells = "hash_cells", GRID, ["params": Uniform, "pos": ReadWrite, "residual": ReadWrite, "image": ReadWrite, "built_at": Write, "cell_of": Write, "cell_count": ReadWrite, "control": ReadWrite, "pair_start": Write, "rev_start": Write];
-    ScanBlocks = "scan_blocks", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": Write];
-    ScanAdd = "scan_add", BASE, ["params": Uniform, "scan_data": ReadWrite, "block_sums": ReadWrite];
-    ScatterCells = "scatter_cells", BASE, ["params": Uniform, "cell_of": Read, "cell_count": Read, "cell_fill": ReadWrite, "cell_grains": Write];
-    DetectCount = "detect_count", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Write, "control": ReadWrite, "rev_fill": Write];
-    PairsReady = "pairs_ready", BASE, ["params": Uniform, "pair_start": Read, "control": ReadWrite, "args": Write];
-    DetectFill = "detect_fill", DETECT, ["params": Uniform, "pos": Read, "residual": Read, "cell_count": Read, "cell_grains": Read, "pair_start": Read, "pair_i": Write, "pair_j": ReadWrite];
-    RemapHistory = "remap_history", BASE, ["params": Uniform, "pair_i": Read, "pair_j": Read, "old_start": Read, "old_j": Read, "old_hist0": Read, "old_hist1": Read, "old_hist2": Read, "hist": Write, "control": Read];
-    ReverseCount = "reverse_count", BASE, ["params": Uniform, "pair_j": Read, "rev_start": ReadWrite, "control": Read];
-    ReverseFill = "reverse_fill", BASE, ["params": Uniform, "pair_j": Read, "rev_start": Read, "rev_fill": ReadWrite, "rev_pair": Write, "control": Read];
-    ReverseSort = "reverse_sort", BASE, ["params": Uniform, "rev_start": Read, "rev_pair": ReadWrite];
-    FindBridgeEvents = "find_bridge_events", FORCES, ["params": Uniform, "pos": Read, "residual": Read, "pair_i": Read, "pair_j": Read, "hist": Read, "bridge_event": Write, "control": Read];
-    UpdateBridges = "update_bridges", FORCES, ["params": Uniform, "pair_i": Read, "pair_j": Read, "bridge_event": Read, "hist": ReadWrite, "liquid": ReadWrite, "control": Read];
-    PairForce = "pair_force", FORCES, ["params": Uniform, "phase": Phase, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "hist": ReadWrite, "out_fi": Write, "out_fj": Write, "out_ti": Write, "out_tj": Write, "control": Read];
-    Gather = "gather", GATHER, ["params": Uniform, "phase": Phase, "vel": ReadWrite, "omega": ReadWrite, "pair_start": Read, "rev_start": Read, "rev_pair": Read, "out_fi": Read, "out_fj": Read, "out_ti": Read, "out_tj": Read, "pos": ReadWrite, "residual": ReadWrite, "material": Read, "coeffs": Read, "walls": Read, "wall_hist": ReadWrite, "wall_partials": Write, "force": Write, "torque": Write, "built_at": Read, "quat": ReadWrite, "control": ReadWrite];
-    WallReduce = "wall_reduce", PISTON, ["params": Uniform, "phase": Phase, "wall_partials": Read, "wall_reaction": ReadWrite, "walls": ReadWrite];
-    ReduceGrains = "reduce_grains", STATS, ["params": Uniform, "pos": Read, "residual": Read, "vel": Read, "omega": Read, "force": Read, "torque": Read, "image": Read, "material": Read, "coeffs": Read, "walls": Read, "grain_rows": Write];
-    ReducePairs = "reduce_pairs", STATS, ["params": Uniform, "pos": Read, "residual": Read, "material": Read, "coeffs": Read, "pair_i": Read, "pair_j": Read, "out_fi": Read, "out_ti": Read, "control": Read, "pair_rows": Write];
-    ReduceFinal = "reduce_final", STATS, ["params": Uniform, "grain_rows": Read, "pair_rows": Read, "control": Read, "stats": Write];
+    Integrate = "integrate", INTEGRATE, [Params: Uniform, Phase: Phase, Pos: ReadWrite, Residual: ReadWrite, Vel: ReadWrite, Omega: ReadWrite, Force: Read, Torque: Read, BuiltAt: Read, Quat: ReadWrite, Walls: ReadWrite, WallReaction: Read, Control: ReadWrite];
+    ServoMove = "servo_move", BASE, [Params: Uniform, Phase: Phase, Walls: ReadWrite, WallReaction: Read, Servo: ReadWrite];
+    DecideRebuild = "decide_rebuild", BASE, [Params: Uniform, Control: ReadWrite, Args: ReadWrite];
+    SaveStarts = "save_starts", BASE, [Params: Uniform, PairStart: Read, OldStart: Write];
+    SavePairs = "save_pairs", BASE, [Params: Uniform, PairJ: Read, Hist: Read, OldJ: Write, OldHist0: Write, OldHist1: Write, OldHist2: Write, Control: Read];
+    ClearCells = "clear_cells", BASE, [Params: Uniform, CellCount: Write, CellFill: Write];
+    HashCells = "hash_cells", GRID, [Params: Uniform, Pos: ReadWrite, Residual: ReadWrite, Image: ReadWrite, BuiltAt: Write, CellOf: Write, CellCount: ReadWrite, Control: ReadWrite, PairStart: Write, RevStart: Write];
+    ScanBlocks = "scan_blocks", BASE, [Params: Uniform, ScanData: ReadWrite, BlockSums: Write];
+    ScanAdd = "scan_add", BASE, [Params: Uniform, ScanData: ReadWrite, BlockSums: ReadWrite];
+    ScatterCells = "scatter_cells", BASE, [Params: Uniform, CellOf: Read, CellCount: Read, CellFill: ReadWrite, CellGrains: Write];
+    DetectCount = "detect_count", DETECT, [Params: Uniform, Pos: Read, Residual: Read, CellCount: Read, CellGrains: Read, PairStart: Write, Control: ReadWrite, RevFill: Write];
+    PairsReady = "pairs_ready", BASE, [Params: Uniform, PairStart: Read, Control: ReadWrite, Args: Write];
+    DetectFill = "detect_fill", DETECT, [Params: Uniform, Pos: Read, Residual: Read, CellCount: Read, CellGrains: Read, PairStart: Read, PairI: Write, PairJ: ReadWrite];
+    RemapHistory = "remap_history", BASE, [Params: Uniform, PairI: Read, PairJ: Read, OldStart: Read, OldJ: Read, OldHist0: Read, OldHist1: Read, OldHist2: Read, Hist: Write, Control: Read];
+    ReverseCount = "reverse_count", BASE, [Params: Uniform, PairJ: Read, RevStart: ReadWrite, Control: Read];
+    ReverseFill = "reverse_fill", BASE, [Params: Uniform, PairJ: Read, RevStart: Read, RevFill: ReadWrite, RevPair: Write, Control: Read];
+    ReverseSort = "reverse_sort", BASE, [Params: Uniform, RevStart: Read, RevPair: ReadWrite];
+    FindBridgeEvents = "find_bridge_events", FORCES, [Params: Uniform, Pos: Read, Residual: Read, PairI: Read, PairJ: Read, Hist: Read, BridgeEvent: Write, Control: Read];
+    UpdateBridges = "update_bridges", FORCES, [Params: Uniform, PairI: Read, PairJ: Read, BridgeEvent: Read, Hist: ReadWrite, Liquid: ReadWrite, Control: Read];
+    PairForce = "pair_force", FORCES, [Params: Uniform, Phase: Phase, Pos: Read, Residual: Read, Vel: Read, Omega: Read, Material: Read, Coeffs: Read, PairI: Read, PairJ: Read, Hist: ReadWrite, OutFi: Write, OutFj: Write, OutTi: Write, OutTj: Write, Control: Read];
+    Gather = "gather", GATHER, [Params: Uniform, Phase: Phase, Vel: ReadWrite, Omega: ReadWrite, PairStart: Read, RevStart: Read, RevPair: Read, OutFi: Read, OutFj: Read, OutTi: Read, OutTj: Read, Pos: ReadWrite, Residual: ReadWrite, Material: Read, Coeffs: Read, Walls: Read, WallHist: ReadWrite, WallPartials: Write, Force: Write, Torque: Write, BuiltAt: Read, Quat: ReadWrite, Control: ReadWrite];
+    WallReduce = "wall_reduce", PISTON, [Params: Uniform, Phase: Phase, WallPartials: Read, WallReaction: ReadWrite, Walls: ReadWrite];
+    ReduceGrains = "reduce_grains", STATS, [Params: Uniform, Pos: Read, Residual: Read, Vel: Read, Omega: Read, Force: Read, Torque: Read, Image: Read, Material: Read, Coeffs: Read, Walls: Read, GrainRows: Write];
+    ReducePairs = "reduce_pairs", STATS, [Params: Uniform, Pos: Read, Residual: Read, Material: Read, Coeffs: Read, PairI: Read, PairJ: Read, OutFi: Read, OutTi: Read, Control: Read, PairRows: Write];
+    ReduceFinal = "reduce_final", STATS, [Params: Uniform, GrainRows: Read, PairRows: Read, Control: Read, Stats: Write];
 }
 
 kernel_table! {
@@ -178,9 +270,9 @@ kernel_table! {
     CdKernel,
     /// Contact dynamics' sweep kernels, in the order a sweep runs them.
     CD_KERNELS,
-    CdSweepColour = "cd_sweep_colour", CD, ["cd": Uniform, "phase": Phase, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "measure": Write, "sweeps": Read];
-    CdSweepTail = "cd_sweep_tail", CD, ["cd": Uniform, "contacts": Read, "impulse": ReadWrite, "vel": ReadWrite, "omega": ReadWrite, "wall_vel": ReadWrite, "measure": Write, "sweeps": Read];
-    CdMeasure = "cd_measure", CD, ["cd": Uniform, "measure": Read, "blocks": Write, "sweeps": Read];
-    CdDecide = "cd_decide", CD, ["cd": Uniform, "blocks": Read, "sweeps": ReadWrite];
+    CdSweepColour = "cd_sweep_colour", CD, [Cd: Uniform, Phase: Phase, Contacts: Read, Impulse: ReadWrite, Vel: ReadWrite, Omega: ReadWrite, Measure: Write, Sweeps: Read];
+    CdSweepTail = "cd_sweep_tail", CD, [Cd: Uniform, Contacts: Read, Impulse: ReadWrite, Vel: ReadWrite, Omega: ReadWrite, WallVel: ReadWrite, Measure: Write, Sweeps: Read];
+    CdMeasure = "cd_measure", CD, [Cd: Uniform, Measure: Read, Blocks: Write, Sweeps: Read];
+    CdDecide = "cd_decide", CD, [Cd: Uniform, Blocks: Read, Sweeps: ReadWrite];
 }
 

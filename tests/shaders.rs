@@ -127,7 +127,7 @@ fn the_kernel_table_matches_each_shaders_bindings() {
             })
             .collect();
         declared.sort_by_key(|d| d.0);
-        let table: Vec<(u32, String, Access)> = k.bindings.iter().enumerate().map(|(i, (n, a))| (i as u32, n.to_string(), *a)).collect();
+        let table: Vec<(u32, String, Access)> = k.bindings.iter().enumerate().map(|(i, (n, a))| (i as u32, n.name().to_string(), *a)).collect();
         assert_eq!(declared, table, "{}: shader bindings vs the kernel table", k.name);
     }
 }

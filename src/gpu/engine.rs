@@ -9,6 +9,7 @@ mod buffers;
 mod contract;
 mod encode;
 mod readback;
+mod setup;
 mod snapshot;
 mod traffic;
 
@@ -17,7 +18,8 @@ use super::device::Gpu;
 use encode::Size;
 use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, SCAN_BLOCK, STAT_ROW};
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
-use crate::kernels::StepKernel;
+use crate::kernels::{Buf, StepKernel};
+use super::pipeline::Buffers;
 use crate::model::{HistoryLayout, NormalSetup, PairCoeffs, RollingFriction, TangentialLaw};
 use super::plan::{Dispatch, Entry, Plans};
 use crate::schedule::{Op, Schedule, Trace};
@@ -48,11 +50,11 @@ pub const SUBMITS_PER_CHECK: u64 = 32;
 
 /// Buffers a checkpoint leaves out: the scene's constants (set up again from the scene) and
 /// scratch space every step or statistics read rewrites before reading it.
-const NOT_STATE: [&str; 14] = [
-    "params", "phase", "material", "coeffs", // constants
-    "cell_count", "cell_fill", "hash_sums", "grain_sums", "spare_sum", // the hash grid
-    "bridge_event", // bridge scratch
-    "wall_partials", "grain_rows", "pair_rows", "stats", // reductions
+const NOT_STATE: [Buf; 14] = [
+    Buf::Params, Buf::Phase, Buf::Material, Buf::Coeffs, // constants
+    Buf::CellCount, Buf::CellFill, Buf::HashSums, Buf::GrainSums, Buf::SpareSum, // the hash grid
+    Buf::BridgeEvent, // bridge scratch
+    Buf::WallPartials, Buf::GrainRows, Buf::PairRows, Buf::Stats, // reductions
 ];
 
 /// The rebuild's scratch, as (binding, buffer): the replaced list's partners and history
@@ -68,15 +70,15 @@ const NOT_STATE: [&str; 14] = [
 /// that rewrites them, where every rebuild runs (`force`, `torque`: 16 B per grain), or
 /// between one evaluation's `wall_reduce` and the next one's gather (`wall_partials`: 256 B
 /// per 64 grains).
-const REBUILD_SCRATCH: [(&str, &str); 8] = [
-    ("old_j", "rev_pair"),
-    ("old_hist0", "out_fi"),
-    ("old_hist1", "out_tj"),
-    ("old_hist2", "out_ti"),
-    ("rev_fill", "cell_fill"),
-    ("old_start", "force"),
-    ("cell_of", "torque"),
-    ("cell_grains", "wall_partials"),
+const REBUILD_SCRATCH: [(Buf, Buf); 8] = [
+    (Buf::OldJ, Buf::RevPair),
+    (Buf::OldHist0, Buf::OutFi),
+    (Buf::OldHist1, Buf::OutTj),
+    (Buf::OldHist2, Buf::OutTi),
+    (Buf::RevFill, Buf::CellFill),
+    (Buf::OldStart, Buf::Force),
+    (Buf::CellOf, Buf::Torque),
+    (Buf::CellGrains, Buf::WallPartials),
 ];
 
 /// Why the GPU engine refused a scene.
@@ -123,8 +125,9 @@ pub struct GpuEngine {
     /// Each kernel's bind group layout and pipeline, indexed by [`StepKernel`].
     layouts: Vec<wgpu::BindGroupLayout>,
     pipelines: Vec<wgpu::ComputePipeline>,
-    buffers: HashMap<&'static str, wgpu::Buffer>,
-    bind_groups: HashMap<String, wgpu::BindGroup>,
+    buffers: Buffers,
+    /// Each kernel's bind group, and the scan kernels' one per scanned array.
+    bind_groups: HashMap<(StepKernel, Option<buffers::Scan>), wgpu::BindGroup>,
     phase_stride: u64,
     has_walls: bool,
     history: HistoryLayout,
@@ -210,190 +213,21 @@ impl GpuEngine {
         let pair_capacity = pairs.unwrap_or(n.max(1024)).max(1).min(binding / per_pair_bytes).min(binding / 16);
         limit("bytes of wall history", 16 * n * scene.walls.len() as u64 * hist_blocks, binding, "use fewer walls or grains")?;
 
-        let model = &scene.model;
-        let r_max = scene.grains.radius.iter().copied().fold(0.0, f64::max);
-        let reach = scene.skin + scene.bridges.reach;
-        let cutoff = 2.0 * r_max + reach;
-        let mut params = Params {
-            n_grains: n as u32,
-            n_walls: scene.walls.len() as u32,
-            n_materials: scene.materials.len() as u32,
-            pair_capacity: pair_capacity as u32,
-            hash_size: hash_size as u32,
-            max_neighbours: scene.max_neighbours as u32,
-            piston: NONE,
-            hist_blocks: hist_blocks as u32,
-            gravity: Vec4::new(scene.gravity[0] as f32, scene.gravity[1] as f32, scene.gravity[2] as f32, 0.0),
-            cell: Vec4::splat(cutoff as f32),
-            skin: scene.skin as f32,
-            reach: reach as f32,
-            ..Default::default()
-        };
-        for a in 0..3 {
-            if let Some([lo, hi]) = scene.periodic[a] {
-                let dims = ((hi - lo) / cutoff).floor().max(1.0);
-                params.periodic_lo[a] = lo as f32;
-                params.periodic_len[a] = (hi - lo) as f32;
-                params.periodic_dims[a] = dims as u32;
-                params.cell[a] = ((hi - lo) / dims) as f32;
-            }
-        }
-        params.normal = model.normal.gpu_block();
-        params.damping = model.damping.gpu_block();
-        params.tangential = model.tangential.gpu_block();
-        params.rolling = model.rolling.gpu_block();
-        params.cohesion = model.cohesion.gpu_block(scene.bridges.volume_cap);
-        match model.tangential {
-            TangentialLaw::None => {}
-            TangentialLaw::Oquendo(l) => {
-                params.kt_law = l.stiffness.code();
-                params.rolling_as_written = (l.rolling_friction == RollingFriction::AsWritten) as u32;
-            }
-            TangentialLaw::Mindlin { stiffness, .. } => params.kt_law = stiffness.code(),
-        }
-
-        // Walls.
-        let mut piston = None;
-        let walls: Vec<layout::Wall> = scene
-            .walls
-            .iter()
-            .enumerate()
-            .map(|(w, wall)| {
-                let mut g = layout::Wall { material: wall.material as u32, ..Default::default() };
-                match wall.shape {
-                    WallShape::Plane { point, normal } => {
-                        g.kind = layout::wall_kind::PLANE;
-                        g.point = Vec4::new(point[0] as f32, point[1] as f32, point[2] as f32, 0.0);
-                        g.normal = Vec4::new(normal[0] as f32, normal[1] as f32, normal[2] as f32, 0.0);
-                    }
-                    WallShape::Cylinder { center, radius } => {
-                        g.kind = layout::wall_kind::CYLINDER;
-                        g.point = Vec4::new(center[0] as f32, center[1] as f32, 0.0, 0.0);
-                        g.normal = Vec4::new(0.0, 0.0, 0.0, radius as f32);
-                    }
-                    WallShape::Piston { z, pressure, mass, area } => {
-                        g.kind = layout::wall_kind::PISTON;
-                        g.point = Vec4::new(0.0, 0.0, z as f32, 0.0);
-                        g.piston = Vec4::new(mass as f32, area as f32, pressure as f32, 0.0);
-                        piston = Some(w);
-                    }
-                }
-                g
-            })
-            .collect();
+        let mut params = setup::params_of(scene, pair_capacity, hash_size, hist_blocks);
+        let (walls, piston) = setup::walls_of(scene);
         if let Some(p) = piston {
             params.piston = p as u32;
         }
-
-        let coeffs: Vec<layout::PairCoeffs> = scene
-            .materials
-            .iter()
-            .flat_map(|a| scene.materials.iter().map(move |b| (a, b)))
-            .map(|(a, b)| {
-                let c: PairCoeffs<f32> = PairCoeffs::mix(&a.constants, &b.constants, &scene.model);
-                layout::PairCoeffs { v_eff: c.v_eff, g_eff: c.g_eff, mu_s: c.mu_s, mu_k: c.mu_k, tan_roll: c.tan_roll, gamma_n: c.gamma_n, gamma_nt: c.gamma_nt, beta: c.beta }
-            })
-            .collect();
-
-        let g = &scene.grains;
-        let v4 = |a: glam::DVec3, w: f64| [a[0] as f32, a[1] as f32, a[2] as f32, w as f32];
-        let pos: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.position[i], g.radius[i])).collect();
-        // What rounding took off each position (src/position.rs), as the CPU's f32 engine keeps it.
-        let residual: Vec<[f32; 4]> = g.position.iter().map(|&x| { let (_, r) = crate::position::split::<f32>(x); [r.x, r.y, r.z, 0.0] }).collect();
-        let vel: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.velocity[i], g.mass[i])).collect();
-        // The inertia in w as the CPU's f32 engine keeps it.
-        let inertia = |i: usize| crate::state::Props::<f32>::sphere(g.radius[i], g.mass[i]).inertia;
-        let omega: Vec<[f32; 4]> = (0..g.len()).map(|i| { let w = g.angular_velocity[i]; [w[0] as f32, w[1] as f32, w[2] as f32, inertia(i)] }).collect();
-        let material: Vec<u32> = g.material.iter().map(|&m| m as u32).collect();
-        let history = model.history_layout();
-        let periodic = scene.periodic.iter().any(Option::is_some);
-
-        let device = &gpu.device;
-        // A device without the memory reports it here, not through wgpu's handler (a panic).
-        let out_of_memory = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let mut buffers = HashMap::new();
-        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
-        let mut init = |name: &'static str, bytes: &[u8], extra: wgpu::BufferUsages| {
-            let b = device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(name), contents: bytes, usage: storage | extra });
-            buffers.insert(name, b);
-        };
-        init("pos", bytemuck::cast_slice(&pos), wgpu::BufferUsages::empty());
-        init("residual", bytemuck::cast_slice(&residual), wgpu::BufferUsages::empty());
-        init("vel", bytemuck::cast_slice(&vel), wgpu::BufferUsages::empty());
-        init("omega", bytemuck::cast_slice(&omega), wgpu::BufferUsages::empty());
-        init("material", bytemuck::cast_slice(&material), wgpu::BufferUsages::empty());
-        let liquid = vec![0.0f32; if layout_of_history.bridge { g.len() } else { 4 }];
-        init("liquid", bytemuck::cast_slice(&liquid), wgpu::BufferUsages::empty());
-        init("coeffs", bytemuck::cast_slice(&coeffs), wgpu::BufferUsages::empty());
-        let walls_bytes: Vec<layout::Wall> = if walls.is_empty() { vec![layout::Wall::default()] } else { walls };
-        init("walls", bytemuck::cast_slice(&walls_bytes), wgpu::BufferUsages::empty());
         let control = Control { max_disp2: f32::INFINITY.to_bits(), overflow_grain: NONE, non_finite: NONE, ..Default::default() };
-        init("control", bytemuck::bytes_of(&control), wgpu::BufferUsages::empty());
-        let mut dispatch_args = vec![DispatchArgs { x: 0, y: 1, z: 1 }; args::SLOTS as usize];
-        (dispatch_args[args::STEP_GRAINS as usize], dispatch_args[args::STEP_ONE as usize]) = (DispatchArgs::items(n), DispatchArgs::ONE);
-        init("args", bytemuck::cast_slice(&dispatch_args), wgpu::BufferUsages::INDIRECT);
-        let quat: Vec<[f32; 4]> = if scene.track_orientation { vec![[1.0, 0.0, 0.0, 0.0]; g.len()] } else { vec![[0.0; 4]] };
-        init("quat", bytemuck::cast_slice(&quat), wgpu::BufferUsages::empty());
-        init("params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
-        let servo = scene.servo.map_or(layout::Servo::default(), |s| {
-            let w = s.walls.map(|w| w as u32);
-            layout::Servo {
-                walls_lo: UVec4::new(w[0], w[1], w[2], w[3]),
-                walls_hi: UVec4::new(w[4], w[5], 0, 0),
-                pressure: s.pressure as f32,
-                gain: s.gain as f32,
-                max_speed: s.max_speed as f32,
-                relaxation: crate::walls::SERVO_RELAXATION as f32,
-                ..Default::default()
-            }
-        });
-        init("servo", bytemuck::bytes_of(&servo), wgpu::BufferUsages::empty());
-
         let phase_stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<Phase>() as u64);
         let dt = scene.time_step.dt;
         let plans = Plans::of(&Schedule::new(scene.integrator, dt));
-        let mut phases: Vec<Phase> = Vec::new();
-        for e in &plans.entries() {
-            if !phases.contains(&e.phase) {
-                phases.push(e.phase);
-            }
-        }
-        let mut phase_bytes = vec![0u8; phase_stride as usize * phases.len()];
-        for (slot, p) in phases.iter().enumerate() {
-            let at = slot * phase_stride as usize;
-            phase_bytes[at..at + std::mem::size_of::<Phase>()].copy_from_slice(bytemuck::bytes_of(p));
-        }
-        init("phase", &phase_bytes, wgpu::BufferUsages::UNIFORM);
-
-        let mut zeroed = |name: &'static str, bytes: u64| {
-            let b = device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size: bytes.max(16), usage: storage, mapped_at_creation: false });
-            buffers.insert(name, b);
-        };
-        let v = 16 * n;
-        for name in ["force", "torque", "built_at"] {
-            zeroed(name, v);
-        }
-        zeroed("image", if periodic { v } else { 16 });
-        zeroed("cell_count", 4 * hash_size);
-        zeroed("cell_fill", 4 * hash_size);
-        zeroed("hash_sums", 4 * hash_size.div_ceil(2048));
-        zeroed("grain_sums", 4 * (n + 1).div_ceil(2048));
-        zeroed("spare_sum", 4);
-        for name in ["pair_start", "rev_start"] {
-            zeroed(name, 4 * (n + 1));
-        }
-        let wall_hist = if hist_blocks > 0 { 16 * n * scene.walls.len() as u64 * hist_blocks } else { 16 };
-        zeroed("wall_hist", wall_hist);
-        // Per wall: the reaction, then the contacts' stiffness and damping (servo walls).
-        let wall_partials = workgroup::rows(n) * 2 * MAX_WALLS as u64 * 16;
-        zeroed("wall_partials", wall_partials);
-        // The rebuild's scratch fits the buffers that hold it (REBUILD_SCRATCH).
-        debug_assert!(v.max(16) >= 4 * (n + 1) && wall_partials >= 4 * n);
-        zeroed("wall_reaction", 2 * MAX_WALLS as u64 * 16);
-        zeroed("grain_rows", workgroup::rows(n) * STAT_ROW as u64 * 4);
-        zeroed("stats", 2 * STAT_ROW as u64 * 4);
+        let (phases, phase_bytes) = setup::phase_slots(&plans, phase_stride);
+        // A device without the memory reports it here, not through wgpu's handler (a panic).
+        let out_of_memory = gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let buffers = setup::scene_buffers(&gpu.device, scene, &params, walls, &control, &phase_bytes);
         if let Some(e) = pollster::block_on(out_of_memory.pop()) {
-            let mib = buffers.values().map(wgpu::Buffer::size).sum::<u64>() as f64 / (1u64 << 20) as f64;
+            let mib = buffers.bytes() as f64 / (1u64 << 20) as f64;
             return Err(GpuSetupError::Memory { adapter, mib, reason: e.to_string() }.into());
         }
 
@@ -411,7 +245,7 @@ impl GpuEngine {
             bind_groups: HashMap::new(),
             phase_stride,
             has_walls: !scene.walls.is_empty(),
-            history,
+            history: layout_of_history,
             track_orientation: scene.track_orientation,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
             piston,

@@ -1,8 +1,47 @@
 //! What every GPU solver builds alike from the kernel table: a kernel's bind group layout and
-//! pipeline, a bind group over named buffers, and buffers read back to the host.
+//! pipeline, its buffers by name, a bind group over them, and buffers read back to the host.
 
 use super::device::Gpu;
-use crate::kernels::{Access, Kernel};
+use crate::kernels::{Access, Buf, Kernel};
+
+/// A solver's device buffers, one per [`Buf`] it uses.
+#[derive(Default)]
+pub struct Buffers(Vec<Option<wgpu::Buffer>>);
+
+impl Buffers {
+    /// Holds `buffer` as `name`'s, replacing the one held before.
+    pub fn insert(&mut self, name: Buf, buffer: wgpu::Buffer) {
+        let at = name as usize;
+        if self.0.len() <= at {
+            self.0.resize_with(at + 1, || None);
+        }
+        self.0[at] = Some(buffer);
+    }
+
+    /// The buffer of `name`, if the solver holds one.
+    pub fn get(&self, name: Buf) -> Option<&wgpu::Buffer> {
+        self.0.get(name as usize).and_then(Option::as_ref)
+    }
+
+    /// Every buffer held, with its name, in the order of [`Buf`].
+    pub fn iter(&self) -> impl Iterator<Item = (Buf, &wgpu::Buffer)> {
+        Buf::ALL.iter().filter_map(|&name| self.get(name).map(|b| (name, b)))
+    }
+
+    /// The bytes of all the buffers held.
+    pub fn bytes(&self) -> u64 {
+        self.iter().map(|(_, b)| b.size()).sum()
+    }
+}
+
+impl std::ops::Index<Buf> for Buffers {
+    type Output = wgpu::Buffer;
+
+    /// The buffer of `name`; a solver asks only for the buffers it made.
+    fn index(&self, name: Buf) -> &wgpu::Buffer {
+        self.get(name).unwrap_or_else(|| panic!("no GPU buffer `{}`: the solver made none", name.name()))
+    }
+}
 
 /// A kernel's bind group layout and compute pipeline, its override constants set to `constants`.
 pub fn compute_pipeline(device: &wgpu::Device, k: &Kernel, constants: &[(&str, f64)]) -> (wgpu::BindGroupLayout, wgpu::ComputePipeline) {
@@ -39,16 +78,16 @@ pub fn compute_pipeline(device: &wgpu::Device, k: &Kernel, constants: &[(&str, f
     (layout, pipeline)
 }
 
-/// A bind group of kernel `k` over the buffers `buffer` names; the `Phase` binding (at a
-/// dynamic offset) sees `phase_bytes` of its buffer.
-pub fn bind_group<'a>(device: &wgpu::Device, label: &str, k: &Kernel, layout: &wgpu::BindGroupLayout, buffer: impl Fn(&str) -> &'a wgpu::Buffer, phase_bytes: u64) -> wgpu::BindGroup {
+/// A bind group of kernel `k` over the buffers `buffer` gives for its bindings; the `Phase`
+/// binding (at a dynamic offset) sees `phase_bytes` of its buffer.
+pub fn bind_group<'a>(device: &wgpu::Device, label: &str, k: &Kernel, layout: &wgpu::BindGroupLayout, buffer: impl Fn(Buf) -> &'a wgpu::Buffer, phase_bytes: u64) -> wgpu::BindGroup {
     let entries: Vec<wgpu::BindGroupEntry> = k
         .bindings
         .iter()
         .enumerate()
-        .map(|(i, (name, access))| {
+        .map(|(i, &(name, access))| {
             let buffer = buffer(name);
-            let resource = if *access == Access::Phase {
+            let resource = if access == Access::Phase {
                 wgpu::BindingResource::Buffer(wgpu::BufferBinding { buffer, offset: 0, size: wgpu::BufferSize::new(phase_bytes) })
             } else {
                 buffer.as_entire_binding()

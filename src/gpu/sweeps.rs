@@ -12,13 +12,12 @@
 
 use super::device::Gpu;
 use super::layout::{CdColour, CdContact, CdControl, CdParams};
-use super::pipeline::{bind_group, compute_pipeline, read_back};
+use super::pipeline::{bind_group, compute_pipeline, read_back, Buffers};
 use crate::cd::{Contact, Partner, Schedule, Solved, Sweeps, WallMotion, MAX_COLOURS, MEASURE_BLOCK};
 use crate::state::Body;
 use crate::engine::SimError;
-use crate::kernels::{CdKernel, CD_KERNELS};
+use crate::kernels::{Buf, CdKernel, CD_KERNELS};
 use crate::real::Vec3;
-use std::collections::HashMap;
 
 /// Most sweeps recorded in one submission.
 pub const MAX_SWEEPS_PER_SUBMIT: u32 = 32;
@@ -28,7 +27,7 @@ pub struct GpuSweeps {
     gpu: Gpu,
     /// Each kernel's bind group layout and pipeline, indexed by [`CdKernel`].
     pipelines: Vec<(wgpu::BindGroupLayout, wgpu::ComputePipeline)>,
-    buffers: HashMap<&'static str, wgpu::Buffer>,
+    buffers: Buffers,
     /// Each kernel's bind group, indexed by [`CdKernel`].
     bind_groups: Vec<wgpu::BindGroup>,
     /// Contacts the contact buffers hold.
@@ -42,39 +41,39 @@ impl GpuSweeps {
     pub fn new(gpu: Gpu, grains: usize, walls: usize) -> Self {
         let pipelines = CD_KERNELS.iter().map(|k| compute_pipeline(&gpu.device, k, &[])).collect();
         let colour_stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<CdColour>() as u64);
-        let mut sweeps = GpuSweeps { gpu, pipelines, buffers: HashMap::new(), bind_groups: Vec::new(), capacity: 0, colour_stride };
+        let mut sweeps = GpuSweeps { gpu, pipelines, buffers: Buffers::default(), bind_groups: Vec::new(), capacity: 0, colour_stride };
         let uniform = wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST;
-        sweeps.buffer("cd", std::mem::size_of::<CdParams>() as u64, uniform);
-        sweeps.buffer("phase", MAX_COLOURS as u64 * colour_stride, uniform);
-        sweeps.buffer("vel", 16 * grains.max(1) as u64, Self::STORAGE);
-        sweeps.buffer("omega", 16 * grains.max(1) as u64, Self::STORAGE);
-        sweeps.buffer("wall_vel", 16 * walls.max(1) as u64, Self::STORAGE);
-        sweeps.buffer("sweeps", std::mem::size_of::<CdControl>() as u64, Self::STORAGE);
+        sweeps.buffer(Buf::Cd, std::mem::size_of::<CdParams>() as u64, uniform);
+        sweeps.buffer(Buf::Phase, MAX_COLOURS as u64 * colour_stride, uniform);
+        sweeps.buffer(Buf::Vel, 16 * grains.max(1) as u64, Self::STORAGE);
+        sweeps.buffer(Buf::Omega, 16 * grains.max(1) as u64, Self::STORAGE);
+        sweeps.buffer(Buf::WallVel, 16 * walls.max(1) as u64, Self::STORAGE);
+        sweeps.buffer(Buf::Sweeps, std::mem::size_of::<CdControl>() as u64, Self::STORAGE);
         sweeps.grow(1024);
         sweeps
     }
 
     const STORAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_DST).union(wgpu::BufferUsages::COPY_SRC);
 
-    fn buffer(&mut self, name: &'static str, bytes: u64, usage: wgpu::BufferUsages) {
-        let b = self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size: bytes.max(16), usage, mapped_at_creation: false });
+    fn buffer(&mut self, name: Buf, bytes: u64, usage: wgpu::BufferUsages) {
+        let b = self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name.name()), size: bytes.max(16), usage, mapped_at_creation: false });
         self.buffers.insert(name, b);
     }
 
     /// Contact buffers for `capacity` contacts, and the bind groups over them.
     fn grow(&mut self, capacity: u64) {
         self.capacity = capacity;
-        self.buffer("contacts", capacity * std::mem::size_of::<CdContact>() as u64, Self::STORAGE);
-        self.buffer("impulse", 16 * capacity, Self::STORAGE);
-        self.buffer("measure", 8 * capacity, Self::STORAGE);
-        self.buffer("blocks", 8 * capacity.div_ceil(MEASURE_BLOCK as u64), Self::STORAGE);
+        self.buffer(Buf::Contacts, capacity * std::mem::size_of::<CdContact>() as u64, Self::STORAGE);
+        self.buffer(Buf::Impulse, 16 * capacity, Self::STORAGE);
+        self.buffer(Buf::Measure, 8 * capacity, Self::STORAGE);
+        self.buffer(Buf::Blocks, 8 * capacity.div_ceil(MEASURE_BLOCK as u64), Self::STORAGE);
         self.bind_groups = CdKernel::ALL
             .iter()
             .map(|&id| bind_group(&self.gpu.device, id.name(), id.kernel(), &self.pipelines[id as usize].0, |name| &self.buffers[name], std::mem::size_of::<CdColour>() as u64))
             .collect();
     }
 
-    fn write<T: bytemuck::NoUninit>(&self, name: &str, offset: u64, data: &[T]) {
+    fn write<T: bytemuck::NoUninit>(&self, name: Buf, offset: u64, data: &[T]) {
         if !data.is_empty() {
             self.gpu.queue.write_buffer(&self.buffers[name], offset, bytemuck::cast_slice(data));
         }
@@ -107,9 +106,9 @@ impl GpuSweeps {
         self.gpu.queue.submit([encoder.finish()]);
     }
 
-    fn read(&self, parts: &[(&str, u64)]) -> Result<Vec<Vec<u32>>, SimError> {
+    fn read(&self, parts: &[(Buf, u64)]) -> Result<Vec<Vec<u32>>, SimError> {
         let buffers: Vec<(&wgpu::Buffer, u64, u64)> = parts.iter().map(|&(name, bytes)| (&self.buffers[name], 0, bytes)).collect();
-        read_back(&self.gpu, &buffers).map_err(|reason| SimError::Device { what: parts.iter().map(|p| p.0).collect::<Vec<_>>().join(", "), reason })
+        read_back(&self.gpu, &buffers).map_err(|reason| SimError::Device { what: parts.iter().map(|p| p.0.name()).collect::<Vec<_>>().join(", "), reason })
     }
 }
 
@@ -158,21 +157,21 @@ impl Sweeps<f32> for GpuSweeps {
         let blocks = n.div_ceil(MEASURE_BLOCK as u64);
         let tail = schedule.tail();
         let params = CdParams { n_contacts: n as u32, tail: tail as u32, n_blocks: blocks as u32, max_iterations, tolerance, ..Default::default() };
-        self.write("cd", 0, &[params]);
+        self.write(Buf::Cd, 0, &[params]);
         let colour_sizes: Vec<usize> = schedule.colours().map(|r| r.len()).collect();
         for (k, range) in schedule.colours().enumerate() {
-            self.write("phase", k as u64 * self.colour_stride, &[CdColour { start: range.start as u32, end: range.end as u32, ..Default::default() }]);
+            self.write(Buf::Phase, k as u64 * self.colour_stride, &[CdColour { start: range.start as u32, end: range.end as u32, ..Default::default() }]);
         }
-        self.write("contacts", 0, &contacts.iter().map(pack).collect::<Vec<_>>());
-        self.write("impulse", 0, &contacts.iter().map(|c| vec4(c.r)).collect::<Vec<_>>());
-        self.write("vel", 0, &body.iter().map(|b| vec4(b.vel)).collect::<Vec<_>>());
-        self.write("omega", 0, &body.iter().map(|b| vec4(b.omega)).collect::<Vec<_>>());
-        self.write("wall_vel", 0, &walls.iter().map(|w| vec4(w.vel)).collect::<Vec<_>>());
-        self.write("sweeps", 0, &[CdControl::default()]);
+        self.write(Buf::Contacts, 0, &contacts.iter().map(pack).collect::<Vec<_>>());
+        self.write(Buf::Impulse, 0, &contacts.iter().map(|c| vec4(c.r)).collect::<Vec<_>>());
+        self.write(Buf::Vel, 0, &body.iter().map(|b| vec4(b.vel)).collect::<Vec<_>>());
+        self.write(Buf::Omega, 0, &body.iter().map(|b| vec4(b.omega)).collect::<Vec<_>>());
+        self.write(Buf::WallVel, 0, &walls.iter().map(|w| vec4(w.vel)).collect::<Vec<_>>());
+        self.write(Buf::Sweeps, 0, &[CdControl::default()]);
         let mut batch = 1;
         let control = loop {
             self.record(batch, &colour_sizes, tail < contacts.len(), blocks);
-            let words = self.read(&[("sweeps", std::mem::size_of::<CdControl>() as u64)])?;
+            let words = self.read(&[(Buf::Sweeps, std::mem::size_of::<CdControl>() as u64)])?;
             let control: CdControl = *bytemuck::from_bytes(bytemuck::cast_slice(&words[0]));
             if control.done != 0 {
                 break control;
@@ -180,7 +179,7 @@ impl Sweeps<f32> for GpuSweeps {
             batch = (2 * batch).min(MAX_SWEEPS_PER_SUBMIT);
         };
         let (grains, nw) = (16 * body.len() as u64, 16 * walls.len() as u64);
-        let out = self.read(&[("impulse", 16 * n), ("vel", grains), ("omega", grains), ("wall_vel", nw)])?;
+        let out = self.read(&[(Buf::Impulse, 16 * n), (Buf::Vel, grains), (Buf::Omega, grains), (Buf::WallVel, nw)])?;
         for (c, w) in contacts.iter_mut().zip(out[0].chunks_exact(4)) {
             c.r = vec3(w);
         }

@@ -3,28 +3,60 @@
 
 use super::*;
 
+/// An array the two-level scan runs over (`scan_blocks`, `scan_add`), with its blocks' totals
+/// (scanned in turn as one block whose own total goes to a spare word): one bind group each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(super) enum Scan {
+    /// The hash buckets' counts.
+    Cells,
+    /// Their blocks' totals.
+    CellSums,
+    /// Each grain's pair count.
+    PairStarts,
+    /// Each grain's partner count, for the reverse list.
+    RevStarts,
+    /// The grain arrays' blocks' totals.
+    GrainSums,
+}
+
+impl Scan {
+    const ALL: [Scan; 5] = [Scan::Cells, Scan::CellSums, Scan::PairStarts, Scan::RevStarts, Scan::GrainSums];
+
+    /// The buffers bound as the kernels' `scan_data` and `block_sums`.
+    fn arrays(self) -> [(Buf, Buf); 2] {
+        let (data, sums) = match self {
+            Scan::Cells => (Buf::CellCount, Buf::HashSums),
+            Scan::CellSums => (Buf::HashSums, Buf::SpareSum),
+            Scan::PairStarts => (Buf::PairStart, Buf::GrainSums),
+            Scan::RevStarts => (Buf::RevStart, Buf::GrainSums),
+            Scan::GrainSums => (Buf::GrainSums, Buf::SpareSum),
+        };
+        [(Buf::ScanData, data), (Buf::BlockSums, sums)]
+    }
+}
+
 impl GpuEngine {
     /// The per-pair buffers and their bytes per pair.
-    pub(super) fn pair_buffers(&self) -> [(&'static str, u64); 9] {
+    pub(super) fn pair_buffers(&self) -> [(Buf, u64); 9] {
         let blocks = self.params.hist_blocks as u64;
         [
-            ("bridge_event", if self.history.bridge { 4 } else { 0 }),
-            ("pair_i", 4),
-            ("pair_j", 4),
-            ("rev_pair", 4),
-            ("hist", 16 * blocks),
-            ("out_fi", 16),
+            (Buf::BridgeEvent, if self.history.bridge { 4 } else { 0 }),
+            (Buf::PairI, 4),
+            (Buf::PairJ, 4),
+            (Buf::RevPair, 4),
+            (Buf::Hist, 16 * blocks),
+            (Buf::OutFi, 16),
             // The force on the partner, where it is not the owner's reversed.
-            ("out_fj", if self.model.keeps_both_forces() { 16 } else { 0 }),
-            ("out_ti", 16),
-            ("out_tj", 16),
+            (Buf::OutFj, if self.model.keeps_both_forces() { 16 } else { 0 }),
+            (Buf::OutTi, 16),
+            (Buf::OutTj, 16),
         ]
     }
 
     /// The per-pair buffers' names and sizes for `capacity` pairs (B).
-    pub(super) fn pair_buffer_sizes(&self, capacity: u64) -> Vec<(&'static str, u64)> {
-        let mut sizes: Vec<(&'static str, u64)> = self.pair_buffers().iter().map(|&(name, per_pair)| (name, (per_pair * capacity).max(16))).collect();
-        sizes.push(("pair_rows", (workgroup::rows(capacity) * STAT_ROW as u64 * 4).max(16)));
+    pub(super) fn pair_buffer_sizes(&self, capacity: u64) -> Vec<(Buf, u64)> {
+        let mut sizes: Vec<(Buf, u64)> = self.pair_buffers().iter().map(|&(name, per_pair)| (name, (per_pair * capacity).max(16))).collect();
+        sizes.push((Buf::PairRows, (workgroup::rows(capacity) * STAT_ROW as u64 * 4).max(16)));
         sizes
     }
 
@@ -39,10 +71,10 @@ impl GpuEngine {
     pub(super) fn allocate_pairs(&mut self, capacity: u64) -> Result<(), String> {
         let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
         let out_of_memory = self.gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let grown: Vec<(&'static str, wgpu::Buffer)> = self
+        let grown: Vec<(Buf, wgpu::Buffer)> = self
             .pair_buffer_sizes(capacity)
             .into_iter()
-            .map(|(name, size)| (name, self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name), size, usage: storage, mapped_at_creation: false })))
+            .map(|(name, size)| (name, self.gpu.device.create_buffer(&wgpu::BufferDescriptor { label: Some(name.name()), size, usage: storage, mapped_at_creation: false })))
             .collect();
         if let Some(e) = pollster::block_on(out_of_memory.pop()) {
             return Err(e.to_string());
@@ -56,7 +88,7 @@ impl GpuEngine {
         }
         self.gpu.queue.submit([encoder.finish()]);
         self.params.pair_capacity = capacity as u32;
-        self.gpu.queue.write_buffer(&self.buffers["params"], 0, bytemuck::bytes_of(&self.params));
+        self.gpu.queue.write_buffer(&self.buffers[Buf::Params], 0, bytemuck::bytes_of(&self.params));
         Ok(())
     }
 
@@ -97,29 +129,21 @@ impl GpuEngine {
     /// Bind groups: one per kernel, and one per scanned array for the scan kernels.
     pub(super) fn build_bind_groups(&mut self) {
         self.bind_groups.clear();
-        // Each scanned array, and its block totals (scanned in turn as one block whose own
-        // total goes to a spare word).
-        let scans: [(&str, &str, &str); 5] = [
-            ("cell", "cell_count", "hash_sums"),
-            ("cell_sums", "hash_sums", "spare_sum"),
-            ("pairs", "pair_start", "grain_sums"),
-            ("rev", "rev_start", "grain_sums"),
-            ("grain_sums", "grain_sums", "spare_sum"),
-        ];
         for &id in StepKernel::ALL {
             let k = id.kernel();
-            let instances: Vec<(String, Vec<(&str, &str)>)> = if matches!(id, StepKernel::ScanBlocks | StepKernel::ScanAdd) {
-                scans.iter().map(|(tag, data, sums)| (format!("{}:{tag}", k.name), vec![("scan_data", *data), ("block_sums", *sums)])).collect()
-            } else {
-                vec![(k.name.to_string(), vec![])]
-            };
-            for (key, aliases) in instances {
-                let buffer = |name: &str| {
-                    let buffer_name = aliases.iter().chain(&REBUILD_SCRATCH).find(|(a, _)| *a == name).map_or(name, |(_, b)| *b);
-                    self.buffers.get(buffer_name).unwrap_or_else(|| panic!("kernel {} binds {buffer_name}, which the engine lacks", k.name))
+            let scans: Vec<Option<Scan>> = if matches!(id, StepKernel::ScanBlocks | StepKernel::ScanAdd) { Scan::ALL.iter().copied().map(Some).collect() } else { vec![None] };
+            for scan in scans {
+                let arrays = scan.map(Scan::arrays);
+                let buffer = |name: Buf| {
+                    let held = arrays.iter().flatten().chain(&REBUILD_SCRATCH).find(|(a, _)| *a == name).map_or(name, |(_, b)| *b);
+                    &self.buffers[held]
                 };
-                let bg = crate::gpu::pipeline::bind_group(&self.gpu.device, &key, k, &self.layouts[id as usize], buffer, std::mem::size_of::<Phase>() as u64);
-                self.bind_groups.insert(key, bg);
+                let label = match scan {
+                    Some(scan) => format!("{}:{scan:?}", k.name),
+                    None => k.name.to_string(),
+                };
+                let bg = crate::gpu::pipeline::bind_group(&self.gpu.device, &label, k, &self.layouts[id as usize], buffer, std::mem::size_of::<Phase>() as u64);
+                self.bind_groups.insert((id, scan), bg);
             }
         }
     }

@@ -75,7 +75,7 @@ impl Engine for GpuEngine {
         if self.servo.is_none() {
             return;
         }
-        let buffer = &self.buffers["servo"];
+        let buffer = &self.buffers[Buf::Servo];
         let at = |offset: usize| offset as u64;
         if let Some(p) = pressure {
             self.gpu.queue.write_buffer(buffer, at(std::mem::offset_of!(layout::Servo, pressure)), bytemuck::bytes_of(&(p as f32)));
@@ -86,7 +86,7 @@ impl Engine for GpuEngine {
     }
 
     fn memory_bytes(&self) -> u64 {
-        self.buffers.values().map(wgpu::Buffer::size).sum()
+        self.buffers.bytes()
     }
 
     fn dispatches(&self) -> Option<u64> {
@@ -101,15 +101,15 @@ impl Engine for GpuEngine {
         if let Some(w) = self.piston {
             let base = (w * std::mem::size_of::<layout::Wall>()) as u64;
             let queue = &self.gpu.queue;
-            queue.write_buffer(&self.buffers["walls"], base + std::mem::offset_of!(layout::Wall, point) as u64 + 8, bytemuck::bytes_of(&(z as f32)));
-            queue.write_buffer(&self.buffers["walls"], base + std::mem::offset_of!(layout::Wall, velocity) as u64 + 8, bytemuck::bytes_of(&0.0f32));
+            queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, point) as u64 + 8, bytemuck::bytes_of(&(z as f32)));
+            queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, velocity) as u64 + 8, bytemuck::bytes_of(&0.0f32));
         }
     }
 
     fn set_piston_pressure(&mut self, pressure: f64) {
         if let Some(w) = self.piston {
             let offset = (w * std::mem::size_of::<layout::Wall>() + std::mem::offset_of!(layout::Wall, piston) + 8) as u64;
-            self.gpu.queue.write_buffer(&self.buffers["walls"], offset, bytemuck::bytes_of(&(pressure as f32)));
+            self.gpu.queue.write_buffer(&self.buffers[Buf::Walls], offset, bytemuck::bytes_of(&(pressure as f32)));
         }
     }
 }

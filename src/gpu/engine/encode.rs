@@ -1,5 +1,6 @@
 //! Encoding the step: the plan's dispatches into a compute pass.
 
+use super::buffers::Scan;
 use super::*;
 
 /// The steps' own sizes: every grain, or one workgroup, until a pair buffer overflow stops
@@ -19,12 +20,12 @@ pub(super) enum Size {
 }
 
 impl GpuEngine {
-    pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass, kernel: StepKernel, group: &str, size: Size, phase: Option<Phase>) {
+    pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass, kernel: StepKernel, scan: Option<Scan>, size: Size, phase: Option<Phase>) {
         pass.set_pipeline(&self.pipelines[kernel as usize]);
         // A kernel with a phase binding is given its phase; the others none.
         let slot = |p: Phase| self.phases.iter().position(|q| *q == p).expect("every phase of the plans has a uniform slot");
         let offsets: Vec<u32> = phase.map(|p| (slot(p) as u64 * self.phase_stride) as u32).into_iter().collect();
-        pass.set_bind_group(0, &self.bind_groups[group], &offsets);
+        pass.set_bind_group(0, &self.bind_groups[&(kernel, scan)], &offsets);
         self.dispatches.set(self.dispatches.get() + 1);
         match size {
             Size::Grains => {
@@ -32,24 +33,24 @@ impl GpuEngine {
                 pass.dispatch_workgroups(x, y, 1);
             }
             Size::One => pass.dispatch_workgroups(1, 1, 1),
-            Size::Indirect(slot) => pass.dispatch_workgroups_indirect(&self.buffers["args"], slot * std::mem::size_of::<DispatchArgs>() as u64),
+            Size::Indirect(slot) => pass.dispatch_workgroups_indirect(&self.buffers[Buf::Args], slot * std::mem::size_of::<DispatchArgs>() as u64),
         }
     }
 
     pub(super) fn run(&self, pass: &mut wgpu::ComputePass, kernel: StepKernel, size: Size, phase: Option<Phase>) {
-        self.dispatch(pass, kernel, kernel.name(), size, phase);
+        self.dispatch(pass, kernel, None, size, phase);
     }
 
     /// Exclusive scan of an array of `elements`: blocks, the blocks' totals, then the offsets
     /// added back (the last two only when there is more than one block).
-    pub(super) fn scan(&self, pass: &mut wgpu::ComputePass, tag: &str, sums_tag: &str, blocks: u64, elements: u64) {
-        self.dispatch(pass, StepKernel::ScanBlocks, &format!("scan_blocks:{tag}"), Size::Indirect(blocks), None);
+    pub(super) fn scan(&self, pass: &mut wgpu::ComputePass, array: Scan, sums: Scan, blocks: u64, elements: u64) {
+        self.dispatch(pass, StepKernel::ScanBlocks, Some(array), Size::Indirect(blocks), None);
         // An array of one block is scanned by then: its offset would be 0.
         if elements <= SCAN_BLOCK {
             return;
         }
-        self.dispatch(pass, StepKernel::ScanBlocks, &format!("scan_blocks:{sums_tag}"), Size::Indirect(args::ONE), None);
-        self.dispatch(pass, StepKernel::ScanAdd, &format!("scan_add:{tag}"), Size::Indirect(blocks), None);
+        self.dispatch(pass, StepKernel::ScanBlocks, Some(sums), Size::Indirect(args::ONE), None);
+        self.dispatch(pass, StepKernel::ScanAdd, Some(array), Size::Indirect(blocks), None);
     }
 
     /// `decide_rebuild` and the rebuild kernels, which run with zero workgroups when the
@@ -74,7 +75,7 @@ impl GpuEngine {
             self.run(pass, StepKernel::RemapHistory, Size::Indirect(args::NEW_PAIRS), None);
         }
         self.run(pass, StepKernel::ReverseCount, Size::Indirect(args::NEW_PAIRS), None);
-        self.scan(pass, "rev", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
+        self.scan(pass, Scan::RevStarts, Scan::GrainSums, args::GRAIN_BLOCKS, self.n as u64 + 1);
         self.run(pass, StepKernel::ReverseFill, Size::Indirect(args::NEW_PAIRS), None);
         self.run(pass, StepKernel::ReverseSort, Size::Indirect(args::GRAINS), None);
     }
@@ -84,10 +85,10 @@ impl GpuEngine {
     pub(super) fn encode_pair_count(&self, pass: &mut wgpu::ComputePass) {
         self.run(pass, StepKernel::ClearCells, Size::Indirect(args::HASH), None);
         self.run(pass, StepKernel::HashCells, Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "cell", "cell_sums", args::HASH_BLOCKS, self.params.hash_size as u64);
+        self.scan(pass, Scan::Cells, Scan::CellSums, args::HASH_BLOCKS, self.params.hash_size as u64);
         self.run(pass, StepKernel::ScatterCells, Size::Indirect(args::GRAINS), None);
         self.run(pass, StepKernel::DetectCount, Size::Indirect(args::GRAINS), None);
-        self.scan(pass, "pairs", "grain_sums", args::GRAIN_BLOCKS, self.n as u64 + 1);
+        self.scan(pass, Scan::PairStarts, Scan::GrainSums, args::GRAIN_BLOCKS, self.n as u64 + 1);
     }
 
     /// The kernels of a plan entry other than the rebuild check, with their sizes and phases

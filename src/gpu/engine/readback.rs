@@ -25,14 +25,14 @@ impl GpuEngine {
     /// Copies buffers out: `(buffer, offset, bytes)` each, returned in order as 4-byte words
     /// (every type the kernels share is 4-byte aligned); a device that fails to answer is a
     /// [`SimError::Device`] naming the buffers.
-    pub(super) fn read(&self, parts: &[(&str, u64, u64)]) -> Result<Vec<Vec<u32>>, SimError> {
+    pub(super) fn read(&self, parts: &[(Buf, u64, u64)]) -> Result<Vec<Vec<u32>>, SimError> {
         let buffers: Vec<(&wgpu::Buffer, u64, u64)> = parts.iter().map(|&(name, offset, bytes)| (&self.buffers[name], offset, bytes)).collect();
-        super::super::pipeline::read_back(&self.gpu, &buffers).map_err(|reason| SimError::Device { what: parts.iter().map(|p| p.0).collect::<Vec<_>>().join(", "), reason })
+        super::super::pipeline::read_back(&self.gpu, &buffers).map_err(|reason| SimError::Device { what: parts.iter().map(|p| p.0.name()).collect::<Vec<_>>().join(", "), reason })
     }
 
     /// Reads the control flags and counters back (and keeps them).
     pub(super) fn read_control(&mut self) -> Result<Control, SimError> {
-        let c = self.read(&[("control", 0, std::mem::size_of::<Control>() as u64)])?;
+        let c = self.read(&[(Buf::Control, 0, std::mem::size_of::<Control>() as u64)])?;
         self.control = *bytemuck::from_bytes(bytemuck::cast_slice(&c[0]));
         Ok(self.control)
     }
@@ -72,11 +72,11 @@ impl GpuEngine {
     /// `decide_rebuild` set them (the steps' own too), the trace cut back to the rebuild.
     fn go_on_after_stop(&mut self, mark: RebuildMark) {
         let queue = &self.gpu.queue;
-        queue.write_buffer(&self.buffers["control"], std::mem::offset_of!(Control, pair_overflow) as u64, bytemuck::bytes_of(&0u32));
+        queue.write_buffer(&self.buffers[Buf::Control], std::mem::offset_of!(Control, pair_overflow) as u64, bytemuck::bytes_of(&0u32));
         let n = self.n as u64;
         let at = |slot: u64| slot * std::mem::size_of::<DispatchArgs>() as u64;
         for (slot, a) in [(args::GRAINS, DispatchArgs::items(n)), (args::GRAIN_BLOCKS, DispatchArgs::scan_blocks(n + 1)), (args::ONE, DispatchArgs::ONE), (args::STEP_GRAINS, DispatchArgs::items(n)), (args::STEP_ONE, DispatchArgs::ONE)] {
-            queue.write_buffer(&self.buffers["args"], at(slot), bytemuck::bytes_of(&a));
+            queue.write_buffer(&self.buffers[Buf::Args], at(slot), bytemuck::bytes_of(&a));
         }
         (self.step, self.time) = (mark.step, mark.time);
         self.trace.keep_first(mark.traced);
@@ -101,7 +101,7 @@ impl GpuEngine {
     /// The number of pairs the last rebuild's count found (the end of `pair_start`), which
     /// may exceed the buffers' capacity.
     fn listed_pairs(&self) -> Result<u64, SimError> {
-        Ok(self.read(&[("pair_start", 4 * self.n as u64, 4)])?[0][0] as u64)
+        Ok(self.read(&[(Buf::PairStart, 4 * self.n as u64, 4)])?[0][0] as u64)
     }
 
     /// Grows the pair buffers, keeping what they hold, to [`PAIR_GROWTH`] times `pairs` when
@@ -143,25 +143,25 @@ impl GpuEngine {
         }
         self.gpu.queue.submit([encoder.finish()]);
         let pairs = self.listed_pairs()?;
-        self.gpu.queue.write_buffer(&self.buffers["control"], 0, bytemuck::bytes_of(&self.control));
+        self.gpu.queue.write_buffer(&self.buffers[Buf::Control], 0, bytemuck::bytes_of(&self.control));
         self.grow_pairs(with_margin(pairs, PAIR_HEADROOM), pairs)
     }
 
     /// Rebuilds the neighbour list at the next step, whatever the displacements.
     pub fn rebuild_next_step(&mut self) {
-        self.gpu.queue.write_buffer(&self.buffers["control"], 0, bytemuck::bytes_of(&f32::INFINITY.to_bits()));
+        self.gpu.queue.write_buffer(&self.buffers[Buf::Control], 0, bytemuck::bytes_of(&f32::INFINITY.to_bits()));
     }
 
     /// The pair list (CSR: starts per grain, partners), read back.
     pub fn pair_list(&mut self) -> Result<(Vec<u32>, Vec<u32>), SimError> {
         let n_pairs = self.read_control()?.n_pairs as u64;
-        let parts = self.read(&[("pair_start", 0, 4 * (self.n as u64 + 1)), ("pair_j", 0, 4 * n_pairs)])?;
+        let parts = self.read(&[(Buf::PairStart, 0, 4 * (self.n as u64 + 1)), (Buf::PairJ, 0, 4 * n_pairs)])?;
         Ok((parts[0].clone(), parts[1].clone()))
     }
 
     /// Force and torque on each grain from the last force evaluation (N, N m), read back.
     pub fn loads(&self) -> Result<Vec<GrainLoad>, SimError> {
-        let a = self.read_vec4s(&["force", "torque"])?;
+        let a = self.read_vec4s(&[Buf::Force, Buf::Torque])?;
         Ok(a[0].iter().zip(&a[1]).map(|(f, t)| ([f[0], f[1], f[2]], [t[0], t[1], t[2]])).collect())
     }
 
@@ -173,7 +173,7 @@ impl GpuEngine {
         let crate::model::CohesionLaw::Capillary { kappa, theta, c } = self.model.cohesion else { return Ok((0, 0.0, 0.0, 0.0)) };
         let blocks = self.params.hist_blocks as usize;
         let n = self.n as u64;
-        let parts = self.read(&[("hist", 0, 16 * n_pairs * blocks as u64), ("liquid", 0, 4 * n), ("pos", 0, 16 * n), ("pair_i", 0, 4 * n_pairs), ("pair_j", 0, 4 * n_pairs), ("residual", 0, 16 * n)])?;
+        let parts = self.read(&[(Buf::Hist, 0, 16 * n_pairs * blocks as u64), (Buf::Liquid, 0, 4 * n), (Buf::Pos, 0, 16 * n), (Buf::PairI, 0, 4 * n_pairs), (Buf::PairJ, 0, 4 * n_pairs), (Buf::Residual, 0, 16 * n)])?;
         let residual: &[[f32; 4]] = bytemuck::cast_slice(&parts[5]);
         let hist: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
         let liquid: &[f32] = bytemuck::cast_slice(&parts[1]);
@@ -196,8 +196,8 @@ impl GpuEngine {
     }
 
     /// Reads grain arrays back (vec4 per grain).
-    pub(super) fn read_vec4s(&self, names: &[&str]) -> Result<Vec<Vec<[f32; 4]>>, SimError> {
-        let parts: Vec<(&str, u64, u64)> = names.iter().map(|n| (*n, 0, 16 * self.n as u64)).collect();
+    pub(super) fn read_vec4s(&self, names: &[Buf]) -> Result<Vec<Vec<[f32; 4]>>, SimError> {
+        let parts: Vec<(Buf, u64, u64)> = names.iter().map(|&n| (n, 0, 16 * self.n as u64)).collect();
         Ok(self.read(&parts)?.into_iter().map(|b| bytemuck::cast_slice(&b).to_vec()).collect())
     }
 
@@ -214,11 +214,11 @@ impl GpuEngine {
         self.gpu.queue.submit([encoder.finish()]);
         let n_walls = self.wall_names.len();
         let parts = self.read(&[
-            ("control", 0, std::mem::size_of::<Control>() as u64),
-            ("stats", 0, 2 * STAT_ROW as u64 * 4),
-            ("wall_reaction", 0, MAX_WALLS as u64 * 16),
-            ("walls", 0, (n_walls.max(1) * std::mem::size_of::<layout::Wall>()) as u64),
-            ("servo", 0, std::mem::size_of::<layout::Servo>() as u64),
+            (Buf::Control, 0, std::mem::size_of::<Control>() as u64),
+            (Buf::Stats, 0, 2 * STAT_ROW as u64 * 4),
+            (Buf::WallReaction, 0, MAX_WALLS as u64 * 16),
+            (Buf::Walls, 0, (n_walls.max(1) * std::mem::size_of::<layout::Wall>()) as u64),
+            (Buf::Servo, 0, std::mem::size_of::<layout::Servo>() as u64),
         ])?;
         let control: Control = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[0]));
         let servo: layout::Servo = *bytemuck::from_bytes(bytemuck::cast_slice(&parts[4]));

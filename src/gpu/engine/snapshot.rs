@@ -64,9 +64,9 @@ impl GpuEngine {
         let n_walls = self.wall_names.len();
         let blocks = self.params.hist_blocks as usize;
         let parts = self.read(&[
-            ("material", 0, 4 * self.n as u64),
-            ("walls", 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64),
-            ("wall_hist", 0, if blocks > 0 { 16 * (self.n as usize * n_walls * blocks) as u64 } else { 0 }),
+            (Buf::Material, 0, 4 * self.n as u64),
+            (Buf::Walls, 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64),
+            (Buf::WallHist, 0, if blocks > 0 { 16 * (self.n as usize * n_walls * blocks) as u64 } else { 0 }),
         ])?;
         // Copied out: a wall's vectors are 16-byte aligned, the words read back 4.
         let walls: Vec<layout::Wall> = bytemuck::pod_collect_to_vec(&parts[1]);
@@ -103,9 +103,9 @@ impl GpuEngine {
     /// The grain state, and the touching pairs and wall contacts with their forces when
     /// `contacts`.
     pub(super) fn snapshot(&self, contacts: bool) -> Result<Frame, SimError> {
-        let mut names = vec!["pos", "vel", "omega", "residual"];
+        let mut names = vec![Buf::Pos, Buf::Vel, Buf::Omega, Buf::Residual];
         if self.track_orientation {
-            names.push("quat");
+            names.push(Buf::Quat);
         }
         let arrays = self.read_vec4s(&names)?;
         let (pos, residual) = (&arrays[0], &arrays[3]);
@@ -116,7 +116,7 @@ impl GpuEngine {
             let blocks = self.params.hist_blocks as u64;
             let rolling_block = self.history.tangential as usize;
             let both = self.model.keeps_both_forces();
-            let parts = self.read(&[("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("out_fi", 0, 16 * np), ("out_fj", 0, if both { 16 * np } else { 0 }), ("hist", 0, 16 * np * blocks), ("out_tj", 0, 16 * np)])?;
+            let parts = self.read(&[(Buf::PairI, 0, 4 * np), (Buf::PairJ, 0, 4 * np), (Buf::OutFi, 0, 16 * np), (Buf::OutFj, 0, if both { 16 * np } else { 0 }), (Buf::Hist, 0, 16 * np * blocks), (Buf::OutTj, 0, 16 * np)])?;
             let (pi, pj): (&[u32], &[u32]) = (&parts[0], &parts[1]);
             let fi: &[[f32; 4]] = bytemuck::cast_slice(&parts[2]);
             let fj: &[[f32; 4]] = bytemuck::cast_slice(&parts[3]);
@@ -172,7 +172,7 @@ impl GpuEngine {
         if n_walls == 0 {
             return Ok(Vec::new());
         }
-        let parts = self.read(&[("walls", 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64)])?;
+        let parts = self.read(&[(Buf::Walls, 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64)])?;
         Ok(bytemuck::pod_collect_to_vec::<u32, layout::Wall>(&parts[0]).iter().map(|w| wall_geom(w).f64()).collect())
     }
 
@@ -185,7 +185,7 @@ impl GpuEngine {
         // The liquid goes to the pairs of the current list.
         self.ensure_loads()?;
         let (n, np, blocks) = (self.n as u64, self.read_control()?.n_pairs as u64, self.params.hist_blocks as u64);
-        let parts = self.read(&[("pos", 0, 16 * n), ("pair_i", 0, 4 * np), ("pair_j", 0, 4 * np), ("hist", 0, 16 * np * blocks), ("liquid", 0, 4 * n), ("residual", 0, 16 * n)])?;
+        let parts = self.read(&[(Buf::Pos, 0, 16 * n), (Buf::PairI, 0, 4 * np), (Buf::PairJ, 0, 4 * np), (Buf::Hist, 0, 16 * np * blocks), (Buf::Liquid, 0, 4 * n), (Buf::Residual, 0, 16 * n)])?;
         let pos: &[[f32; 4]] = bytemuck::cast_slice(&parts[0]);
         let residual: &[[f32; 4]] = bytemuck::cast_slice(&parts[5]);
         let (pi, pj) = (&parts[1], &parts[2]);
@@ -209,8 +209,8 @@ impl GpuEngine {
         for l in &mut liquid {
             *l += rest;
         }
-        self.gpu.queue.write_buffer(&self.buffers["hist"], 0, bytemuck::cast_slice(&hist));
-        self.gpu.queue.write_buffer(&self.buffers["liquid"], 0, bytemuck::cast_slice(&liquid));
+        self.gpu.queue.write_buffer(&self.buffers[Buf::Hist], 0, bytemuck::cast_slice(&hist));
+        self.gpu.queue.write_buffer(&self.buffers[Buf::Liquid], 0, bytemuck::cast_slice(&liquid));
         self.forces_valid = false;
         Ok(())
     }
@@ -219,11 +219,12 @@ impl GpuEngine {
     pub(super) fn save_state(&self) -> Result<crate::engine::EngineState, SimError> {
         let mut s = crate::engine::EngineState::default();
         let n_pairs = self.control.n_pairs as u64;
-        let per_pair: HashMap<&str, u64> = self.pair_buffers().into_iter().collect();
-        let mut names: Vec<&'static str> = self.buffers.keys().copied().filter(|name| !NOT_STATE.contains(name)).collect();
-        names.sort_unstable();
-        let parts: Vec<(&str, u64, u64)> = names.iter().map(|&name| (name, 0, per_pair.get(name).map_or(self.buffers[name].size(), |b| b * n_pairs))).collect();
-        for (name, words) in names.iter().zip(self.read(&parts)?) {
+        let per_pair: HashMap<Buf, u64> = self.pair_buffers().into_iter().collect();
+        // In the order of their names, as checkpoints have always listed them.
+        let mut names: Vec<Buf> = self.buffers.iter().map(|(name, _)| name).filter(|name| !NOT_STATE.contains(name)).collect();
+        names.sort_unstable_by_key(|name| name.name());
+        let parts: Vec<(Buf, u64, u64)> = names.iter().map(|&name| (name, 0, per_pair.get(&name).map_or(self.buffers[name].size(), |b| b * n_pairs))).collect();
+        for (name, words) in names.iter().map(|name| name.name()).zip(self.read(&parts)?) {
             // Two 4-byte words per stored integer, the first in the low half.
             s.put_ints(&format!("gpu:{name}"), words.chunks(2).map(|c| c[0] as u64 | (c.get(1).copied().unwrap_or(0) as u64) << 32));
         }
@@ -241,7 +242,7 @@ impl GpuEngine {
         }
         for (key, words) in &s.ints {
             let Some(name) = key.strip_prefix("gpu:") else { continue };
-            let buffer = self.buffers.get(name).ok_or_else(|| anyhow::anyhow!("the checkpoint holds a GPU buffer `{name}` this engine lacks; fix: resume with the grains version that wrote it"))?;
+            let buffer = Buf::of_name(name).and_then(|b| self.buffers.get(b)).ok_or_else(|| anyhow::anyhow!("the checkpoint holds a GPU buffer `{name}` this engine lacks; fix: resume with the grains version that wrote it"))?;
             let bytes: Vec<u8> = words.iter().flat_map(|&w| w.to_le_bytes()).collect();
             // A list of an odd number of words was padded with one (beyond the live pairs).
             if bytes.len() as u64 > buffer.size() + 4 {

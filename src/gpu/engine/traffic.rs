@@ -12,7 +12,7 @@ impl GpuEngine {
     pub(super) fn traffic(&self) -> Vec<(&'static str, u64)> {
         let pairs = self.control.n_pairs as u64;
         let per_pair = self.pair_buffers();
-        let used = |name: &str| match per_pair.iter().find(|p| p.0 == name) {
+        let used = |name: Buf| match per_pair.iter().find(|p| p.0 == name) {
             Some(&(_, bytes)) => bytes * pairs,
             None => self.buffers.get(name).map_or(0, wgpu::Buffer::size),
         };
