@@ -12,7 +12,6 @@ pub mod compare;
 pub mod cpu;
 pub mod engine;
 pub mod gpu;
-pub mod kernels;
 pub mod lammps;
 pub mod model;
 pub mod output;

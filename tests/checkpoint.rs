@@ -13,14 +13,9 @@ use std::process::Command;
 
 /// Three stages of a frictional, twisting, spinning gas in a box with a piston: every kind of
 /// history (tangential springs, wall springs, orientation, piston) crosses the boundaries.
-const SCENE: &str = r#"
+const SCENE: &str = concat!(r#"
 seed = 21
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
+"#, include_str!("fixtures/sand.toml"), r#"mu_s = 0.5
 restitution = 0.6
 [[generate]]
 material = "sand"
@@ -59,7 +54,7 @@ piston_pressure = 200.0
 [[stage]]
 kind = "run"
 duration = 2.0e-3
-"#;
+"#);
 
 /// SCENE with a checkpoint at every statistics read inside a stage.
 fn checkpointing_within_stages() -> String {

@@ -13,13 +13,8 @@ use grains::protocol;
 /// Two grains falling side by side, far from each other and from everything: no contact, and
 /// gravity acting. Checkpoints at every statistics read; the second stage starts after a fill
 /// cut short, so its checkpoint carries the fill's result too.
-const SCENE: &str = r#"
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-[[grain]]
+const SCENE: &str = concat!(r#"
+"#, include_str!("fixtures/sand.toml"), r#"[[grain]]
 material = "sand"
 radius = 5.0e-4
 position = [0.0, 0.0, 0.1]
@@ -37,7 +32,7 @@ kind = "run"
 duration = 1.0e-3
 [output]
 checkpoint_interval = 1.0e-9
-"#;
+"#);
 
 #[test]
 fn a_checkpoint_taken_while_no_grain_touches_reads_back_and_resumes() {

@@ -11,14 +11,9 @@ use grains::real::Vec3;
 /// Momentum drift allowed relative to the sum of |momentum| of the grains (f64 round-off).
 const MOMENTUM_ROUNDOFF: f64 = 1e-12;
 
-const FRICTIONAL_GAS: &str = r#"
+const FRICTIONAL_GAS: &str = concat!(r#"
 seed = 3
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
+"#, include_str!("fixtures/sand.toml"), r#"mu_s = 0.5
 restitution = 0.6
 
 [[generate]]
@@ -45,7 +40,7 @@ gravity = [0.0, 0.0, 0.0]
 [[stage]]
 kind = "run"
 duration = 1.0e-3
-"#;
+"#);
 
 #[test]
 fn hertz_mindlin_conserves_linear_and_angular_momentum_to_round_off() {
@@ -76,13 +71,8 @@ fn hertz_mindlin_conserves_linear_and_angular_momentum_to_round_off() {
 /// friction `friction`; returns the scene and the engine.
 fn counter_rotating_pair(friction: &str, r: f64, gap: f64) -> (grains::scene::Scene, CpuEngine<f64>) {
     let text = format!(
-        r#"
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
+        concat!(r#"
+"#, include_str!("fixtures/sand.toml"), r#"mu_s = 0.5
 mu_k = 0.4
 rolling_angle = 10.0
 
@@ -109,7 +99,7 @@ dt = 1.0e-8
 [[stage]]
 kind = "run"
 duration = 1.0e-8
-"#
+"#), r = r, friction = friction
     );
     // Listed grains may not start overlapping; put the second one in light contact here.
     let mut scene = common::parse(&text);

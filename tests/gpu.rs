@@ -36,14 +36,9 @@ fn gas_with(periodic: bool, material: &str, model: &str) -> Scene {
         "[[wall]]\ntype = \"box\"\nmaterial = \"sand\"\nmin = [0.0, 0.0, 0.0]\nmax = [16.0e-3, 16.0e-3, 16.0e-3]\n"
     };
     common::parse(&format!(
-        r#"
+        concat!(r#"
 seed = 4
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
+"#, include_str!("fixtures/sand.toml"), r#"mu_s = 0.5
 {material}
 [[generate]]
 material = "sand"
@@ -60,7 +55,7 @@ skin = 3.0e-4
 [[stage]]
 kind = "run"
 duration = 1.0e-3
-"#
+"#), material = material, walls = walls, model = model
     ))
 }
 

@@ -34,13 +34,8 @@ fn has_lammps() -> bool {
 /// in x and y with a floor.
 fn reading(dir: &Path, name: &str, file: &str, format: &str) -> Scene {
     let text = format!(
-        r#"
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-restitution = 0.5
+        concat!(r#"
+"#, include_str!("fixtures/sand.toml"), r#"restitution = 0.5
 [[material]]
 name = "steel"
 density = 7800.0
@@ -67,7 +62,7 @@ dt = 1.0e-7
 [[stage]]
 kind = "run"
 duration = 1.0e-6
-"#
+"#), file = file, format = format
     );
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
@@ -109,13 +104,8 @@ fn lammps_data_and_dump_of_the_same_atoms_read_as_the_same_grains() {
     }
 }
 
-const RUN: &str = r#"
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
+const RUN: &str = concat!(r#"
+"#, include_str!("fixtures/sand.toml"), r#"mu_s = 0.5
 restitution = 0.5
 [[material]]
 name = "glass"
@@ -152,7 +142,7 @@ dt = "auto"
 [[stage]]
 kind = "run"
 duration = 0.03
-"#;
+"#);
 
 /// The atoms of a data file LAMMPS wrote, read by grains' reader.
 fn lammps_wrote(path: &Path) -> grains::lammps::Atoms {

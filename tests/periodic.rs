@@ -50,14 +50,9 @@ fn a_collision_across_the_boundary_equals_the_same_collision_inside() {
 
 #[test]
 fn a_fully_periodic_frictional_gas_conserves_momentum_and_stays_in_the_cell() {
-    let text = r#"
+    let text = concat!(r#"
 seed = 5
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
+"#, include_str!("fixtures/sand.toml"), r#"mu_s = 0.5
 restitution = 0.7
 [[generate]]
 material = "sand"
@@ -77,7 +72,7 @@ gravity = [0.0, 0.0, 0.0]
 [[stage]]
 kind = "run"
 duration = 1.0e-3
-"#;
+"#);
     let scene = common::parse(text);
     let mut e: CpuEngine<f64> = common::engine(&scene);
     let s0 = e.stats().unwrap();

@@ -3,7 +3,7 @@
 //! and field offsets.
 
 use grains::gpu::layout;
-use grains::kernels::{Access, CD_KERNELS, KERNELS};
+use grains::gpu::kernels::{Access, CD_KERNELS, KERNELS};
 use naga::valid::{Capabilities, ValidationFlags, Validator};
 use std::mem::{offset_of, size_of};
 
@@ -153,7 +153,7 @@ macro_rules! check_struct {
 
 #[test]
 fn rust_mirrors_match_the_wgsl_structures() {
-    let src = grains::kernels::shared("types");
+    let src = grains::gpu::kernels::shared("types");
     let m = module(&format!("{src}\n@group(0) @binding(0) var<storage, read_write> c: Control;\n@compute @workgroup_size(1) fn main() {{ atomicStore(&c.max_disp2, 0u); }}"), "types");
     check_struct!(&m, layout::Params, "Params", [
         n_grains, n_walls, n_materials, pair_capacity, hash_size, max_neighbours, piston, hist_blocks,
@@ -201,7 +201,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
 
 #[test]
 fn contact_dynamics_mirrors_match_the_wgsl_structures() {
-    let src = format!("{}\n{}", grains::kernels::shared("types"), grains::kernels::shared("cd"));
+    let src = format!("{}\n{}", grains::gpu::kernels::shared("types"), grains::gpu::kernels::shared("cd"));
     let m = module(&format!("{src}\n@group(0) @binding(0) var<storage, read_write> c: array<CdContact>;\n@group(0) @binding(1) var<uniform> p: CdParams;\n@group(0) @binding(2) var<uniform> k: CdColour;\n@group(0) @binding(3) var<storage, read_write> s: CdControl;\n@compute @workgroup_size(1) fn main() {{ s.iterations = p.n_contacts + k.start + c[0].a; }}"), "cd");
     check_struct!(&m, layout::CdContact, "CdContact", [a, b, to_wall, _pad0, n, radius_a, radius_b, mu, w_n, w_t, inv_mass_a, inv_inertia_a, inv_mass_b, inv_inertia_b, _pad1, _pad2, _pad3]);
     check_struct!(&m, layout::CdParams, "CdParams", [n_contacts, tail, n_blocks, max_iterations, tolerance, _pad0, _pad1, _pad2]);
@@ -219,7 +219,7 @@ fn contact_dynamics_mirrors_match_the_wgsl_structures() {
 /// another.
 #[test]
 fn every_registered_law_has_its_code_and_a_branch_in_the_shaders() {
-    let src = grains::kernels::StepKernel::PairForce.kernel().wgsl();
+    let src = grains::gpu::kernels::StepKernel::PairForce.kernel().wgsl();
     let m = module(&src, "pair_force");
     let prelude = grains::model::wgsl_codes();
     // The model's WGSL without the prelude and without comments: where a law must be named.

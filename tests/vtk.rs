@@ -20,15 +20,10 @@ const F32_ROUNDING: f64 = 1.2e-7;
 /// 80 grains poured into a cylinder on a floor, then pressed by the piston: every wall kind,
 /// orientation tracked, particle pressures (analysis on) and contacts in the MCAP frames for
 /// the comparison.
-const SCENE: &str = r#"
+const SCENE: &str = concat!(r#"
 name = "vtk_cylinder"
 seed = 3
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
+"#, include_str!("fixtures/sand.toml"), r#"mu_s = 0.5
 restitution = 0.5
 [[generate]]
 material = "sand"
@@ -70,7 +65,7 @@ piston_pressure = 50.0
 frame_interval = 2.0e-3
 analysis = true
 contact_forces = true
-"#;
+"#);
 
 fn frames(path: &Path) -> Vec<Frame> {
     let bytes = std::fs::read(path).unwrap();

@@ -1,7 +1,7 @@
 //! Adapters and devices: listing, choosing the best (or a named) adapter, opening it with its
 //! own limits rather than WebGPU's defaults.
 
-use crate::kernels::{Access, CD_KERNELS, KERNELS};
+use crate::gpu::kernels::{Access, CD_KERNELS, KERNELS};
 
 /// Backends tried: Vulkan (every desktop OS, and lavapipe without a GPU), Metal, DX12. GL is
 /// left out: it lacks the storage-buffer counts the kernels need, and with it a missing

@@ -18,7 +18,7 @@ use super::device::Gpu;
 use encode::Size;
 use super::layout::{self, args, Control, DispatchArgs, Params, Phase, MAX_SCAN, MAX_WALLS, NONE, SCAN_BLOCK, STAT_ROW};
 use crate::engine::{ContactRecord, Engine, Frame, PistonStats, SimError, Stats, WallStats};
-use crate::kernels::{Buf, StepKernel};
+use crate::gpu::kernels::{Buf, StepKernel};
 use super::pipeline::Buffers;
 use crate::model::{HistoryLayout, NormalSetup, PairCoeffs, RollingFriction, TangentialLaw};
 use super::plan::{Dispatch, Entry, Plans};

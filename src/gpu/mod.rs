@@ -3,6 +3,7 @@
 
 pub mod device;
 mod engine;
+pub mod kernels;
 pub mod layout;
 mod pipeline;
 mod sweeps;

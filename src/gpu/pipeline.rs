@@ -2,7 +2,7 @@
 //! pipeline, its buffers by name, a bind group over them, and buffers read back to the host.
 
 use super::device::Gpu;
-use crate::kernels::{Access, Buf, Kernel};
+use crate::gpu::kernels::{Access, Buf, Kernel};
 
 /// A solver's device buffers, one per [`Buf`] it uses.
 #[derive(Default)]

@@ -16,7 +16,7 @@ use super::pipeline::{bind_group, compute_pipeline, read_back, Buffers};
 use crate::cd::{Contact, Partner, Schedule, Solved, Sweeps, WallMotion, MAX_COLOURS, MEASURE_BLOCK};
 use crate::state::Body;
 use crate::engine::SimError;
-use crate::kernels::{Buf, CdKernel, CD_KERNELS};
+use crate::gpu::kernels::{Buf, CdKernel, CD_KERNELS};
 use crate::real::Vec3;
 
 /// Most sweeps recorded in one submission.

@@ -96,14 +96,9 @@ pub fn wet_gas() -> Scene {
 /// tracked: many pairs, wall contacts and rebuilds.
 pub fn box_gas(count: usize, side: f64) -> String {
     format!(
-        r#"
+        concat!(r#"
 seed = 11
-[[material]]
-name = "sand"
-density = 2650.0
-youngs_modulus = 7.0e7
-poisson_ratio = 0.3
-mu_s = 0.5
+"#, include_str!("../fixtures/sand.toml"), r#"mu_s = 0.5
 mu_k = 0.4
 rolling_angle = 3.0
 gamma_n = 1.0e5
@@ -133,7 +128,7 @@ track_orientation = true
 [[stage]]
 kind = "run"
 duration = 1.0e-3
-"#
+"#), count = count, side = side
     )
 }
 

@@ -5,7 +5,7 @@
 //! stores to ([`Access::Write`]) written; the per-pair buffers at the live pair count.
 
 use super::*;
-use crate::kernels::Access;
+use crate::gpu::kernels::Access;
 
 impl GpuEngine {
     /// Bytes each kernel of a later step moves, by kernel, in dispatch order.

@@ -132,24 +132,24 @@ pub struct Kernel {
 /// A shared WGSL file by name.
 pub fn shared(name: &str) -> &'static str {
     match name {
-        "types" => include_str!("../shaders/shared/types.wgsl"),
-        "dispatch" => include_str!("../shaders/shared/dispatch.wgsl"),
-        "grid" => include_str!("../shaders/shared/grid.wgsl"),
-        "model" => include_str!("../shaders/shared/model.wgsl"),
-        "model/normal" => include_str!("../shaders/shared/model/normal.wgsl"),
-        "model/damping" => include_str!("../shaders/shared/model/damping.wgsl"),
-        "model/tangential" => include_str!("../shaders/shared/model/tangential.wgsl"),
-        "model/rolling" => include_str!("../shaders/shared/model/rolling.wgsl"),
-        "model/twisting" => include_str!("../shaders/shared/model/twisting.wgsl"),
-        "model/cohesion" => include_str!("../shaders/shared/model/cohesion.wgsl"),
-        "neighbours" => include_str!("../shaders/shared/neighbours.wgsl"),
-        "walls" => include_str!("../shaders/shared/walls.wgsl"),
-        "reduce" => include_str!("../shaders/shared/reduce.wgsl"),
-        "kick" => include_str!("../shaders/shared/kick.wgsl"),
-        "piston" => include_str!("../shaders/shared/piston.wgsl"),
-        "drift" => include_str!("../shaders/shared/drift.wgsl"),
-        "position" => include_str!("../shaders/shared/position.wgsl"),
-        "cd" => include_str!("../shaders/shared/cd.wgsl"),
+        "types" => include_str!("../../shaders/shared/types.wgsl"),
+        "dispatch" => include_str!("../../shaders/shared/dispatch.wgsl"),
+        "grid" => include_str!("../../shaders/shared/grid.wgsl"),
+        "model" => include_str!("../../shaders/shared/model.wgsl"),
+        "model/normal" => include_str!("../../shaders/shared/model/normal.wgsl"),
+        "model/damping" => include_str!("../../shaders/shared/model/damping.wgsl"),
+        "model/tangential" => include_str!("../../shaders/shared/model/tangential.wgsl"),
+        "model/rolling" => include_str!("../../shaders/shared/model/rolling.wgsl"),
+        "model/twisting" => include_str!("../../shaders/shared/model/twisting.wgsl"),
+        "model/cohesion" => include_str!("../../shaders/shared/model/cohesion.wgsl"),
+        "neighbours" => include_str!("../../shaders/shared/neighbours.wgsl"),
+        "walls" => include_str!("../../shaders/shared/walls.wgsl"),
+        "reduce" => include_str!("../../shaders/shared/reduce.wgsl"),
+        "kick" => include_str!("../../shaders/shared/kick.wgsl"),
+        "piston" => include_str!("../../shaders/shared/piston.wgsl"),
+        "drift" => include_str!("../../shaders/shared/drift.wgsl"),
+        "position" => include_str!("../../shaders/shared/position.wgsl"),
+        "cd" => include_str!("../../shaders/shared/cd.wgsl"),
         other => panic!("no shared WGSL file {other}"),
     }
 }
@@ -195,7 +195,7 @@ const STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "wall
 
 macro_rules! kernel {
     ($name:literal, $inc:expr, [$($b:ident: $a:expr),* $(,)?]) => {
-        Kernel { name: $name, source: include_str!(concat!("../shaders/", $name, ".wgsl")), includes: $inc, bindings: &[$((Buf::$b, $a)),*] }
+        Kernel { name: $name, source: include_str!(concat!("../../shaders/", $name, ".wgsl")), includes: $inc, bindings: &[$((Buf::$b, $a)),*] }
     };
 }
 
@@ -265,7 +265,7 @@ kernel_table! {
 }
 
 kernel_table! {
-    /// A kernel of contact dynamics' sweeps ([`crate::gpu::GpuSweeps`]), by name: its row in
+    /// A kernel of contact dynamics' sweeps ([`super::GpuSweeps`]), by name: its row in
     /// [`CD_KERNELS`].
     CdKernel,
     /// Contact dynamics' sweep kernels, in the order a sweep runs them.
