@@ -3,7 +3,7 @@
 //! and turns a [`KeyProblem`] into its error, which names the file, the key, the value and the
 //! fix.
 
-use super::{MaterialConstants, NormalLaw, NormalSetup, TangentialStiffness};
+use super::{MaterialConstants, NormalLaw};
 
 /// The keys of a scene's `[model]` table, by name.
 pub trait LawKeys {
@@ -39,17 +39,6 @@ pub struct LawInput<'a> {
     pub materials: &'a [MaterialUse],
     /// The normal law, for the slots chosen after it (`None` while the normal law is chosen).
     pub normal: Option<&'a NormalLaw<f64>>,
-}
-
-impl LawInput<'_> {
-    /// The tangential spring's stiffness: `kt_ratio` times the normal secant stiffness when
-    /// the scene sets it, else the normal law's default.
-    pub fn tangential_stiffness(&self) -> Result<TangentialStiffness<f64>, KeyProblem> {
-        match self.keys.number("kt_ratio") {
-            Some(_) => Ok(TangentialStiffness::RatioToNormal(required_positive(self.keys, "kt_ratio", "give a ratio such as 2/7")?)),
-            None => Ok(self.normal.map_or(TangentialStiffness::Mindlin, |n| n.default_tangential_stiffness())),
-        }
-    }
 }
 
 /// A key whose value a law refuses.

@@ -2,7 +2,7 @@
 //! `tangential mindlin`, LIGGGHTS `tangential history`). Scene: `tangential = "mindlin"`, with
 //! `tangential_damping_ratio` and `kt_ratio`; the materials' `mu_k` must equal their `mu_s`.
 
-use super::{contact_tangential_velocity, rotate_into_plane, TangentialLaw};
+use super::{contact_tangential_velocity, rotate_into_plane, stiffness_of, TangentialLaw};
 use crate::model::keys::{non_negative_or, KeyProblem, LawInput};
 use crate::model::registry::Entry;
 use crate::model::{Geometry, Kinematics};
@@ -18,7 +18,7 @@ pub(super) const ENTRY: Entry<TangentialLaw<f64>> = Entry {
         }
         Ok(TangentialLaw::Mindlin {
             damping_ratio: non_negative_or(input.keys, "tangential_damping_ratio", 0.0, "give a fraction such as 0.9075")?,
-            stiffness: input.tangential_stiffness()?,
+            stiffness: stiffness_of(input)?,
         })
     },
 };

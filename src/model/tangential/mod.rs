@@ -9,9 +9,9 @@ mod oquendo;
 pub use mindlin::mindlin_tangential;
 pub use oquendo::{oquendo_tangential, OquendoLaw, RollingFriction, TangentialOut};
 
-use super::keys::LawInput;
+use super::keys::{required_positive, KeyProblem, LawInput};
 use super::registry::{Entry, Slot};
-use super::{Geometry, History, Kinematics};
+use super::{Geometry, History, Kinematics, NormalSetup};
 use crate::real::{Real, Vec3};
 
 /// Tangential law.
@@ -50,6 +50,15 @@ pub const SLOT: Slot<TangentialLaw<f64>> = Slot {
     name: "tangential",
     laws: &[Entry { name: "none", keys: &[], parse: |_: &LawInput| Ok(TangentialLaw::None) }, oquendo::ENTRY, mindlin::ENTRY],
 };
+
+/// The spring's stiffness a law with one reads (`kt_ratio` is both laws' key): `kt_ratio` times
+/// the normal secant stiffness when the scene sets it, else the normal law's default.
+fn stiffness_of(input: &LawInput) -> Result<TangentialStiffness<f64>, KeyProblem> {
+    match input.keys.number("kt_ratio") {
+        Some(_) => Ok(TangentialStiffness::RatioToNormal(required_positive(input.keys, "kt_ratio", "give a ratio such as 2/7")?)),
+        None => Ok(input.normal.map_or(TangentialStiffness::Mindlin, |n| n.default_tangential_stiffness())),
+    }
+}
 
 /// The stiffnesses' WGSL codes, `STIFFNESS_<NAME>` (`params.kt_law`).
 pub const STIFFNESS_CODES: &[(&str, u32)] = &[("STIFFNESS_MINDLIN", 0), ("STIFFNESS_RATIO", 1)];

@@ -2,7 +2,7 @@
 //! "Tangential force"). Scene: `tangential = "oquendo"`, with `static_damping`,
 //! `rolling_friction` and `kt_ratio`.
 
-use super::{contact_tangential_velocity, rotate_into_plane, TangentialLaw, TangentialStiffness};
+use super::{contact_tangential_velocity, rotate_into_plane, stiffness_of, TangentialLaw, TangentialStiffness};
 use crate::model::keys::{non_negative_or, KeyProblem, LawInput};
 use crate::model::registry::Entry;
 use crate::model::{Bodies, Geometry, History, Kinematics, PairCoeffs, Regime};
@@ -26,7 +26,7 @@ pub(super) const ENTRY: Entry<TangentialLaw<f64>> = Entry {
         };
         Ok(TangentialLaw::Oquendo(OquendoLaw {
             static_damping: non_negative_or(input.keys, "static_damping", DEFAULT_STATIC_DAMPING, "give a fraction of critical damping such as 0.3")?,
-            stiffness: input.tangential_stiffness()?,
+            stiffness: stiffness_of(input)?,
             rolling_friction,
         }))
     },
