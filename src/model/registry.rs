@@ -1,8 +1,8 @@
 //! A slot's registry (after LAMMPS' `gran_sub_mod_register.cpp`): one row per law, naming it
 //! as scenes write it, the `[model]` keys it owns and how it reads them. Every slot (normal,
 //! damping, tangential, rolling, twisting, cohesion) keeps one in its `mod.rs`; a law's WGSL
-//! code is its row's index, written into the kernels' prelude by [`Slot::wgsl_codes`], so that
-//! the Rust and WGSL codes cannot drift.
+//! code is its row's index, written into the kernels' prelude from [`Slot::codes`]
+//! (`crate::model::wgsl_codes`), so that the Rust and WGSL codes cannot drift.
 
 use super::keys::{KeyProblem, LawInput};
 
@@ -65,10 +65,5 @@ impl<L> Slot<L> {
     /// Each law's WGSL constant and code, `(<SLOT>_<LAW>, row)`.
     pub fn codes(&self) -> impl Iterator<Item = (String, u32)> + '_ {
         self.laws.iter().enumerate().map(|(i, e)| (format!("{}_{}", self.name.to_uppercase(), e.name.to_uppercase()), i as u32))
-    }
-
-    /// The WGSL constants naming each law's code, `const <SLOT>_<LAW>: u32 = <row>u;`.
-    pub fn wgsl_codes(&self) -> String {
-        self.codes().map(|(name, code)| format!("const {name}: u32 = {code}u;\n")).collect()
     }
 }
