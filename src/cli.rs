@@ -177,6 +177,11 @@ pub enum Command {
         /// the pour's order (off), comma-separated: `--reorder on,off` compares the two.
         #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Reorder::On])]
         reorder: Vec<Reorder>,
+        /// Busy threads computing beside each CPU throughput run, competing for the cores as
+        /// other programs would, comma-separated: `--busy 0,1` measures each configuration quiet
+        /// and beside one.
+        #[arg(long, value_delimiter = ',', default_values_t = [0usize])]
+        busy: Vec<usize>,
         /// Particle-steps per timed run (its steps are this over the grain count, at least 20).
         #[arg(long, default_value_t = 5e7)]
         work: f64,

@@ -159,7 +159,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
             Ok(())
         }
-        Command::Bench { sizes, backend, adapter, precision, threads, reorder, work, repeats, part, compaction_grains, cache, bed, out, json } => {
+        Command::Bench { sizes, backend, adapter, precision, threads, reorder, busy, work, repeats, part, compaction_grains, cache, bed, out, json } => {
             let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
             let mut threads = if threads.is_empty() { vec![1, cores] } else { threads };
             threads.dedup();
@@ -177,6 +177,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 precisions: precision.iter().map(|p| if *p == Precision::F32 { "f32".to_string() } else { "f64".to_string() }).collect(),
                 threads,
                 reorder: reorder.iter().map(|r| *r == Reorder::On).collect(),
+                busy,
                 work,
                 repeats: repeats as usize,
                 throughput: matches!(part, BenchPart::Throughput | BenchPart::All),

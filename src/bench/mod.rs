@@ -4,6 +4,7 @@
 
 pub mod bandwidth;
 pub mod bed;
+pub mod busy;
 pub mod compaction;
 pub mod ladder;
 pub mod memory;
@@ -31,6 +32,9 @@ pub struct BenchOptions {
     pub threads: Vec<usize>,
     /// CPU runs with the engine renumbering the grains in cell order (true) and without.
     pub reorder: Vec<bool>,
+    /// Busy threads competing for the cores during each CPU throughput run ([`busy::Busy`]),
+    /// one run per entry: `[0, 1]` measures each configuration quiet and beside one.
+    pub busy: Vec<usize>,
     /// Particle-steps per timed run (the steps are this over the grain count, at least 20).
     pub work: f64,
     /// Timed runs per configuration; the median is reported.
@@ -154,16 +158,25 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
     if opts.throughput {
         for &n in &opts.sizes {
             for backend in &opts.backends {
-                let configs: Vec<(String, usize, bool)> = if backend == "gpu" {
-                    vec![("f32".into(), 1, false)]
+                let configs: Vec<(String, usize, bool, usize)> = if backend == "gpu" {
+                    vec![("f32".into(), 1, false, 0)]
                 } else {
-                    opts.precisions.iter().flat_map(|p| opts.threads.iter().flat_map(move |&t| opts.reorder.iter().map(move |&r| (p.clone(), t, r)))).collect()
+                    let mut configs = Vec::new();
+                    for p in &opts.precisions {
+                        for &t in &opts.threads {
+                            for &r in &opts.reorder {
+                                configs.extend(opts.busy.iter().map(|&b| (p.clone(), t, r, b)));
+                            }
+                        }
+                    }
+                    configs
                 };
-                for (precision, threads, reorder) in configs {
+                for (precision, threads, reorder, busy) in configs {
                     let steps = ((opts.work / n as f64).round() as u64).max(20);
                     let warmup = (steps / 5).max(10);
                     let order = if backend == "gpu" { "" } else if reorder { ", renumbered in cell order" } else { ", in the pour's order" };
-                    say(&format!("{backend} {precision} {threads} thread(s), {n} grains{order}: {warmup} + {} x {steps} steps", opts.repeats));
+                    let beside = if busy > 0 { format!(", beside {busy} busy thread(s)") } else { String::new() };
+                    say(&format!("{backend} {precision} {threads} thread(s), {n} grains{order}{beside}: {warmup} + {} x {steps} steps", opts.repeats));
                     let peak_reset = memory::reset_peak();
                     let row = if backend == "gpu" {
                         let gpu = crate::gpu::open(opts.adapter.as_deref())?;
@@ -182,8 +195,10 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
                                 (true, every) => every,
                             };
                             let mut engine = crate::runner::cpu_engine(&scene, &precision)?;
+                            let _busy = busy::Busy::start(busy);
                             throughput::measure(engine.as_mut(), &machine.cpu, threads, Some(scene.reorder_every), warmup, steps, opts.repeats, peak_reset)
-                        })?
+                        })
+                        .map(|row| Throughput { busy, ..row })?
                     };
                     say(&format!("  {:.3e} particle-steps/s, Z = {:.3}, {:.0} B/grain", row.particle_steps_per_second, row.contacts_per_grain, row.bytes_per_grain));
                     rows.push(row);
@@ -260,7 +275,8 @@ impl BenchReport {
                 s.push_str(&format!("memory bandwidth (STREAM triad), {} thread(s): {:.2} GB/s\n", b.threads, b.triad_bytes_per_second / 1e9));
             }
             s.push_str("(reorder: rebuilds between the CPU engine's renumberings in cell order; 0: the grains stay in the pour's order)\n");
-            s.push_str("backend prec thr reorder    grains  particle-steps/s  spread  ns/p-step     Z  pairs/grain  B/grain  B/p-step  GB/s (of triad)  peak RSS MiB  time shares\n");
+            s.push_str("(busy: threads computing beside the run, competing for the cores as other programs would)\n");
+            s.push_str("backend prec thr busy reorder    grains  particle-steps/s  spread  ns/p-step     Z  pairs/grain  B/grain  B/p-step  GB/s (of triad)  peak RSS MiB  time shares\n");
             for r in &self.throughput {
                 let mut phases = r.phases.clone();
                 phases.sort_by(|a, b| b.share.total_cmp(&a.share));
@@ -272,10 +288,11 @@ impl BenchReport {
                     _ => "-".to_string(),
                 };
                 s.push_str(&format!(
-                    "{:<7} {:<4} {:>3} {:>7} {:>9} {:>17.3e} {:>6.1}% {:>10.1} {:>5.2} {:>12.2} {:>8.0} {:>9} {:>16} {:>13} {}\n",
+                    "{:<7} {:<4} {:>3} {:>4} {:>7} {:>9} {:>17.3e} {:>6.1}% {:>10.1} {:>5.2} {:>12.2} {:>8.0} {:>9} {:>16} {:>13} {}\n",
                     r.backend,
                     r.precision,
                     r.threads,
+                    r.busy,
                     r.reorder_every.map_or("-".to_string(), |e| e.to_string()),
                     r.grains,
                     r.particle_steps_per_second,

@@ -37,6 +37,8 @@ pub struct Throughput {
     pub precision: String,
     /// Worker threads (CPU); 1 for the GPU's host thread.
     pub threads: usize,
+    /// Busy threads that competed for the cores during the run (`grains bench --busy`).
+    pub busy: usize,
     /// Rebuilds between the CPU engine's renumberings of the grains in cell order (0: never;
     /// `simulation.reorder_every`); absent on the GPU, which keeps the scene's order.
     pub reorder_every: Option<u64>,
@@ -169,6 +171,7 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, reorder_ev
         device: device.to_string(),
         precision: engine.precision().to_string(),
         threads,
+        busy: 0,
         reorder_every,
         grains: n,
         warmup_steps: warmup,

@@ -37,7 +37,7 @@ impl<T: Real> CpuEngine<T> {
         // Each part's owner blocks (parts start at block boundaries).
         let parts: Vec<Vec<OwnerBlock<T>>> = bounds.windows(2).map(|w| blocks.by_ref().take(w[1].div_ceil(pair_force::OWNERS) - w[0].div_ceil(pair_force::OWNERS)).collect()).collect();
         let together = warm::Together::new(parts.len());
-        parts.into_par_iter().for_each(|part| {
+        parts.into_par_iter().with_max_len(1).for_each(|part| {
             let mut scratch = TaskScratch::default();
             for b in part {
                 owner_block(b, &mut scratch, pairs, body, prop, &ctx, gravity);
@@ -58,9 +58,14 @@ impl<T: Real> CpuEngine<T> {
         moved
     }
 
-    /// The slots' parts, one per thread of the pool ([`split::split`], [`split::parts_for`]).
+    /// The slots' parts, for the pool's threads ([`split::split`], [`split::parts_for`]), or
+    /// one where the calling thread runs the step alone ([`crew`]).
     pub(super) fn split(&self) -> Vec<usize> {
-        split::split(&self.pairs, self.body.len(), split::parts_for(rayon::current_num_threads()))
+        let wanted = match self.crew.who() {
+            Who::Pool => split::parts_for(rayon::current_num_threads()),
+            Who::Caller => 1,
+        };
+        split::split(&self.pairs, self.body.len(), wanted)
     }
 }
 
@@ -121,6 +126,7 @@ pub(super) fn complete_loads<T: Real>(
     let together = warm::Together::new(parts.len());
     let done: Vec<(Vec<WallTouch<T>>, T)> = parts
         .into_par_iter()
+        .with_max_len(1)
         .map(|(first, mut loads, mut bodies, mut residuals, mut springs)| {
             let (mut touches, mut moved) = (Vec::new(), T::ZERO);
             // A block of grains at a time, gathered, wall-contacted, kicked and (carried)

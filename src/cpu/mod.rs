@@ -12,6 +12,7 @@ mod built_at;
 mod forces;
 mod gather;
 mod controllers;
+mod crew;
 mod integrate;
 mod lanes;
 mod pair_force;
@@ -53,6 +54,7 @@ use crate::schedule::{Op, Schedule, Sweep, Trace};
 use crate::scene::{Scene, WallShape};
 use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
+use crew::{Crew, Who};
 use gather::gather_block;
 use crate::state::{hash_cells, CellGrid};
 use pair_force::{owner_block, OwnerBlock, TaskScratch};
@@ -156,6 +158,8 @@ pub struct CpuEngine<T: Real> {
     external_work: f64,
     /// Time per phase, when profiling.
     clock: PhaseClock<Phase>,
+    /// Whether a run's steps go on the pool or on the calling thread alone ([`crew`]).
+    crew: Crew,
 }
 
 impl<T: Real> CpuEngine<T> {
@@ -274,9 +278,18 @@ impl<T: Real> Engine for CpuEngine<T> {
         self.time
     }
     fn advance(&mut self, n: u64) -> Result<(), SimError> {
-        warm::with_warm_pool(|| {
+        let timed = rayon::current_num_threads() > 1;
+        warm::with_warm_pool(|warm| {
             for k in 0..n {
+                if self.crew.who() == Who::Pool {
+                    warm.rearm();
+                }
+                if timed {
+                    self.crew.step_starts();
+                }
+                let rebuilds = self.rebuilds;
                 self.step_in_run(k + 1 < n)?;
+                self.crew.step_ends(self.rebuilds != rebuilds);
             }
             Ok(())
         })

@@ -90,6 +90,7 @@ impl<T: Real> CpuEngine<T> {
             renumberings: 0,
             external_work: 0.0,
             clock: PhaseClock::default(),
+            crew: Crew::default(),
         };
         engine.rebuild()?;
         Ok(engine)

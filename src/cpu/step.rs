@@ -42,6 +42,7 @@ impl<T: Real> CpuEngine<T> {
         let together = warm::Together::new(parts.len());
         let moved: Vec<T> = parts
             .into_par_iter()
+            .with_max_len(1)
             .map(|(b, r, at, l, p)| {
                 let moved = integrate::kick_drift(b, r, at, l, p, kick, tau);
                 together.finish();

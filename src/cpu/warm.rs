@@ -3,9 +3,10 @@
 //! a rayon worker that finds no work spins briefly and then sleeps, and waking it again costs
 //! tens of microseconds on a virtual machine, which at 10^4 grains is a sizeable part of a
 //! step (three such waits per step of about 0.6 ms on two threads; measured below). Here each
-//! other worker runs a job that steals and runs the pool's pending work until the run is over
-//! ([`rayon::yield_now`]), spinning while there is none, so that it takes its share of each
-//! parallel loop at once. Which thread runs which task never changes a result (each task
+//! other worker runs a job that steals and runs the pool's pending work ([`rayon::yield_now`]),
+//! spinning while there is none, so that it takes its share of each parallel loop at once,
+//! until the run is over or it has found no work for [`HELPER_IDLE`] (then it sleeps, and the
+//! next step sends it again). Which thread runs which task never changes a result (each task
 //! writes its own outputs and reductions combine fixed chunks in order), so the bits are the
 //! same with and without it.
 //!
@@ -17,47 +18,81 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 /// Runs `f` with the current pool's other threads kept awake (see the module's note) until it
-/// returns. With one thread, only `f`.
-pub fn with_warm_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+/// returns; `f` calls [`Warm::rearm`] where a helper that went to sleep should wake again (at
+/// the start of each step). With one thread, only `f`.
+pub fn with_warm_pool<R: Send>(f: impl FnOnce(&Warm) -> R + Send) -> R {
     let helpers = rayon::current_num_threads().saturating_sub(1);
+    let state = &WarmState { stop: AtomicBool::new(false), awake: AtomicUsize::new(0) };
     if helpers == 0 {
-        return f();
+        return f(&Warm { send: None, helpers });
     }
-    let stop = &AtomicBool::new(false);
     rayon::scope(|s| {
         let leader = rayon::current_thread_index();
-        for _ in 0..helpers {
-            s.spawn(move |_| keep_warm(stop, leader));
-        }
+        let send = move || s.spawn(move |_| keep_warm(state, leader));
+        let warm = Warm { send: Some((&send, state)), helpers };
+        warm.rearm();
         // Set on the way out, however `f` leaves (a panic included), so the scope ends.
-        let _stop = StopOnDrop(stop);
-        f()
+        let _stop = StopOnDrop(&state.stop);
+        f(&warm)
     })
 }
 
-/// A helper's job: runs the pool's pending work until `stop`. On the thread running the scope's
-/// body (`leader`, which may pick the job up itself while it waits on a parallel loop) it
-/// returns at once: spinning there would never let the body reach `stop`.
-fn keep_warm(stop: &AtomicBool, leader: Option<usize>) {
-    if rayon::current_thread_index() == leader {
-        return;
-    }
-    while !stop.load(Ordering::Acquire) {
-        run_pending_or_spin();
+/// The helpers of a warm run ([`with_warm_pool`]).
+pub struct Warm<'a> {
+    /// Sends one more helper, and what the helpers share; none with one thread.
+    send: Option<(&'a (dyn Fn() + Sync), &'a WarmState)>,
+    /// Helpers wanted awake: the pool's other threads.
+    helpers: usize,
+}
+
+/// What the helpers of a warm run share.
+struct WarmState {
+    /// Set when the run is over.
+    stop: AtomicBool,
+    /// Helpers sent and not yet left.
+    awake: AtomicUsize,
+}
+
+impl Warm<'_> {
+    /// Sends helpers again in place of those that left, idle for [`HELPER_IDLE`] (on a busy
+    /// machine: see [`keep_warm`]).
+    pub fn rearm(&self) {
+        let Some((send, state)) = self.send else { return };
+        while state.awake.load(Ordering::Acquire) < self.helpers {
+            state.awake.fetch_add(1, Ordering::AcqRel);
+            send();
+        }
     }
 }
 
-/// Where the tasks of one parallel loop end together. The thread that calls the loop runs one
-/// task and, finishing it before the others, waits in the loop's join, where rayon lets it
+/// A helper's job: runs the pool's pending work until the run is over, or until it has found
+/// none for [`HELPER_IDLE`]. It leaves then, and rayon lets its thread sleep: on a machine
+/// where another program wants the cores, a helper that spun on would keep its core from the
+/// thread it waits for (the one running the step's serial work, or a task it has not
+/// finished), which the kernel moves onto a core that falls idle. On the thread running the
+/// scope's body (`leader`, which may pick the job up itself while it waits on a parallel
+/// loop) it returns at once: spinning there would never let the body reach `stop`.
+fn keep_warm(state: &WarmState, leader: Option<usize>) {
+    if rayon::current_thread_index() != leader {
+        run_pending_until(|| state.stop.load(Ordering::Acquire), HELPER_IDLE);
+    }
+    state.awake.fetch_sub(1, Ordering::AcqRel);
+}
+
+/// How long a helper spins without finding work before it leaves: far above the serial gaps
+/// between a step's parallel loops on a quiet machine (a few microseconds; the serial parts of
+/// a rebuild at 10^4 grains, a few hundred), below the kernel's time slice (milliseconds).
+const HELPER_IDLE: Duration = Duration::from_millis(1);
+
+/// Where the tasks of one parallel loop end together. The thread that calls the loop runs
+/// tasks and, finishing before the others, waits in the loop's join, where rayon lets it
 /// sleep; waking it when the last task ended cost 20 us on the 2-core KVM guest (the pair pass
 /// at 10^4 grains, f64, two threads: 494 us from the loop's start to its return, the caller's
 /// task done after 457 us, the helper's after 471). Each task that ends here waits for the
-/// others, running the pool's pending work meanwhile, for at most [`TOGETHER_LIMIT`], so the
-/// caller is awake when the last ends (the pair pass then 471 us; the bench, interleaved runs,
-/// f64, two threads: 10^4 grains 1.611e7 -> 1.647e7 particle-steps/s, means of five; 10^6
-/// 1.20e7 -> 1.25e7; three threads on the two cores 1.03e7-1.28e7 -> 1.49e7-1.51e7). The
-/// limit keeps a wait for a task that this thread itself must run (more tasks than threads)
-/// short.
+/// others, running the pool's pending work meanwhile (the loop's other tasks among it), until
+/// it has found none for [`TOGETHER_IDLE`], so the caller is awake when the last ends (the
+/// pair pass then 471 us; the bench, interleaved runs, f64, two threads: 10^4 grains 1.611e7
+/// -> 1.647e7 particle-steps/s, means of five; 10^6 1.20e7 -> 1.25e7).
 pub struct Together {
     done: AtomicUsize,
     tasks: usize,
@@ -72,21 +107,25 @@ impl Together {
     /// The end of one task: waits for the others (see [`Together`]).
     pub fn finish(&self) {
         self.done.fetch_add(1, Ordering::AcqRel);
-        let start = Instant::now();
-        while self.done.load(Ordering::Acquire) < self.tasks && start.elapsed() < TOGETHER_LIMIT {
-            run_pending_or_spin();
-        }
+        run_pending_until(|| self.done.load(Ordering::Acquire) >= self.tasks, TOGETHER_IDLE);
     }
 }
 
-/// The longest [`Together::finish`] waits: a few wake-ups' worth.
-const TOGETHER_LIMIT: Duration = Duration::from_micros(100);
+/// How long [`Together::finish`] spins without finding work: a few wake-ups' worth.
+const TOGETHER_IDLE: Duration = Duration::from_micros(100);
 
-/// One turn of a wait that stays awake: a unit of the pool's pending work if there is one
-/// ([`rayon::yield_now`]), else a spin.
-fn run_pending_or_spin() {
-    if rayon::yield_now() != Some(rayon::Yield::Executed) {
-        std::hint::spin_loop();
+/// Runs the pool's pending work ([`rayon::yield_now`]), spinning while there is none, until
+/// `over()` or until none has been found for `idle`.
+fn run_pending_until(over: impl Fn() -> bool, idle: Duration) {
+    let mut last_work = Instant::now();
+    while !over() {
+        if rayon::yield_now() == Some(rayon::Yield::Executed) {
+            last_work = Instant::now();
+        } else if last_work.elapsed() >= idle {
+            return;
+        } else {
+            std::hint::spin_loop();
+        }
     }
 }
 
@@ -112,7 +151,7 @@ mod tests {
         let serial: Vec<f64> = v.chunks(1000).map(|c| c.iter().sum()).collect();
         for threads in 1..=4 {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            let runs: Vec<Vec<f64>> = pool.install(|| with_warm_pool(|| (0..50).map(|_| v.par_chunks(1000).map(|c| c.iter().sum()).collect()).collect()));
+            let runs: Vec<Vec<f64>> = pool.install(|| with_warm_pool(|_| (0..50).map(|_| v.par_chunks(1000).map(|c| c.iter().sum()).collect()).collect()));
             assert!(runs.iter().all(|r| *r == serial), "{threads} threads");
         }
     }
@@ -137,7 +176,7 @@ mod tests {
         };
         for threads in 1..=4 {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            let runs: Vec<(Vec<f64>, usize)> = pool.install(|| (0..10).map(|_| sums()).chain(with_warm_pool(|| (0..10).map(|_| sums()).collect::<Vec<_>>())).collect());
+            let runs: Vec<(Vec<f64>, usize)> = pool.install(|| (0..10).map(|_| sums()).chain(with_warm_pool(|_| (0..10).map(|_| sums()).collect::<Vec<_>>())).collect());
             assert!(runs.iter().all(|(r, done)| *r == serial && *done == serial.len()), "{threads} threads");
         }
     }
