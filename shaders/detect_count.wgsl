@@ -1,5 +1,5 @@
 // One invocation counts the pairs one grain owns (partners of higher id within reach) and
-// flags a grain over the neighbour capacity. It also clears the grain's counter for
+// flags a grain over its neighbour capacity (owner_capacity). It also clears the grain's counter for
 // reverse_fill: rev_fill lives in cell_fill's buffer, which scatter_cells uses until then.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> pos: array<vec4<f32>>;
@@ -28,11 +28,12 @@ fn detect_count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
             }
         }
     }
-    if (count > params.max_neighbours) {
+    let capacity = owner_capacity(pi.w);
+    if (count > capacity) {
         if (atomicMin(&control.overflow_grain, i) > i) {
             atomicStore(&control.overflow_count, count);
         }
-        count = params.max_neighbours;
+        count = capacity;
     }
     pair_start[i] = count;
 }

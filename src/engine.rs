@@ -8,9 +8,9 @@ use std::collections::BTreeMap;
 /// Why a run stopped early.
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
-    /// A grain owns more pairs than the neighbour capacity.
+    /// A grain owns more pairs than its size allows ([`crate::state::owner_capacity`]).
     #[error(
-        "neighbour capacity exceeded at step {step}: grain {grain} has {count} neighbour pairs, above simulation.max_neighbours = {capacity}; fix: raise simulation.max_neighbours to at least {count} (or lower simulation.skin)"
+        "neighbour capacity exceeded at step {step}: grain {grain} has {count} neighbour pairs, above what simulation.max_neighbours = {capacity} allows a grain of its size (that many for the smallest grains, 4x for each doubling of the grain's radius plus the smallest one's); fix: raise simulation.max_neighbours (or lower simulation.skin)"
     )]
     Capacity {
         /// Step at which the list was built.
@@ -19,7 +19,7 @@ pub enum SimError {
         grain: u32,
         /// Pairs it owns.
         count: usize,
-        /// The capacity.
+        /// `simulation.max_neighbours`.
         capacity: usize,
     },
     /// The GPU's neighbour list outgrew what one storage binding of the device holds.

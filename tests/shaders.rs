@@ -158,7 +158,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     check_struct!(&m, layout::Params, "Params", [
         n_grains, n_walls, n_materials, pair_capacity, hash_size, max_neighbours, piston, hist_blocks,
         gravity, cell, periodic_lo, periodic_len, periodic_dims, normal, damping, tangential, rolling, cohesion,
-        skin, reach, kt_law, rolling_as_written
+        skin, reach, kt_law, rolling_as_written, r_min, _pad0, _pad1, _pad2
     ]);
     check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, then_kick]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);

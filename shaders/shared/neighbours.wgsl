@@ -44,6 +44,23 @@ fn bucket_range(h: u32) -> vec2<u32> {
     return vec2<u32>(cell_count[h], end);
 }
 
+// The most pairs a grain of this radius may own (m): params.max_neighbours for the smallest
+// grains, 4x for each doubling radius + r_min needs past 2 r_min (src/state/pairs.rs
+// owner_capacity: exact doublings and one correctly rounded sum, the same bits).
+fn owner_capacity(radius: f32) -> u32 {
+    let reach = radius + params.r_min;
+    var edge = 2.0 * params.r_min;
+    var capacity = params.max_neighbours;
+    for (var k = 0u; k < OWNER_DOUBLINGS; k++) {
+        if (edge >= reach) {
+            break;
+        }
+        edge *= 2.0;
+        capacity *= 4u;
+    }
+    return capacity;
+}
+
 // True when grain j is a partner grain i owns: a higher id within reach (minimum image).
 fn owns(i: u32, j: u32, pi: vec4<f32>) -> bool {
     if (j <= i) {

@@ -26,6 +26,10 @@ struct Params {
     reach: f32,           // distance beyond contact that pair detection reaches (m)
     kt_law: u32,          // STIFFNESS_MINDLIN or STIFFNESS_RATIO (tangential.x x the normal secant stiffness)
     rolling_as_written: u32, // Oquendo et al.'s rolling friction: 0 torque pair, 1 eqs. 8-9 on each grain
+    r_min: f32,           // the smallest grain's radius (m), for owner_capacity
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // What changes between the dispatches of one step (uniform, dynamic offset).

@@ -351,10 +351,10 @@ impl<T: Real> ContactDynamics<T> {
     fn detect(&mut self) {
         let allowance = T::of(self.params.gap_allowance);
         let periodic = Periodic::<T>::of(&[None, None, None]);
-        let mut grid = crate::state::CellGrid::default();
         let cutoff = self.r_max * T::of(2.0) + allowance;
-        crate::state::hash_cells(&self.body, cutoff, &periodic, &mut grid);
-        let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grid, &periodic, allowance, usize::MAX).unwrap_or_default();
+        // Non-finite positions find no pairs here; the step's own check reports them.
+        let grids = crate::state::Grids::hash(&self.body, &self.prop, cutoff, allowance, &periodic).unwrap_or_default();
+        let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grids, &periodic, allowance, |_| usize::MAX).unwrap_or_default();
         let mut contacts = Vec::with_capacity(pairs.len() + self.walls.len());
         for (a, &b) in pairs.owners_of(0..pairs.len()).zip(&pairs.partner) {
             let b = b as usize;

@@ -56,7 +56,7 @@ use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
 use crew::{Crew, Who};
 use gather::gather_block;
-use crate::state::{hash_cells, CellGrid};
+use crate::state::{CellGrid, Grids};
 use pair_force::{owner_block, OwnerBlock, TaskScratch};
 use crate::state::profile::{Phase, PhaseClock};
 use reorder::Renumbering;
@@ -84,7 +84,11 @@ pub struct CpuEngine<T: Real> {
     /// scenes, the rupture distance of the largest bridge (m).
     detect_reach: T,
     cutoff: T,
+    /// `simulation.max_neighbours`: the pairs a grain of the smallest size may own
+    /// ([`crate::state::owner_capacity`]).
     capacity: usize,
+    /// The smallest grain's radius (m, f32 as the GPU holds it), for the capacities.
+    r_min: f32,
     /// Largest bridge volume (m^3).
     bridge_cap: T,
     /// Liquid on each grain waiting for its next bridge (m^3); empty without cohesion.

@@ -30,21 +30,22 @@ impl<T: Real> CpuEngine<T> {
                 }
             }
         }
-        // The grid lives for the rebuild alone (6 bytes a grain at the bed's density).
-        let mut grid = CellGrid::default();
-        if !hash_cells(&self.body, self.cutoff, &self.periodic, &mut grid) {
+        // The grids live for the rebuild alone (6 bytes a grain at the bed's density).
+        let Some(grids) = Grids::hash(&self.body, &self.prop, self.cutoff, self.detect_reach, &self.periodic) else {
             return Err(self.non_finite_error());
-        }
+        };
         self.clock.stop(Phase::Hash, t);
         let t = self.clock.start();
-        let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grid, &self.periodic, self.detect_reach, self.capacity)
+        let (prop, capacity, r_min) = (&self.prop, self.capacity, self.r_min);
+        let capacity_of = |i: usize| crate::state::owner_capacity(capacity, r_min, prop[i].radius.f64() as f32);
+        let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grids, &self.periodic, self.detect_reach, capacity_of)
             .map_err(|(i, count)| SimError::Capacity { step: self.step, grain: self.id[i], count, capacity: self.capacity })?;
         self.clock.stop(Phase::Detect, t);
         let t = self.clock.start();
         self.hist = crate::state::remap_all(&pairs, &self.pairs, &self.hist, &self.id, self.slots.stride);
         self.pairs = pairs;
         if self.reorder_every > 0 && self.rebuilds.is_multiple_of(self.reorder_every) {
-            self.reorder(&grid);
+            self.reorder(grids.finest());
         }
         self.pairs.build_reverse(&kept_or_found(&self.slot, &self.id));
         let n_pairs = self.pairs.len();

@@ -51,6 +51,7 @@ impl<T: Real> CpuEngine<T> {
             detect_reach: T::of(scene.skin + scene.bridges.reach),
             cutoff: T::of(2.0 * r_max + scene.skin + scene.bridges.reach),
             capacity: scene.max_neighbours,
+            r_min: scene.grains.radius.iter().copied().fold(f64::INFINITY, f64::min) as f32,
             bridge_cap: T::of(scene.bridges.volume_cap),
             liquid: if slots.layout.bridge { vec![T::ZERO; n] } else { Vec::new() },
             periodic: Periodic::of(&scene.periodic),

@@ -162,7 +162,7 @@ impl Kernel {
     /// (`model`) is every slot's law codes, written from the registries
     /// ([`crate::model::wgsl_codes`]), each slot's file ([`MODEL_SLOTS`],
     /// `shaders/shared/model/<slot>.wgsl`), then `shaders/shared/model.wgsl`, which composes
-    /// them.
+    /// them. The neighbour search gets [`crate::state::OWNER_DOUBLINGS`].
     pub fn wgsl(&self) -> String {
         let mut s = String::new();
         for inc in self.includes {
@@ -172,6 +172,9 @@ impl Kernel {
                     s.push_str(shared(slot));
                     s.push('\n');
                 }
+            }
+            if *inc == "neighbours" {
+                s.push_str(&format!("const OWNER_DOUBLINGS: u32 = {}u;\n", crate::state::OWNER_DOUBLINGS));
             }
             s.push_str(shared(inc));
             s.push('\n');

@@ -56,6 +56,15 @@ pub struct Params {
     pub kt_law: u32,
     /// Oquendo et al.'s rolling friction: 0 a torque pair, 1 eqs. 8-9 on each grain as written.
     pub rolling_as_written: u32,
+    /// The smallest grain's radius (m), for the pairs a grain may own
+    /// ([`crate::state::owner_capacity`]).
+    pub r_min: f32,
+    /// Padding to the struct's 16-byte alignment.
+    pub _pad0: u32,
+    /// Padding.
+    pub _pad1: u32,
+    /// Padding.
+    pub _pad2: u32,
 }
 
 /// What changes between dispatches of one step (WGSL `Phase`, uniform with dynamic offset).

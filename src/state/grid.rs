@@ -74,6 +74,14 @@ impl<T: Real> CellGrid<T> {
 /// sorts grain indices by cell (counting sort: count, exclusive scan, stable scatter).
 /// Returns `false` when a position is not finite.
 pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, periodic: &Periodic<T>, grid: &mut CellGrid<T>) -> bool {
+    let Some(bounds) = bounds_of(body, periodic) else { return false };
+    place(body, None, bounds, cutoff, periodic, grid);
+    true
+}
+
+/// The grains' bounding box, lower and upper corners (m; the period along a wrapping axis),
+/// or `None` when a position is not finite.
+pub(super) fn bounds_of<T: Real>(body: &[Body<T>], periodic: &Periodic<T>) -> Option<([f64; 3], [f64; 3])> {
     let bounds = chunked(body.len(), |r| {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
@@ -92,7 +100,7 @@ pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, periodic: &Periodic<T>, 
     let mut hi = [f64::NEG_INFINITY; 3];
     for (l, h, finite) in bounds {
         if !finite {
-            return false;
+            return None;
         }
         for a in 0..3 {
             lo[a] = lo[a].min(l[a]);
@@ -105,8 +113,15 @@ pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, periodic: &Periodic<T>, 
             hi[a] = lo[a] + periodic.len[a].f64();
         }
     }
+    Some((lo, hi))
+}
+
+/// Sizes `grid` to the box `(lo, hi)` with cells at least `cutoff` wide and sorts by cell the
+/// slots of `members` (every grain when `None`), ascending within a cell.
+pub(super) fn place<T: Real>(body: &[Body<T>], members: Option<&[u32]>, (lo, hi): ([f64; 3], [f64; 3]), cutoff: T, periodic: &Periodic<T>, grid: &mut CellGrid<T>) {
+    let count = members.map_or(body.len(), |m| m.len());
     let mut cell = cutoff.f64();
-    let cap = (MAX_CELLS_PER_GRAIN * body.len() as f64).max(64.0);
+    let cap = (MAX_CELLS_PER_GRAIN * count as f64).max(64.0);
     let dims = loop {
         // A wrapping axis has a whole number of cells over its period, each at least `cell`.
         let d: Vec<f64> = (0..3).map(|a| if periodic.on[a] { ((hi[a] - lo[a]) / cell).floor().max(1.0) } else { ((hi[a] - lo[a]) / cell).floor() + 1.0 }).collect();
@@ -122,7 +137,10 @@ pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, periodic: &Periodic<T>, 
     let n_cells = (dims[0] * dims[1] * dims[2]) as usize;
     let cells: Vec<u32> = {
         let g = &*grid;
-        chunked(body.len(), |r| body[r].iter().map(|b| g.index(g.coords(b.pos)) as u32).collect::<Vec<u32>>()).concat()
+        match members {
+            None => chunked(body.len(), |r| body[r].iter().map(|b| g.index(g.coords(b.pos)) as u32).collect::<Vec<u32>>()).concat(),
+            Some(m) => m.iter().map(|&i| g.index(g.coords(body[i as usize].pos)) as u32).collect(),
+        }
     };
     grid.cell_start.clear();
     grid.cell_start.resize(n_cells + 1, 0);
@@ -134,12 +152,27 @@ pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, periodic: &Periodic<T>, 
     }
     let mut cursor = grid.cell_start[..n_cells].to_vec();
     grid.cell_grains.clear();
-    grid.cell_grains.resize(body.len(), 0);
-    for (i, &c) in cells.iter().enumerate() {
-        grid.cell_grains[cursor[c as usize] as usize] = i as u32;
+    grid.cell_grains.resize(count, 0);
+    for (k, &c) in cells.iter().enumerate() {
+        grid.cell_grains[cursor[c as usize] as usize] = members.map_or(k as u32, |m| m[k]);
         cursor[c as usize] += 1;
     }
-    true
+}
+
+impl<T: Real> CellGrid<T> {
+    /// The distinct coordinates along axis `a` within `h` cells of `c` (itself included),
+    /// wrapped on a periodic axis, clipped otherwise, in increasing offset: `(first, count)`,
+    /// coordinate `k` being `(first + k) % dims[a]`.
+    #[inline(always)]
+    pub(super) fn within(&self, c: u32, a: usize, h: u32) -> (u32, u32) {
+        let d = self.dims[a];
+        if self.wraps[a] {
+            if 2 * h + 1 >= d { (0, d) } else { (c + d - h, 2 * h + 1) }
+        } else {
+            let lo = c.saturating_sub(h);
+            (lo, (c + h).min(d - 1) - lo + 1)
+        }
+    }
 }
 
 /// `detect_pairs` for grain `i`: appends to `out` every grain `j` with a higher permanent id
@@ -166,19 +199,37 @@ pub fn detect_pairs<T: Real>(
     for &z in &zs[..nz] {
         for &y in &ys[..ny] {
             for &x in &xs[..nx] {
-                let cell = grid.index([x, y, z]);
-                for &j in &grid.cell_grains[grid.cell_start[cell] as usize..grid.cell_start[cell + 1] as usize] {
-                    let j = j as usize;
-                    if id[j] <= id[i] {
-                        continue;
-                    }
-                    let reach = prop[i].radius + prop[j].radius + skin;
-                    if position::separation_of(periodic, |k| body[k].pos, residual, i, j).norm2() < reach * reach {
-                        out.push(j as u32);
-                    }
-                }
+                partners_in_cell(i, grid.index([x, y, z]), body, residual, prop, id, grid, periodic, skin, out);
             }
         }
     }
     out[start..].sort_unstable_by_key(|&j| id[j as usize]);
+}
+
+/// Appends to `out` the grains of `cell` that grain `i` owns: a higher permanent id and a
+/// surface within `skin` of i's (see [`detect_pairs`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+pub(super) fn partners_in_cell<T: Real>(
+    i: usize,
+    cell: usize,
+    body: &[Body<T>],
+    residual: &[Vec3<T>],
+    prop: &[Props<T>],
+    id: &[u32],
+    grid: &CellGrid<T>,
+    periodic: &Periodic<T>,
+    skin: T,
+    out: &mut Vec<u32>,
+) {
+    for &j in &grid.cell_grains[grid.cell_start[cell] as usize..grid.cell_start[cell + 1] as usize] {
+        let j = j as usize;
+        if id[j] <= id[i] {
+            continue;
+        }
+        let reach = prop[i].radius + prop[j].radius + skin;
+        if position::separation_of(periodic, |k| body[k].pos, residual, i, j).norm2() < reach * reach {
+            out.push(j as u32);
+        }
+    }
 }

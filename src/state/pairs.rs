@@ -1,7 +1,7 @@
 //! The pair list (CSR by owner, with the reverse index the gather reads) and
 //! `remap_history`, which carries per-contact history across a rebuild.
 
-use super::grid::{detect_pairs, CellGrid};
+use super::levels::{detect_pairs_in, Grids};
 use super::reduce::chunked;
 use super::arrays::{Body, Props};
 use crate::periodic::Periodic;
@@ -53,17 +53,17 @@ impl PairList {
     }
 
     /// Runs `detect_pairs` for every grain and assembles the list, without the reverse lists
-    /// ([`Self::build_reverse`]). Of the grains that own more than `capacity` pairs, returns
-    /// the one with the lowest permanent id (slot, count).
+    /// ([`Self::build_reverse`]). Of the grains that own more pairs than `capacity` gives for
+    /// their slot, returns the one with the lowest permanent id (slot, count).
     pub fn detect<T: Real>(
         body: &[Body<T>],
         residual: &[Vec3<T>],
         prop: &[Props<T>],
         id: &[u32],
-        grid: &CellGrid<T>,
+        grids: &Grids<T>,
         periodic: &Periodic<T>,
         skin: T,
-        capacity: usize,
+        capacity: impl Fn(usize) -> usize,
     ) -> Result<Self, (usize, usize)> {
         let n = body.len();
         let parts = chunked(n, |r| {
@@ -71,7 +71,7 @@ impl PairList {
             let mut partners = Vec::new();
             for i in r {
                 let before = partners.len();
-                detect_pairs(i, body, residual, prop, id, grid, periodic, skin, &mut partners);
+                detect_pairs_in(i, body, residual, prop, id, grids, periodic, skin, &mut partners);
                 counts.push((partners.len() - before) as u32);
             }
             (counts, partners)
@@ -84,7 +84,7 @@ impl PairList {
         for (counts, partners) in parts {
             for c in counts {
                 let i = list.owner_start.len() - 1;
-                if c as usize > capacity && over.is_none_or(|(o, _)| id[i] < id[o]) {
+                if c as usize > capacity(i) && over.is_none_or(|(o, _)| id[i] < id[o]) {
                     over = Some((i, c as usize));
                 }
                 list.owner_start.push(list.owner_start[i] + c);
@@ -142,6 +142,30 @@ impl PairList {
         self.partner[a..b].binary_search_by_key(&partner_id, |&j| id[j as usize]).ok().map(|k| a + k)
     }
 }
+
+/// The most pairs a grain of `radius` may own (m; f32, as the GPU holds it) in a scene whose
+/// smallest grain has radius `r_min`: `max_neighbours` for a grain of the smallest size, times
+/// 4 for each doubling the grain's `radius + r_min` needs to reach past `2 r_min` (the centres
+/// of its smallest neighbours lie on a sphere of radius `radius + r_min`, whose area grows as
+/// its square): a 20 mm ball among 2 mm grains may own 64 times as many. At most 8 doublings.
+/// A guard against a list that explodes (a skin far too large, grains collapsing into each
+/// other), not a size the list is allocated to; computed with exact doublings and one correctly
+/// rounded f32 sum, so that `detect_count.wgsl`'s twin gives the same bits.
+pub fn owner_capacity(max_neighbours: usize, r_min: f32, radius: f32) -> usize {
+    let reach = radius + r_min;
+    let (mut edge, mut capacity) = (2.0 * r_min, max_neighbours);
+    for _ in 0..OWNER_DOUBLINGS {
+        if edge >= reach {
+            break;
+        }
+        edge *= 2.0;
+        capacity *= 4;
+    }
+    capacity
+}
+
+/// The most doublings [`owner_capacity`] takes (WGSL `OWNER_DOUBLINGS`).
+pub const OWNER_DOUBLINGS: u32 = 8;
 
 /// `(owner, pair)` for every pair of a list whose owners' pairs start at `starts` (the
 /// `owner_start` a saved state holds), in pair order.

@@ -19,6 +19,7 @@ pub(super) fn params_of(scene: &Scene, pair_capacity: u64, hash_size: u64, hist_
         pair_capacity: pair_capacity as u32,
         hash_size: hash_size as u32,
         max_neighbours: scene.max_neighbours as u32,
+        r_min: scene.grains.radius.iter().copied().fold(f64::INFINITY, f64::min) as f32,
         piston: NONE,
         hist_blocks: hist_blocks as u32,
         gravity: Vec4::new(scene.gravity[0] as f32, scene.gravity[1] as f32, scene.gravity[2] as f32, 0.0),

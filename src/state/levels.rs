@@ -1,0 +1,177 @@
+//! The neighbour search for grains of very different sizes: a cell grid per size class, as
+//! LAMMPS' `neigh_modify ... multi` bins each type by its own cut-off. One grid sized by the
+//! largest grain puts hundreds of small grains in each cell when one grain is ten times the
+//! others (a 20 mm ball among 2 mm grains: cells of 21 mm, some 1,500 grains each at the bed's
+//! density); here each class has cells as wide as its own largest pair, and a grain searches
+//! every class's grid as far as its reach into that class goes (the ball, about six of the
+//! small grains' cells each way; a small grain, the ball's cells next to its own). The pair
+//! list does not depend on the grids (each owner's partners in ascending permanent id, by the
+//! same distance test), so it is the single grid's to the bit; a scene whose radii are within
+//! [`CLASS_RATIO`] of each other keeps the single grid and its search.
+
+use super::arrays::{Body, Props};
+use super::grid::{bounds_of, detect_pairs, partners_in_cell, place, CellGrid};
+use crate::periodic::Periodic;
+use crate::real::{Real, Vec3};
+
+/// Radii within this ratio share a size class: the class's smallest grains search cells at most
+/// this many of their own diameters wide.
+pub const CLASS_RATIO: f64 = 2.0;
+
+/// The most size classes: radii beyond the last class's lower bound join it.
+const MAX_CLASSES: usize = 8;
+
+/// The grids of a neighbour build: one over every grain, or one per size class.
+#[derive(Clone, Debug, Default)]
+pub struct Grids<T> {
+    /// The grid of each class, smallest grains first, with the class's largest radius (m).
+    pub classes: Vec<(CellGrid<T>, T)>,
+}
+
+impl<T: Real> Grids<T> {
+    /// The grid over every grain, or the smallest class's (over the same box): what
+    /// renumbering in cell order follows.
+    pub fn finest(&self) -> &CellGrid<T> {
+        &self.classes[0].0
+    }
+
+    /// Hashes the grains into grids: one (exactly `hash_cells` with cells of `cutoff`, the
+    /// largest pair's reach, m) when the radii are within [`CLASS_RATIO`] of each other, else
+    /// one per size class, each with cells of its largest pair plus `reach` (m: the skin and
+    /// any bridge's rupture distance). Returns `None` when a position is not finite.
+    pub fn hash(body: &[Body<T>], prop: &[Props<T>], cutoff: T, reach: T, periodic: &Periodic<T>) -> Option<Self> {
+        let (r_min, r_max) = prop.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| (lo.min(p.radius.f64()), hi.max(p.radius.f64())));
+        let bounds = bounds_of(body, periodic)?;
+        let classes = if prop.is_empty() { 1 } else { class_count(r_min, r_max) };
+        let mut grids = Grids { classes: Vec::with_capacity(classes) };
+        if classes == 1 {
+            let mut grid = CellGrid::default();
+            place(body, None, bounds, cutoff, periodic, &mut grid);
+            grids.classes.push((grid, T::of(r_max)));
+            return Some(grids);
+        }
+        let mut members = vec![Vec::new(); classes];
+        for (i, p) in prop.iter().enumerate() {
+            members[class_of(r_min, p.radius.f64(), classes)].push(i as u32);
+        }
+        // A class no radius falls in gets no grid.
+        for m in members.iter().filter(|m| !m.is_empty()) {
+            let largest = m.iter().map(|&i| prop[i as usize].radius).fold(T::ZERO, T::max);
+            let mut grid = CellGrid::default();
+            place(body, Some(m), bounds, largest + largest + reach, periodic, &mut grid);
+            grids.classes.push((grid, largest));
+        }
+        Some(grids)
+    }
+}
+
+/// Size classes for radii from `r_min` to `r_max`: one per factor of [`CLASS_RATIO`], at most
+/// [`MAX_CLASSES`].
+fn class_count(r_min: f64, r_max: f64) -> usize {
+    let mut classes = 1;
+    let mut top = r_min * CLASS_RATIO;
+    while top < r_max && classes < MAX_CLASSES {
+        top *= CLASS_RATIO;
+        classes += 1;
+    }
+    classes
+}
+
+/// The class of a grain of `radius`: how many factors of [`CLASS_RATIO`] above `r_min` it lies.
+fn class_of(r_min: f64, radius: f64, classes: usize) -> usize {
+    let mut class = 0;
+    let mut top = r_min * CLASS_RATIO;
+    while top < radius && class + 1 < classes {
+        top *= CLASS_RATIO;
+        class += 1;
+    }
+    class
+}
+
+/// `detect_pairs` over [`Grids`]: appends to `out` every grain `j` with a higher permanent id
+/// whose surface is within `reach` of i's, in ascending id order (see [`detect_pairs`]; with
+/// one grid, it is that search).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn detect_pairs_in<T: Real>(i: usize, body: &[Body<T>], residual: &[Vec3<T>], prop: &[Props<T>], id: &[u32], grids: &Grids<T>, periodic: &Periodic<T>, reach: T, out: &mut Vec<u32>) {
+    if let [(grid, _)] = &grids.classes[..] {
+        return detect_pairs(i, body, residual, prop, id, grid, periodic, reach, out);
+    }
+    let start = out.len();
+    for (grid, largest) in &grids.classes {
+        let c = grid.coords(body[i].pos);
+        // How many of this grid's cells the farthest partner's centre may lie away.
+        let far = prop[i].radius + *largest + reach;
+        let span = [0, 1, 2].map(|a| grid.within(c[a], a, ((far / grid.cell[a]).f64().ceil() as u32).max(1)));
+        for kz in 0..span[2].1 {
+            for ky in 0..span[1].1 {
+                for kx in 0..span[0].1 {
+                    let at = |a: usize, k: u32| (span[a].0 + k) % grid.dims[a];
+                    partners_in_cell(i, grid.index([at(0, kx), at(1, ky), at(2, kz)]), body, residual, prop, id, grid, periodic, reach, out);
+                }
+            }
+        }
+    }
+    out[start..].sort_unstable_by_key(|&j| id[j as usize]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::state::{hash_cells, owner_capacity, PairList};
+
+    /// A box of `n` grains (a deterministic scatter, overlaps allowed: the search is geometry
+    /// alone) of radii from `radius(k)`, in a 40 x 40 x 40 mm box, periodic along x when
+    /// `wrap`.
+    fn scene(n: usize, radius: impl Fn(usize) -> f64, wrap: bool) -> (Vec<Body<f64>>, Vec<Props<f64>>, Periodic<f64>) {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let body = (0..n).map(|_| Body { pos: Vec3::of([0.04 * next(), 0.04 * next(), 0.04 * next()]), ..Default::default() }).collect();
+        let prop = (0..n).map(|k| Props { radius: radius(k), mass: 1.0, inertia: 1.0 }).collect();
+        (body, prop, Periodic::of(&[wrap.then_some([0.0, 0.04]), None, None]))
+    }
+
+    /// The list through the size classes, against the one grid sized by the largest grain
+    /// (the search every other scene uses): the same pairs in the same order, for a few 10 mm
+    /// balls among 1 mm grains and for radii spread evenly from 0.5 to 5 mm, with and without a
+    /// periodic axis; a class for each factor of two the radii span that holds a grain.
+    #[test]
+    fn size_classes_find_the_single_grids_pairs() {
+        let reach = 2e-4;
+        let cases: [(&str, Box<dyn Fn(usize) -> f64>, usize); 2] =
+            [("balls in a bed", Box::new(|k| if k % 500 == 7 { 0.010 } else { 0.001 }), 2), ("ratio-10 spread", Box::new(|k| 0.0005 + 0.0045 * ((k * 7919) % 1000) as f64 / 999.0), 4)];
+        for (name, radius, classes) in cases {
+            for wrap in [false, true] {
+                let (body, prop, periodic) = scene(3000, &radius, wrap);
+                let id: Vec<u32> = (0..body.len() as u32).rev().collect();
+                let r_max = prop.iter().map(|p| p.radius).fold(0.0, f64::max);
+                let cutoff = 2.0 * r_max + reach;
+                let grids = Grids::hash(&body, &prop, cutoff, reach, &periodic).unwrap();
+                assert_eq!(grids.classes.len(), classes, "{name}");
+                let mut one = CellGrid::default();
+                assert!(hash_cells(&body, cutoff, &periodic, &mut one));
+                let single = Grids { classes: vec![(one, r_max)] };
+                let by_classes = PairList::detect(&body, &[], &prop, &id, &grids, &periodic, reach, |_| usize::MAX).unwrap();
+                let by_one = PairList::detect(&body, &[], &prop, &id, &single, &periodic, reach, |_| usize::MAX).unwrap();
+                assert!(by_one.len() > body.len(), "{name}: {} pairs", by_one.len());
+                assert_eq!(by_classes, by_one, "{name}, periodic {wrap}");
+            }
+        }
+    }
+
+    /// A grain of the smallest size may own `max_neighbours` pairs; one whose radius plus the
+    /// smallest is 2, 4 or 5.5 times the smallest diameter, 4, 16 or 64 times as many.
+    #[test]
+    fn larger_grains_may_own_more_pairs() {
+        let r = 0.001f32;
+        assert_eq!(owner_capacity(32, r, r), 32);
+        assert_eq!(owner_capacity(32, r, 3.0 * r), 128);
+        assert_eq!(owner_capacity(32, r, 7.0 * r), 512);
+        assert_eq!(owner_capacity(32, r, 10.0 * r), 2048);
+    }
+}
