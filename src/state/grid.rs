@@ -45,28 +45,6 @@ impl<T: Real> CellGrid<T> {
     pub fn index(&self, c: [u32; 3]) -> usize {
         (c[0] as usize) + self.dims[0] as usize * ((c[1] as usize) + self.dims[1] as usize * c[2] as usize)
     }
-    /// The distinct neighbour coordinates of cell coordinate `c` along axis `a` (itself
-    /// included): wrapped on a periodic axis, clipped otherwise. At most 3.
-    #[inline(always)]
-    fn neighbours(&self, c: u32, a: usize) -> ([u32; 3], usize) {
-        let d = self.dims[a];
-        if self.wraps[a] {
-            match d {
-                1 => ([0, 0, 0], 1),
-                2 => ([0, 1, 0], 2),
-                _ => ([(c + d - 1) % d, c, (c + 1) % d], 3),
-            }
-        } else {
-            let lo = c.saturating_sub(1);
-            let hi = (c + 1).min(d - 1);
-            let mut out = [lo, lo, lo];
-            let n = (hi - lo + 1) as usize;
-            for (k, o) in out.iter_mut().enumerate().take(n) {
-                *o = lo + k as u32;
-            }
-            (out, n)
-        }
-    }
 }
 
 /// `hash_cells`: sizes the grid to the grains' bounding box (the period along a wrapping
@@ -179,6 +157,7 @@ impl<T: Real> CellGrid<T> {
 /// whose surface is within `skin` of i's (`|r_i - r_j| < R_i + R_j + skin`, minimum image,
 /// residuals included: the grid bins by `pos`, which is within a rounding of the position),
 /// in ascending id order, so that the list does not depend on the grid.
+#[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn detect_pairs<T: Real>(
     i: usize,
@@ -192,27 +171,18 @@ pub fn detect_pairs<T: Real>(
     out: &mut Vec<u32>,
 ) {
     let start = out.len();
-    let c = grid.coords(body[i].pos);
-    let (xs, nx) = grid.neighbours(c[0], 0);
-    let (ys, ny) = grid.neighbours(c[1], 1);
-    let (zs, nz) = grid.neighbours(c[2], 2);
-    for &z in &zs[..nz] {
-        for &y in &ys[..ny] {
-            for &x in &xs[..nx] {
-                partners_in_cell(i, grid.index([x, y, z]), body, residual, prop, id, grid, periodic, skin, out);
-            }
-        }
-    }
+    scan_cells(i, [1; 3], body, residual, prop, id, grid, periodic, skin, out);
     out[start..].sort_unstable_by_key(|&j| id[j as usize]);
 }
 
-/// Appends to `out` the grains of `cell` that grain `i` owns: a higher permanent id and a
-/// surface within `skin` of i's (see [`detect_pairs`]).
+/// Appends to `out`, unsorted, the grains `grain i` owns (a higher permanent id and a surface
+/// within `skin` of i's) among those of `grid` within `h[a]` cells of i's along each axis `a`
+/// ([`CellGrid::within`]).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-pub(super) fn partners_in_cell<T: Real>(
+pub(super) fn scan_cells<T: Real>(
     i: usize,
-    cell: usize,
+    h: [u32; 3],
     body: &[Body<T>],
     residual: &[Vec3<T>],
     prop: &[Props<T>],
@@ -222,14 +192,24 @@ pub(super) fn partners_in_cell<T: Real>(
     skin: T,
     out: &mut Vec<u32>,
 ) {
-    for &j in &grid.cell_grains[grid.cell_start[cell] as usize..grid.cell_start[cell + 1] as usize] {
-        let j = j as usize;
-        if id[j] <= id[i] {
-            continue;
-        }
-        let reach = prop[i].radius + prop[j].radius + skin;
-        if position::separation_of(periodic, |k| body[k].pos, residual, i, j).norm2() < reach * reach {
-            out.push(j as u32);
+    let c = grid.coords(body[i].pos);
+    let span = [0, 1, 2].map(|a| grid.within(c[a], a, h[a]));
+    let at = |a: usize, k: u32| (span[a].0 + k) % grid.dims[a];
+    for kz in 0..span[2].1 {
+        for ky in 0..span[1].1 {
+            for kx in 0..span[0].1 {
+                let cell = grid.index([at(0, kx), at(1, ky), at(2, kz)]);
+                for &j in &grid.cell_grains[grid.cell_start[cell] as usize..grid.cell_start[cell + 1] as usize] {
+                    let j = j as usize;
+                    if id[j] <= id[i] {
+                        continue;
+                    }
+                    let reach = prop[i].radius + prop[j].radius + skin;
+                    if position::separation_of(periodic, |k| body[k].pos, residual, i, j).norm2() < reach * reach {
+                        out.push(j as u32);
+                    }
+                }
+            }
         }
     }
 }

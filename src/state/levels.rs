@@ -10,7 +10,7 @@
 //! [`CLASS_RATIO`] of each other keeps the single grid and its search.
 
 use super::arrays::{Body, Props};
-use super::grid::{bounds_of, detect_pairs, partners_in_cell, place, CellGrid};
+use super::grid::{bounds_of, detect_pairs, place, scan_cells, CellGrid};
 use crate::periodic::Periodic;
 use crate::real::{Real, Vec3};
 
@@ -99,18 +99,10 @@ pub fn detect_pairs_in<T: Real>(i: usize, body: &[Body<T>], residual: &[Vec3<T>]
     }
     let start = out.len();
     for (grid, largest) in &grids.classes {
-        let c = grid.coords(body[i].pos);
         // How many of this grid's cells the farthest partner's centre may lie away.
         let far = prop[i].radius + *largest + reach;
-        let span = [0, 1, 2].map(|a| grid.within(c[a], a, ((far / grid.cell[a]).f64().ceil() as u32).max(1)));
-        for kz in 0..span[2].1 {
-            for ky in 0..span[1].1 {
-                for kx in 0..span[0].1 {
-                    let at = |a: usize, k: u32| (span[a].0 + k) % grid.dims[a];
-                    partners_in_cell(i, grid.index([at(0, kx), at(1, ky), at(2, kz)]), body, residual, prop, id, grid, periodic, reach, out);
-                }
-            }
-        }
+        let h = [0, 1, 2].map(|a| ((far / grid.cell[a]).f64().ceil() as u32).max(1));
+        scan_cells(i, h, body, residual, prop, id, grid, periodic, reach, out);
     }
     out[start..].sort_unstable_by_key(|&j| id[j as usize]);
 }
@@ -143,11 +135,12 @@ mod tests {
     #[test]
     fn size_classes_find_the_single_grids_pairs() {
         let reach = 2e-4;
-        let cases: [(&str, Box<dyn Fn(usize) -> f64>, usize); 2] =
-            [("balls in a bed", Box::new(|k| if k % 500 == 7 { 0.010 } else { 0.001 }), 2), ("ratio-10 spread", Box::new(|k| 0.0005 + 0.0045 * ((k * 7919) % 1000) as f64 / 999.0), 4)];
+        let balls_in_a_bed = |k: usize| if k % 500 == 7 { 0.010 } else { 0.001 };
+        let ratio_ten_spread = |k: usize| 0.0005 + 0.0045 * ((k * 7919) % 1000) as f64 / 999.0;
+        let cases = [("balls in a bed", balls_in_a_bed as fn(usize) -> f64, 2), ("ratio-10 spread", ratio_ten_spread, 4)];
         for (name, radius, classes) in cases {
             for wrap in [false, true] {
-                let (body, prop, periodic) = scene(3000, &radius, wrap);
+                let (body, prop, periodic) = scene(3000, radius, wrap);
                 let id: Vec<u32> = (0..body.len() as u32).rev().collect();
                 let r_max = prop.iter().map(|p| p.radius).fold(0.0, f64::max);
                 let cutoff = 2.0 * r_max + reach;
