@@ -140,12 +140,13 @@ pub(super) fn place<T: Real>(body: &[Body<T>], members: Option<&[u32]>, (lo, hi)
 impl<T: Real> CellGrid<T> {
     /// The distinct coordinates along axis `a` within `h` cells of `c` (itself included),
     /// wrapped on a periodic axis, clipped otherwise, in increasing offset: `(first, count)`,
-    /// coordinate `k` being `(first + k) % dims[a]`.
+    /// coordinate `k` being `first + k`, less `dims[a]` where that reaches it (`first` is
+    /// below `dims[a]` and `count` at most `dims[a]`).
     #[inline(always)]
     pub(super) fn within(&self, c: u32, a: usize, h: u32) -> (u32, u32) {
         let d = self.dims[a];
         if self.wraps[a] {
-            if 2 * h + 1 >= d { (0, d) } else { (c + d - h, 2 * h + 1) }
+            if 2 * h + 1 >= d { (0, d) } else { ((c + d - h) % d, 2 * h + 1) }
         } else {
             let lo = c.saturating_sub(h);
             (lo, (c + h).min(d - 1) - lo + 1)
@@ -194,11 +195,15 @@ pub(super) fn scan_cells<T: Real>(
 ) {
     let c = grid.coords(body[i].pos);
     let span = [0, 1, 2].map(|a| grid.within(c[a], a, h[a]));
-    let at = |a: usize, k: u32| (span[a].0 + k) % grid.dims[a];
+    let at = |a: usize, k: u32| {
+        let x = span[a].0 + k;
+        if x >= grid.dims[a] { x - grid.dims[a] } else { x }
+    };
     for kz in 0..span[2].1 {
         for ky in 0..span[1].1 {
+            let row = grid.index([0, at(1, ky), at(2, kz)]);
             for kx in 0..span[0].1 {
-                let cell = grid.index([at(0, kx), at(1, ky), at(2, kz)]);
+                let cell = row + at(0, kx) as usize;
                 for &j in &grid.cell_grains[grid.cell_start[cell] as usize..grid.cell_start[cell + 1] as usize] {
                     let j = j as usize;
                     if id[j] <= id[i] {
