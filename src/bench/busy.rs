@@ -1,7 +1,8 @@
 //! Busy programs beside a measurement (`grains bench --busy`): threads that compute until
 //! dropped, at the bench's own priority. The kernel schedules threads, not processes, so each
-//! competes for the cores as another program's busy loop would (`sh -c 'while :; do :; done'`
-//! started beside the bench gave the same figures: see docs/performance.md).
+//! competes for the cores as another program's busy loop in the same session would (one run of
+//! `--busy 0,1` gave two threads 7.5e6 particle-steps/s beside one busy thread, where
+//! `sh -c 'while :; do :; done'` beside the bench gave 7.8e6; see docs/performance.md).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
