@@ -17,18 +17,12 @@ fn detect_count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
         return;
     }
     rev_fill[i] = 0u;
-    let pi = pos[i];
-    let b = neighbour_buckets(pi.xyz);
+    var it = search(i);
     var count = 0u;
-    for (var k = 0u; k < b.n; k++) {
-        let r = bucket_range(b.h[k]);
-        for (var s = r.x; s < r.y; s++) {
-            if (owns(i, cell_grains[s], pi)) {
-                count += 1u;
-            }
-        }
+    while (next_partner(&it) != NONE) {
+        count += 1u;
     }
-    let capacity = owner_capacity(pi.w);
+    let capacity = owner_capacity(it.p.w);
     if (count > capacity) {
         if (atomicMin(&control.overflow_grain, i) > i) {
             atomicStore(&control.overflow_count, count);

@@ -20,24 +20,19 @@ fn detect_fill(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_
     if (start >= end) {
         return;
     }
-    let pi = pos[i];
-    let b = neighbour_buckets(pi.xyz);
-    var slot = start;
-    for (var k = 0u; k < b.n; k++) {
-        let r = bucket_range(b.h[k]);
-        for (var s = r.x; s < r.y; s++) {
-            let j = cell_grains[s];
-            if (slot < end && owns(i, j, pi)) {
-                // Insertion into the sorted run pair_j[start..slot).
-                var at = slot;
-                while (at > start && pair_j[at - 1u] > j) {
-                    pair_j[at] = pair_j[at - 1u];
-                    at -= 1u;
-                }
-                pair_j[at] = j;
-                pair_i[slot] = i;
-                slot += 1u;
-            }
+    var it = search(i);
+    for (var slot = start; slot < end; slot++) {
+        let j = next_partner(&it);
+        if (j == NONE) {
+            break;
         }
+        // Insertion into the sorted run pair_j[start..slot).
+        var at = slot;
+        while (at > start && pair_j[at - 1u] > j) {
+            pair_j[at] = pair_j[at - 1u];
+            at -= 1u;
+        }
+        pair_j[at] = j;
+        pair_i[slot] = i;
     }
 }

@@ -1,5 +1,6 @@
 // One invocation starts the rebuild for one grain: wraps it into the periodic cell (counting
-// images), marks its position as built, and counts it into its hash bucket.
+// images), marks its position as built, and counts it into the hash bucket of its cell in its
+// size class's grid.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read_write> pos: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> residual: array<vec4<f32>>;
@@ -46,13 +47,14 @@ fn hash_cells(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
     p = vec4<f32>(select(p.xyz, y.s, wraps), p.w);
     r = vec4<f32>(select(r.xyz, y.e, wraps), r.w);
     moved = vec3<i32>(n);
-    if (params.periodic_dims.x + params.periodic_dims.y + params.periodic_dims.z > 0u) {
+    if (any(wraps)) {
         pos[i] = p;
         residual[i] = r;
         image[i] = image[i] + vec4<i32>(moved, 0);
     }
     built_at[i] = p;
-    let h = cell_hash(cell_coords(p.xyz));
+    let k = class_of(p.w);
+    let h = cell_hash(cell_coords(p.xyz, k), k);
     cell_of[i] = h;
     atomicAdd(&cell_count[h], 1u);
 }

@@ -27,7 +27,7 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         let v = vel[i];
         let w = omega[i];
         var x = p.xyz;
-        if (params.periodic_dims.x + params.periodic_dims.y + params.periodic_dims.z > 0u) {
+        if (any(params.periodic_len.xyz > vec3<f32>(0.0))) {
             x += vec3<f32>(image[i].xyz) * params.periodic_len.xyz;
         }
         let mv = v.xyz * v.w;

@@ -30,23 +30,28 @@ fn gas(periodic: bool) -> Scene {
 /// The gas of [`gas`] with `material` added to its sand's keys (after `mu_s = 0.5`) and `model`
 /// as its `[model]` table.
 fn gas_with(periodic: bool, material: &str, model: &str) -> Scene {
+    let grains = "count = 1500\ndiameter = { min = 0.8e-3, max = 1.2e-3 }\n";
+    gas_of(periodic, material, model, 16.0e-3, &[grains])
+}
+
+/// A gas of [`gas_with`]'s kind in a cube of `edge` (m) whose grains are one `[[generate]]`
+/// block per entry of `grains` (its count and diameters; the region is the cube).
+fn gas_of(periodic: bool, material: &str, model: &str, edge: f64, grains: &[&str]) -> Scene {
     let walls = if periodic {
-        "[periodic]\nx = [0.0, 16.0e-3]\ny = [0.0, 16.0e-3]\n[[wall]]\ntype = \"plane\"\nmaterial = \"sand\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n"
+        format!("[periodic]\nx = [0.0, {edge}]\ny = [0.0, {edge}]\n[[wall]]\ntype = \"plane\"\nmaterial = \"sand\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]\n")
     } else {
-        "[[wall]]\ntype = \"box\"\nmaterial = \"sand\"\nmin = [0.0, 0.0, 0.0]\nmax = [16.0e-3, 16.0e-3, 16.0e-3]\n"
+        format!("[[wall]]\ntype = \"box\"\nmaterial = \"sand\"\nmin = [0.0, 0.0, 0.0]\nmax = [{edge}, {edge}, {edge}]\n")
     };
+    let generate: String = grains
+        .iter()
+        .map(|g| format!("[[generate]]\nmaterial = \"sand\"\n{g}region = {{ shape = \"box\", min = [0.0, 0.0, 0.0], max = [{edge}, {edge}, {edge}] }}\nrandom_speed = 0.5\n"))
+        .collect();
     common::parse(&format!(
         concat!(r#"
 seed = 4
 "#, include_str!("fixtures/sand.toml"), r#"mu_s = 0.5
 {material}
-[[generate]]
-material = "sand"
-count = 1500
-diameter = {{ min = 0.8e-3, max = 1.2e-3 }}
-region = {{ shape = "box", min = [0.0, 0.0, 0.0], max = [16.0e-3, 16.0e-3, 16.0e-3] }}
-random_speed = 0.5
-{walls}
+{generate}{walls}
 [model]
 {model}
 [simulation]
@@ -55,7 +60,7 @@ skin = 3.0e-4
 [[stage]]
 kind = "run"
 duration = 1.0e-3
-"#), material = material, walls = walls, model = model
+"#), material = material, generate = generate, walls = walls, model = model
     ))
 }
 
@@ -120,23 +125,30 @@ fn both_engines_walk_the_schedule_of_each_integrator() {
     }
 }
 
+/// The GPU's neighbour search lists the CPU's pairs, in the same order: grains of one size,
+/// a few grains ten times the others' diameter among them, and diameters spread over a factor
+/// of ten (a grid per size class on both backends), each with and without periodic axes.
 #[test]
 fn hash_cells_and_detect_pairs_list_the_cpus_pairs() {
+    let balls = ["count = 6\ndiameter = { min = 8.0e-3, max = 8.0e-3 }\n", "count = 6000\ndiameter = { min = 0.8e-3, max = 0.8e-3 }\n"];
+    let spread = ["count = 300\ndiameter = { min = 0.4e-3, max = 4.0e-3 }\n"];
     for periodic in [false, true] {
-        let scene = gas(periodic);
-        let Some(mut g) = common::gpu_engine(&scene) else { return };
-        let mut c: CpuEngine<f32> = common::engine(&scene);
-        g.stats().unwrap();
-        c.stats().unwrap();
-        g.advance(50).unwrap();
-        c.advance(50).unwrap();
-        let (starts, partners) = g.pair_list().unwrap();
-        // The GPU does not renumber its grains: its slots are the permanent ids.
-        let (c_starts, c_partners) = c.pair_list();
-        println!("periodic {periodic}: {} pairs on the GPU, {} on the CPU", partners.len(), c_partners.len());
-        assert!(c_partners.len() > 1000);
-        assert_eq!(starts, c_starts, "pair starts per grain");
-        assert_eq!(partners, c_partners, "partners");
+        let cases = [("one size", gas(periodic)), ("balls among grains", gas_of(periodic, "", "", 24.0e-3, &balls)), ("ratio-10 spread", gas_of(periodic, "", "", 24.0e-3, &spread))];
+        for (name, scene) in cases {
+            let Some(mut g) = common::gpu_engine(&scene) else { return };
+            let mut c: CpuEngine<f32> = common::engine(&scene);
+            g.stats().unwrap();
+            c.stats().unwrap();
+            g.advance(50).unwrap();
+            c.advance(50).unwrap();
+            let (starts, partners) = g.pair_list().unwrap();
+            // The GPU does not renumber its grains: its slots are the permanent ids.
+            let (c_starts, c_partners) = c.pair_list();
+            println!("{name}, periodic {periodic}: {} pairs on the GPU, {} on the CPU", partners.len(), c_partners.len());
+            assert!(c_partners.len() > scene.grains.len() / 3, "{name}: {} pairs", c_partners.len());
+            assert_eq!(starts, c_starts, "{name}, periodic {periodic}: pair starts per grain");
+            assert_eq!(partners, c_partners, "{name}, periodic {periodic}: partners");
+        }
     }
 }
 

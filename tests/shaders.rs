@@ -157,8 +157,8 @@ fn rust_mirrors_match_the_wgsl_structures() {
     let m = module(&format!("{src}\n@group(0) @binding(0) var<storage, read_write> c: Control;\n@compute @workgroup_size(1) fn main() {{ atomicStore(&c.max_disp2, 0u); }}"), "types");
     check_struct!(&m, layout::Params, "Params", [
         n_grains, n_walls, n_materials, pair_capacity, hash_size, max_neighbours, piston, hist_blocks,
-        gravity, cell, periodic_lo, periodic_len, periodic_dims, normal, damping, tangential, rolling, cohesion,
-        skin, reach, kt_law, rolling_as_written, r_min, _pad0, _pad1, _pad2
+        gravity, periodic_lo, periodic_len, normal, damping, tangential, rolling, cohesion,
+        skin, reach, kt_law, rolling_as_written, r_min, classes, _pad1, _pad2, class_cell, class_dims
     ]);
     check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, then_kick]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);
@@ -176,6 +176,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     };
     assert_eq!(constant("WG"), layout::WG);
     assert_eq!(constant("MAX_WALLS") as usize, layout::MAX_WALLS);
+    assert_eq!(constant("MAX_CLASSES") as usize, layout::MAX_CLASSES);
     assert_eq!(constant("STAT_ROW") as usize, layout::STAT_ROW);
     assert_eq!(constant("RATTLER_CONTACTS") as u64, grains::engine::RATTLER_CONTACTS);
     assert_eq!(constant("SCAN_BLOCK") as u64, layout::SCAN_BLOCK);

@@ -1,38 +1,99 @@
-// Neighbour search shared by detect_count and detect_fill (which declare pos, residual,
-// cell_count and cell_grains): the distinct buckets of the 27 cells around a grain.
+// The neighbour search shared by detect_count and detect_fill (which declare pos, residual,
+// cell_count and cell_grains): the grains one grain owns, from each size class's grid within
+// the owner's reach into that class (src/state/levels.rs detect_pairs_in: the same cells),
+// one cell at a time. A bucket may hold grains of other cells and classes (grid.wgsl); a
+// grain counts only in the cell it was hashed to, so that each is found once.
 
-struct Buckets {
-    h: array<u32, 27>,
-    n: u32,
+struct Search {
+    i: u32,           // the owner
+    p: vec4<f32>,     // its position (m) in xyz, its radius (m) in w
+    size: u32,        // the size class whose grid is being searched
+    first: vec3<i32>, // the cells of that grid within reach: first + at, wrapped, for at < count
+    count: vec3<u32>,
+    at: vec3<u32>,
+    cell: vec3<i32>,  // the cell being scanned (wrapped)
+    s: u32,           // the range of cell_grains of its bucket still to scan
+    end: u32,
 }
 
-fn neighbour_buckets(p: vec3<f32>) -> Buckets {
-    var b: Buckets;
-    b.n = 0u;
-    let c = cell_coords(p);
-    for (var dz = -1; dz <= 1; dz++) {
-        for (var dy = -1; dy <= 1; dy++) {
-            for (var dx = -1; dx <= 1; dx++) {
-                var q = c + vec3<i32>(dx, dy, dz);
-                for (var a = 0u; a < 3u; a++) {
-                    let d = i32(params.periodic_dims[a]);
-                    if (d > 0) {
-                        q[a] = ((q[a] % d) + d) % d;
+// A search for the grains grain i owns, at the first class's grid.
+fn search(i: u32) -> Search {
+    var it: Search;
+    it.i = i;
+    it.p = pos[i];
+    it.size = 0u;
+    aim(&it);
+    return it;
+}
+
+// Points the search at the cells of its class's grid that may hold a partner: those within
+// h = ceil((R_i + the class's largest radius + reach) / cell edge), at least 1, of the
+// owner's cell along each axis, every cell once where that spans a wrapping axis.
+fn aim(it: ptr<function, Search>) {
+    let k = (*it).size;
+    let grid = params.class_cell[k];
+    let far = (*it).p.w + grid.w + params.reach;
+    let c = cell_coords((*it).p.xyz, k);
+    for (var a = 0u; a < 3u; a++) {
+        let h = max(1u, u32(ceil(far / grid[a])));
+        let d = params.class_dims[k][a];
+        if (d > 0u && 2u * h + 1u >= d) {
+            (*it).first[a] = 0;
+            (*it).count[a] = d;
+        } else {
+            (*it).first[a] = c[a] - i32(h);
+            (*it).count[a] = 2u * h + 1u;
+        }
+    }
+    (*it).at = vec3<u32>(0u);
+    enter(it);
+}
+
+// Starts the scan of the search's current cell.
+fn enter(it: ptr<function, Search>) {
+    let q = wrap_cell((*it).first + vec3<i32>((*it).at), (*it).size);
+    (*it).cell = q;
+    let r = bucket_range(cell_hash(q, (*it).size));
+    (*it).s = r.x;
+    (*it).end = r.y;
+}
+
+// The next grain the search's owner owns, or NONE when the search is done: cells x fastest,
+// then the next class.
+fn next_partner(it: ptr<function, Search>) -> u32 {
+    loop {
+        if ((*it).s < (*it).end) {
+            let j = cell_grains[(*it).s];
+            (*it).s += 1u;
+            if (owns((*it).i, j, (*it).p)) {
+                let pj = pos[j];
+                let k = (*it).size;
+                if (class_of(pj.w) == k && all(cell_coords(pj.xyz, k) == (*it).cell)) {
+                    return j;
+                }
+            }
+            continue;
+        }
+        (*it).at.x += 1u;
+        if ((*it).at.x == (*it).count.x) {
+            (*it).at.x = 0u;
+            (*it).at.y += 1u;
+            if ((*it).at.y == (*it).count.y) {
+                (*it).at.y = 0u;
+                (*it).at.z += 1u;
+                if ((*it).at.z == (*it).count.z) {
+                    (*it).size += 1u;
+                    if ((*it).size == params.classes) {
+                        break;
                     }
-                }
-                let h = cell_hash(q);
-                var seen = false;
-                for (var k = 0u; k < b.n; k++) {
-                    if (b.h[k] == h) { seen = true; }
-                }
-                if (!seen) {
-                    b.h[b.n] = h;
-                    b.n += 1u;
+                    aim(it);
+                    continue;
                 }
             }
         }
+        enter(it);
     }
-    return b;
+    return NONE;
 }
 
 // Range of cell_grains holding bucket h.

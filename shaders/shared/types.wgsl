@@ -12,10 +12,8 @@ struct Params {
     piston: u32,          // wall index of the piston, or 0xffffffff
     hist_blocks: u32,     // vec4 history blocks per contact (tangential with the sliding flag in w, rolling, bridge volume in x)
     gravity: vec4<f32>,   // m/s^2 (xyz)
-    cell: vec4<f32>,      // cell edge per axis (m)
     periodic_lo: vec4<f32>,
     periodic_len: vec4<f32>, // period per axis (m); 0 where the axis does not wrap
-    periodic_dims: vec4<u32>, // cells per wrapping axis; 0 where it does not wrap
     // One block per slot of the contact model, its laws' constants (src/model/):
     normal: vec4<f32>,     // the normal law's (src/model/normal/<law>.rs gpu_block): x k_n (N/m, linear) or gamma (J/m^2, dmt)
     damping: vec4<f32>,    // x: viscous c_n (N s/m)
@@ -27,9 +25,11 @@ struct Params {
     kt_law: u32,          // STIFFNESS_MINDLIN or STIFFNESS_RATIO (tangential.x x the normal secant stiffness)
     rolling_as_written: u32, // Oquendo et al.'s rolling friction: 0 torque pair, 1 eqs. 8-9 on each grain
     r_min: f32,           // the smallest grain's radius (m), for owner_capacity
-    _pad0: u32,
+    classes: u32,         // size classes of the neighbour search, 1 to MAX_CLASSES (src/state/levels.rs class_tops)
     _pad1: u32,
     _pad2: u32,
+    class_cell: array<vec4<f32>, MAX_CLASSES>, // per size class: its grid's cell edge per axis (m) in xyz, its largest radius (m) in w
+    class_dims: array<vec4<u32>, MAX_CLASSES>, // per size class: its grid's cells per wrapping axis; 0 where the axis does not wrap
 }
 
 // What changes between the dispatches of one step (uniform, dynamic offset).
@@ -135,6 +135,8 @@ const ARGS_STEP_ONE: u32 = 10u;     // one workgroup, until a pair buffer overfl
 const ARGS_SLOTS: u32 = 11u;
 
 const MAX_WALLS: u32 = 8u;
+// Size classes of the neighbour search (src/state/levels.rs MAX_CLASSES).
+const MAX_CLASSES: u32 = 8u;
 // Elements one workgroup of the scan handles (src/gpu/layout.rs SCAN_BLOCK).
 const SCAN_BLOCK: u32 = 2048u;
 // Grains with fewer contacts are rattlers (src/engine.rs RATTLER_CONTACTS).

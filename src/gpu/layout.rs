@@ -27,14 +27,10 @@ pub struct Params {
     pub hist_blocks: u32,
     /// Gravity (m/s^2).
     pub gravity: Vec4,
-    /// Cell edge per axis (m).
-    pub cell: Vec4,
     /// Lower bound of each periodic axis (m).
     pub periodic_lo: Vec4,
     /// Period per axis (m), 0 where it does not wrap.
     pub periodic_len: Vec4,
-    /// Cells per periodic axis, 0 where it does not wrap.
-    pub periodic_dims: UVec4,
     /// The normal law's constants ([`crate::model::NormalSetup::gpu_block`]).
     pub normal: Vec4,
     /// The damping law's ([`crate::model::DampingLaw::gpu_block`]).
@@ -59,12 +55,17 @@ pub struct Params {
     /// The smallest grain's radius (m), for the pairs a grain may own
     /// ([`crate::state::owner_capacity`]).
     pub r_min: f32,
-    /// Padding to the struct's 16-byte alignment.
-    pub _pad0: u32,
-    /// Padding.
+    /// Size classes of the neighbour search, 1 to [`MAX_CLASSES`]
+    /// ([`crate::state::class_tops`]).
+    pub classes: u32,
+    /// Padding to the class tables' 16-byte alignment.
     pub _pad1: u32,
     /// Padding.
     pub _pad2: u32,
+    /// Per size class: its grid's cell edge per axis (m) in xyz, its largest radius (m) in w.
+    pub class_cell: [Vec4; MAX_CLASSES],
+    /// Per size class: its grid's cells per wrapping axis, 0 where the axis does not wrap.
+    pub class_dims: [UVec4; MAX_CLASSES],
 }
 
 /// What changes between dispatches of one step (WGSL `Phase`, uniform with dynamic offset).
@@ -257,6 +258,8 @@ impl DispatchArgs {
 /// "No grain" / "no wall" (WGSL `NONE`).
 pub const NONE: u32 = u32::MAX;
 pub use crate::workgroup::WG;
+pub use crate::state::MAX_CLASSES;
+
 /// Walls a GPU scene may have (WGSL `MAX_WALLS`).
 pub const MAX_WALLS: usize = 8;
 /// Reals per statistics row (WGSL `STAT_ROW`).

@@ -18,8 +18,9 @@ use crate::real::{Real, Vec3};
 /// this many of their own diameters wide.
 pub const CLASS_RATIO: f64 = 2.0;
 
-/// The most size classes: radii beyond the last class's lower bound join it.
-const MAX_CLASSES: usize = 8;
+/// The most size classes: radii beyond the last class's lower bound join it (WGSL
+/// `MAX_CLASSES`, the length of `Params`' class tables).
+pub const MAX_CLASSES: usize = 8;
 
 /// The grids of a neighbour build: one over every grain, or one per size class.
 #[derive(Clone, Debug, Default)]
@@ -40,23 +41,21 @@ impl<T: Real> Grids<T> {
     /// one per size class, each with cells of its largest pair plus `reach` (m: the skin and
     /// any bridge's rupture distance). Returns `None` when a position is not finite.
     pub fn hash(body: &[Body<T>], prop: &[Props<T>], cutoff: T, reach: T, periodic: &Periodic<T>) -> Option<Self> {
-        let (r_min, r_max) = prop.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| (lo.min(p.radius.f64()), hi.max(p.radius.f64())));
         let bounds = bounds_of(body, periodic)?;
-        let classes = if prop.is_empty() { 1 } else { class_count(r_min, r_max) };
-        let mut grids = Grids { classes: Vec::with_capacity(classes) };
-        if classes == 1 {
+        let tops = class_tops(prop.iter().map(|p| p.radius.f64()));
+        let mut grids = Grids { classes: Vec::with_capacity(tops.len()) };
+        if tops.len() <= 1 {
             let mut grid = CellGrid::default();
             place(body, None, bounds, cutoff, periodic, &mut grid);
-            grids.classes.push((grid, T::of(r_max)));
+            grids.classes.push((grid, T::of(tops.first().copied().unwrap_or(0.0))));
             return Some(grids);
         }
-        let mut members = vec![Vec::new(); classes];
+        let mut members = vec![Vec::new(); tops.len()];
         for (i, p) in prop.iter().enumerate() {
-            members[class_of(r_min, p.radius.f64(), classes)].push(i as u32);
+            members[class_index(&tops, p.radius.f64())].push(i as u32);
         }
-        // A class no radius falls in gets no grid.
-        for m in members.iter().filter(|m| !m.is_empty()) {
-            let largest = m.iter().map(|&i| prop[i as usize].radius).fold(T::ZERO, T::max);
+        for (m, &largest) in members.iter().zip(&tops) {
+            let largest = T::of(largest);
             let mut grid = CellGrid::default();
             place(body, Some(m), bounds, largest + largest + reach, periodic, &mut grid);
             grids.classes.push((grid, largest));
@@ -65,27 +64,30 @@ impl<T: Real> Grids<T> {
     }
 }
 
-/// Size classes for radii from `r_min` to `r_max`: one per factor of [`CLASS_RATIO`], at most
-/// [`MAX_CLASSES`].
-fn class_count(r_min: f64, r_max: f64) -> usize {
-    let mut classes = 1;
-    let mut top = r_min * CLASS_RATIO;
-    while top < r_max && classes < MAX_CLASSES {
-        top *= CLASS_RATIO;
-        classes += 1;
+/// The size classes of grains of `radii` (m): the largest radius of each class that holds a
+/// grain, smallest first. A class spans a factor of [`CLASS_RATIO`]: the first from `r_min`
+/// to `CLASS_RATIO r_min` inclusive, the next to `CLASS_RATIO^2 r_min`, ...; radii beyond the
+/// [`MAX_CLASSES`]th join the last. Both backends class grains by these tops
+/// ([`class_index`]; on the GPU `class_of` in `shaders/shared/grid.wgsl`).
+pub fn class_tops(radii: impl Iterator<Item = f64> + Clone) -> Vec<f64> {
+    let r_min = radii.clone().fold(f64::INFINITY, f64::min);
+    let mut tops = [f64::NEG_INFINITY; MAX_CLASSES];
+    for r in radii {
+        let mut class = 0;
+        let mut top = r_min * CLASS_RATIO;
+        while top < r && class + 1 < MAX_CLASSES {
+            top *= CLASS_RATIO;
+            class += 1;
+        }
+        tops[class] = tops[class].max(r);
     }
-    classes
+    tops.into_iter().filter(|t| t.is_finite()).collect()
 }
 
-/// The class of a grain of `radius`: how many factors of [`CLASS_RATIO`] above `r_min` it lies.
-fn class_of(r_min: f64, radius: f64, classes: usize) -> usize {
-    let mut class = 0;
-    let mut top = r_min * CLASS_RATIO;
-    while top < radius && class + 1 < classes {
-        top *= CLASS_RATIO;
-        class += 1;
-    }
-    class
+/// The class of a grain of `radius` (m) among classes of `tops` ([`class_tops`]): the first
+/// whose top it does not exceed, the last when it exceeds them all.
+pub fn class_index(tops: &[f64], radius: f64) -> usize {
+    tops.iter().position(|&t| radius <= t).unwrap_or(tops.len() - 1)
 }
 
 /// `detect_pairs` over [`Grids`]: appends to `out` every grain `j` with a higher permanent id

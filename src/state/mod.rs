@@ -18,7 +18,7 @@ mod wall;
 
 pub use arrays::{material_at, Body, Counts, HistorySlots, ImageCount, Images, Load, PairFlags, PairReports, Props};
 pub use grid::{detect_pairs, hash_cells, CellGrid};
-pub use levels::{detect_pairs_in, Grids, CLASS_RATIO};
+pub use levels::{class_index, class_tops, detect_pairs_in, Grids, CLASS_RATIO, MAX_CLASSES};
 pub use pairs::{owned_pairs, owner_capacity, remap_all, remap_history, PairList, OWNER_DOUBLINGS};
 pub use context::{coeffs_of, ForceContext};
 pub use wall::{wall_contact, wall_contact_records, WallState};

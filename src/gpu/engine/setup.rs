@@ -9,9 +9,7 @@ use super::*;
 pub(super) fn params_of(scene: &Scene, pair_capacity: u64, hash_size: u64, hist_blocks: u64) -> Params {
     let model = &scene.model;
     let n = scene.grains.len() as u64;
-    let r_max = scene.grains.radius.iter().copied().fold(0.0, f64::max);
     let reach = scene.skin + scene.bridges.reach;
-    let cutoff = 2.0 * r_max + reach;
     let mut params = Params {
         n_grains: n as u32,
         n_walls: scene.walls.len() as u32,
@@ -23,18 +21,32 @@ pub(super) fn params_of(scene: &Scene, pair_capacity: u64, hash_size: u64, hist_
         piston: NONE,
         hist_blocks: hist_blocks as u32,
         gravity: Vec4::new(scene.gravity[0] as f32, scene.gravity[1] as f32, scene.gravity[2] as f32, 0.0),
-        cell: Vec4::splat(cutoff as f32),
         skin: scene.skin as f32,
         reach: reach as f32,
         ..Default::default()
     };
     for a in 0..3 {
         if let Some([lo, hi]) = scene.periodic[a] {
-            let dims = ((hi - lo) / cutoff).floor().max(1.0);
             params.periodic_lo[a] = lo as f32;
             params.periodic_len[a] = (hi - lo) as f32;
-            params.periodic_dims[a] = dims as u32;
-            params.cell[a] = ((hi - lo) / dims) as f32;
+        }
+    }
+    // A grid per size class, with cells as wide as the class's largest pair and the reach
+    // (the CPU's, src/state/levels.rs), a whole number of them over a period.
+    let mut tops = crate::state::class_tops(scene.grains.radius.iter().copied());
+    if tops.is_empty() {
+        tops.push(0.0);
+    }
+    params.classes = tops.len() as u32;
+    for (k, top) in tops.into_iter().enumerate() {
+        let cutoff = 2.0 * top + reach;
+        params.class_cell[k] = Vec4::new(cutoff as f32, cutoff as f32, cutoff as f32, top as f32);
+        for a in 0..3 {
+            if let Some([lo, hi]) = scene.periodic[a] {
+                let dims = ((hi - lo) / cutoff).floor().max(1.0);
+                params.class_dims[k][a] = dims as u32;
+                params.class_cell[k][a] = ((hi - lo) / dims) as f32;
+            }
         }
     }
     params.normal = model.normal.gpu_block();
