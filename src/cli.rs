@@ -57,6 +57,10 @@ pub enum Reorder {
 pub enum BenchPart {
     /// Particle-steps per second, memory and time per phase on the dense bed.
     Throughput,
+    /// Particle-steps per second and each rebuild's cost per grain on loose, agitated beds of
+    /// one size, of a few grains ten times the others' diameter among many small, and of
+    /// diameters spread over a factor of ten.
+    Mixed,
     /// Wall time against error over a ladder of time steps.
     Ladder,
     /// Steps per second of small scenes (280, 1200 and 10^4 grains), dispatch-bound on a GPU.
@@ -64,7 +68,7 @@ pub enum BenchPart {
     /// Richefeu et al.'s isotropic compaction to 100 Pa by DEM and by contact dynamics
     /// (`--compaction-grains`): wall times, sweeps and contact updates per second.
     Compaction,
-    /// Throughput and ladder (not the small scenes or the compaction).
+    /// Throughput, mixed sizes and ladder (not the small scenes or the compaction).
     All,
 }
 

@@ -182,6 +182,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
                 repeats: repeats as usize,
                 throughput: matches!(part, BenchPart::Throughput | BenchPart::All),
                 ladder: matches!(part, BenchPart::Ladder | BenchPart::All),
+                mixed: matches!(part, BenchPart::Mixed | BenchPart::All),
                 small: part == BenchPart::Small,
                 compaction: (part == BenchPart::Compaction).then_some(compaction_grains as usize),
                 cache: cache.unwrap_or_else(grains::bench::bed::default_cache),

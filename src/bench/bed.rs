@@ -54,17 +54,20 @@ pub fn default_cache() -> PathBuf {
     base.map_or_else(|| PathBuf::from(".grains-cache"), |b| b.join("grains"))
 }
 
-/// The bed's scene, before the pour.
-pub fn bed_scene() -> anyhow::Result<Scene> {
-    Ok(scene::parse(Path::new(BED_PATH), BED_SCENE)?)
-}
-
 /// The settled 10^4-grain bed: read from `cache`, or poured (f64, on the current thread pool)
 /// and written there. Returns the scene with the settled grains and what the pour gave.
 pub fn settled_bed(cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedInfo)> {
-    let mut scene = bed_scene()?;
-    let hash = checkpoint::fnv1a(format!("{BED_SCENE}\npour revision {POUR_REVISION}").as_bytes());
-    let path = cache.join(format!("bench-bed-{hash:016x}.grains"));
+    settled(Path::new(BED_PATH), BED_SCENE, cache, progress)
+}
+
+/// The grains of the scene `text` (named `path`) at the end of its stages: read from `cache`
+/// (a file named after the scene and a hash of its text and [`POUR_REVISION`]), or run (f64,
+/// on the current thread pool) and written there. Returns the scene with those grains and what
+/// the run gave.
+pub fn settled(path: &Path, text: &str, cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedInfo)> {
+    let mut scene = scene::parse(path, text)?;
+    let hash = checkpoint::fnv1a(format!("{text}\npour revision {POUR_REVISION}").as_bytes());
+    let path = cache.join(format!("{}-{hash:016x}.grains", scene.name.replace('_', "-")));
     if path.exists() {
         let (info, state): (BedInfo, EngineState) = checkpoint::read(&path)?;
         let n = scene.grains.len();
@@ -75,7 +78,7 @@ pub fn settled_bed(cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedIn
         return Ok((scene, info));
     }
     if progress {
-        eprintln!("pouring the {}-grain bench bed once (the peers' recipe); it is cached in {}", scene.grains.len(), cache.display());
+        eprintln!("pouring the {}-grain bed {} once; it is cached in {}", scene.grains.len(), scene.name, cache.display());
     }
     let started = std::time::Instant::now();
     let mut engine = CpuEngine::<f64>::new(&scene)?;
@@ -83,7 +86,7 @@ pub fn settled_bed(cache: &Path, progress: bool) -> anyhow::Result<(Scene, BedIn
     let stages = crate::protocol::run(&scene, &mut engine, &mut rec);
     rec.finish()?;
     let stages: Vec<StageResult> = stages?;
-    let last = stages.last().context("the bench bed scene has no stage")?;
+    let last = stages.last().with_context(|| format!("{}: the bed's scene has no stage", scene.path.display()))?;
     let info = BedInfo {
         scene_hash: hash,
         time: last.time_end,

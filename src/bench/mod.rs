@@ -8,6 +8,7 @@ pub mod busy;
 pub mod compaction;
 pub mod ladder;
 pub mod memory;
+pub mod mixed;
 pub mod small;
 pub mod throughput;
 
@@ -43,6 +44,8 @@ pub struct BenchOptions {
     pub throughput: bool,
     /// Run the speed-against-error part.
     pub ladder: bool,
+    /// Run the mixed-sizes part ([`mixed`]).
+    pub mixed: bool,
     /// Run the small-scene part (steps per second at 280, 1200 and 10^4 grains).
     pub small: bool,
     /// Run the compaction part at this many grains: Richefeu et al.'s isotropic compaction to 100 Pa
@@ -83,6 +86,8 @@ pub struct BenchReport {
     pub bed: Option<BedInfo>,
     /// Throughput runs.
     pub throughput: Vec<Throughput>,
+    /// Throughput runs on the beds of mixed sizes ([`mixed`]).
+    pub mixed: Vec<Throughput>,
     /// Speed against error.
     pub ladder: Option<Ladder>,
     /// Small scenes.
@@ -123,7 +128,7 @@ pub fn spread_percent(repeats: &[f64], median: f64) -> f64 {
     50.0 * (hi - lo) / median
 }
 
-fn pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
+pub(crate) fn pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")
 }
 
@@ -200,12 +205,14 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
                         })
                         .map(|row| Throughput { busy, ..row })?
                     };
+                    let row = Throughput { scene: base()?.name.clone(), ..row };
                     say(&format!("  {:.3e} particle-steps/s, Z = {:.3}, {:.0} B/grain", row.particle_steps_per_second, row.contacts_per_grain, row.bytes_per_grain));
                     rows.push(row);
                 }
             }
         }
     }
+    let mixed = if opts.mixed { mixed::run(opts, &machine.cpu, &say)? } else { Vec::new() };
     let ladder = if opts.ladder { Some(all.install(|| ladder::ladder(base()?, &say))?) } else { None };
     let mut small_rows = Vec::new();
     if opts.small {
@@ -250,7 +257,7 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
             }
         }
     }
-    Ok(BenchReport { machine, bed, throughput: rows, ladder, small: small_rows, memory_bandwidth, compaction: compactions })
+    Ok(BenchReport { machine, bed, throughput: rows, mixed, ladder, small: small_rows, memory_bandwidth, compaction: compactions })
 }
 
 impl BenchReport {
@@ -320,6 +327,30 @@ impl BenchReport {
                 throughput::DISPATCH_SECONDS * 1e6,
                 each.join(", ")
             ));
+        }
+        if let Some(first) = self.mixed.first() {
+            s.push_str("\nmixed sizes (beds poured by the bench bed's recipe, as poured and stirred to 1 m/s in random directions; x one size: against the bench bed in the same state on the same backend, precision and threads)\n");
+            s.push_str("bed                          backend prec thr  particle-steps/s  spread  x one size     Z  rebuilds  rebuild ns/grain  x one size  pairs/grain\n");
+            for r in &self.mixed {
+                let reference = if r.scene.ends_with(mixed::STIRRED) { format!("{}{}", first.scene, mixed::STIRRED) } else { first.scene.clone() };
+                let one = self.mixed.iter().find(|o| o.scene == reference && o.backend == r.backend && o.precision == r.precision && o.threads == r.threads);
+                let ratio = |a: Option<f64>, b: Option<f64>| a.zip(b).map_or("-".to_string(), |(a, b)| format!("{:.2}", a / b));
+                s.push_str(&format!(
+                    "{:<28} {:<7} {:<4} {:>3} {:>17.3e} {:>6.1}% {:>11} {:>5.2} {:>9} {:>17} {:>11} {:>12.2}\n",
+                    r.scene,
+                    r.backend,
+                    r.precision,
+                    r.threads,
+                    r.particle_steps_per_second,
+                    r.spread_percent(),
+                    ratio(Some(r.particle_steps_per_second), one.map(|o| o.particle_steps_per_second)),
+                    r.contacts_per_grain,
+                    r.rebuilds,
+                    r.rebuild_ns_per_grain.map_or("-".to_string(), |ns| format!("{ns:.0}")),
+                    ratio(r.rebuild_ns_per_grain, one.and_then(|o| o.rebuild_ns_per_grain)),
+                    r.pairs_per_grain
+                ));
+            }
         }
         if !self.small.is_empty() {
             s.push_str("\nsmall scenes (from their initial state; the GPU's dispatches per step include the rebuild kernels, empty on steps that keep the list)\n");

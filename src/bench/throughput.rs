@@ -29,6 +29,8 @@ pub struct PhaseBytes {
 /// One throughput measurement.
 #[derive(Clone, Debug, Serialize)]
 pub struct Throughput {
+    /// The scene's name: the bench bed's, or a bed of [`super::mixed`].
+    pub scene: String,
     /// "cpu" or "gpu".
     pub backend: String,
     /// The CPU model or the GPU adapter.
@@ -62,6 +64,9 @@ pub struct Throughput {
     pub pairs_per_grain: f64,
     /// Neighbour-list rebuilds during the timed steps.
     pub rebuilds: u64,
+    /// Nanoseconds a rebuild's phases (hash, detect, remap) took per grain, over the timed
+    /// steps (CPU; absent where the engine does not time its phases or nothing was rebuilt).
+    pub rebuild_ns_per_grain: Option<f64>,
     /// Translational kinetic energy per grain at the end (J): the bed stayed static.
     pub ke_per_grain: f64,
     /// Bytes of the engine's arrays or device buffers.
@@ -87,6 +92,9 @@ pub struct Throughput {
     /// bytes and dispatches ([`projected`]).
     pub projected: Vec<Projection>,
 }
+
+/// The phases of a neighbour-list rebuild ([`crate::state::profile::PHASE_NAMES`]).
+const REBUILD_PHASES: [&str; 3] = ["hash", "detect", "remap"];
 
 /// Memory bandwidths (bytes/s) of the GPUs the GPU rows are projected to (their data sheets).
 pub const PROJECTED_GPUS: [(&str, f64); 2] = [("H100 SXM, 3.35 TB/s", 3.35e12), ("H200, 4.8 TB/s", 4.8e12)];
@@ -155,6 +163,9 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, reorder_ev
         .into_iter()
         .map(|(phase, s)| PhaseShare { phase: phase.to_string(), share: if phase_total > 0.0 { s / phase_total } else { 0.0 }, ns_per_particle_step: s * 1e9 / work_all })
         .collect();
+    let rebuilds = after.rebuilds - before.rebuilds;
+    let rebuild_seconds: f64 = engine.phase_seconds().iter().filter(|(p, _)| REBUILD_PHASES.contains(p)).map(|(_, s)| s).sum();
+    let rebuild_ns_per_grain = (rebuilds > 0 && rebuild_seconds > 0.0).then(|| rebuild_seconds * 1e9 / (rebuilds * n as u64) as f64);
     let engine_bytes = engine.memory_bytes();
     let by_phase = engine.step_traffic();
     let traffic: u64 = by_phase.iter().map(|(_, b)| b).sum();
@@ -167,6 +178,7 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, reorder_ev
         _ => Vec::new(),
     };
     Ok(Throughput {
+        scene: String::new(),
         backend: engine.backend().to_string(),
         device: device.to_string(),
         precision: engine.precision().to_string(),
@@ -182,7 +194,8 @@ pub fn measure(engine: &mut dyn Engine, device: &str, threads: usize, reorder_ev
         ns_per_particle_step: seconds * 1e9 / work,
         contacts_per_grain: after.coordination,
         pairs_per_grain: after.pairs as f64 / n as f64,
-        rebuilds: after.rebuilds - before.rebuilds,
+        rebuilds,
+        rebuild_ns_per_grain,
         ke_per_grain: after.ke_translational / n as f64,
         engine_bytes,
         bytes_per_grain: engine_bytes as f64 / n as f64,

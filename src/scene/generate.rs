@@ -239,7 +239,7 @@ fn sample(c: &Complainer, k: usize, region: &RegionSpec, r: f64, rng: &mut ChaCh
 }
 
 /// A unit vector uniform on the sphere (rejection from the cube).
-fn random_direction(rng: &mut ChaCha8Rng) -> [f64; 3] {
+pub(crate) fn random_direction(rng: &mut ChaCha8Rng) -> [f64; 3] {
     loop {
         let v: [f64; 3] = [rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0)];
         let n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];

@@ -12,6 +12,7 @@ pub mod schema;
 pub mod types;
 
 pub use error::SceneError;
+pub(crate) use generate::random_direction;
 pub use stage_specs::pressure_label;
 pub use types::*;
 pub use wall_specs::{cross_section, wall_distance};
