@@ -7,8 +7,8 @@
 //! second, and what each rebuild costs per grain.
 
 use super::bed::{self, BedInfo, BED_SCENE};
-use super::throughput::{self, Throughput};
-use super::{pool, BenchOptions};
+use super::throughput::Throughput;
+use super::{measure_scene, pool, BenchOptions, Config};
 use crate::scene::Scene;
 use anyhow::Context;
 use rand::SeedableRng;
@@ -99,25 +99,14 @@ pub fn run(opts: &BenchOptions, cpu: &str, say: &dyn Fn(&str)) -> anyhow::Result
         let warmup = (steps / 5).max(10);
         for scene in [poured.clone(), stirred(&poured)] {
             for backend in &opts.backends {
-                let configs: Vec<(String, usize)> = if backend == "gpu" {
-                    vec![("f32".into(), 1)]
+                let configs: Vec<Config> = if backend == "gpu" {
+                    vec![Config::gpu()]
                 } else {
-                    opts.precisions.iter().flat_map(|p| opts.threads.iter().map(move |&t| (p.clone(), t))).collect()
+                    opts.precisions.iter().flat_map(|p| opts.threads.iter().map(move |&t| Config { backend: "cpu".into(), precision: p.clone(), threads: t, busy: 0 })).collect()
                 };
-                for (precision, threads) in configs {
-                    say(&format!("mixed sizes: {} on {backend} {precision}, {threads} thread(s): {warmup} + {} x {steps} steps", scene.name, opts.repeats));
-                    let peak_reset = super::memory::reset_peak();
-                    let row = if backend == "gpu" {
-                        let gpu = crate::gpu::open(opts.adapter.as_deref())?;
-                        let device = gpu.info.name.clone();
-                        let mut engine = crate::gpu::GpuEngine::new(gpu, &scene)?;
-                        throughput::measure(&mut engine, &device, 1, None, warmup, steps, opts.repeats, peak_reset)?
-                    } else {
-                        pool(threads)?.install(|| -> anyhow::Result<Throughput> {
-                            let mut engine = crate::runner::cpu_engine(&scene, &precision)?;
-                            throughput::measure(engine.as_mut(), cpu, threads, Some(scene.reorder_every), warmup, steps, opts.repeats, peak_reset)
-                        })?
-                    };
+                for config in configs {
+                    say(&format!("mixed sizes: {} on {backend} {}, {} thread(s): {warmup} + {} x {steps} steps", scene.name, config.precision, config.threads, opts.repeats));
+                    let row = measure_scene(opts, cpu, &scene, &config, warmup, steps)?;
                     let rebuild = row.rebuild_ns_per_grain.map_or(String::new(), |ns| format!(", rebuild {ns:.0} ns a grain"));
                     say(&format!("  {:.3e} particle-steps/s, Z = {:.2}, {} rebuilds{rebuild}", row.particle_steps_per_second, row.contacts_per_grain, row.rebuilds));
                     rows.push(Throughput { scene: scene.name.clone(), ..row });

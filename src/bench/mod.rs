@@ -132,6 +132,44 @@ pub(crate) fn pool(threads: usize) -> anyhow::Result<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().context("cannot start the worker threads")
 }
 
+/// One configuration of a throughput run.
+pub(crate) struct Config {
+    /// "cpu" or "gpu".
+    pub backend: String,
+    /// "f32" or "f64" (the GPU's is f32).
+    pub precision: String,
+    /// CPU worker threads (1 on the GPU).
+    pub threads: usize,
+    /// Busy threads beside a CPU run ([`busy::Busy`]).
+    pub busy: usize,
+}
+
+impl Config {
+    /// The GPU's one configuration.
+    pub fn gpu() -> Self {
+        Config { backend: "gpu".into(), precision: "f32".into(), threads: 1, busy: 0 }
+    }
+}
+
+/// Throughput of `scene` in `config` ([`throughput::measure`], `warmup` + `opts.repeats` x
+/// `steps` steps): on the GPU `opts.adapter` names, or on the CPU on a pool of the config's
+/// threads beside its busy ones.
+pub(crate) fn measure_scene(opts: &BenchOptions, cpu: &str, scene: &crate::scene::Scene, config: &Config, warmup: u64, steps: u64) -> anyhow::Result<Throughput> {
+    let peak_reset = memory::reset_peak();
+    if config.backend == "gpu" {
+        let gpu = crate::gpu::open(opts.adapter.as_deref())?;
+        let device = gpu.info.name.clone();
+        let mut engine = crate::gpu::GpuEngine::new(gpu, scene)?;
+        return throughput::measure(&mut engine, &device, 1, None, warmup, steps, opts.repeats, peak_reset);
+    }
+    let row = pool(config.threads)?.install(|| -> anyhow::Result<Throughput> {
+        let mut engine = crate::runner::cpu_engine(scene, &config.precision)?;
+        let _busy = busy::Busy::start(config.busy);
+        throughput::measure(engine.as_mut(), cpu, config.threads, Some(scene.reorder_every), warmup, steps, opts.repeats, peak_reset)
+    })?;
+    Ok(Throughput { busy: config.busy, ..row })
+}
+
 /// Runs the benchmark.
 pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
     let say = |s: &str| {
@@ -163,49 +201,35 @@ pub fn run(opts: &BenchOptions) -> anyhow::Result<BenchReport> {
     if opts.throughput {
         for &n in &opts.sizes {
             for backend in &opts.backends {
-                let configs: Vec<(String, usize, bool, usize)> = if backend == "gpu" {
-                    vec![("f32".into(), 1, false, 0)]
+                let configs: Vec<(Config, bool)> = if backend == "gpu" {
+                    vec![(Config::gpu(), false)]
                 } else {
                     let mut configs = Vec::new();
                     for p in &opts.precisions {
                         for &t in &opts.threads {
                             for &r in &opts.reorder {
-                                configs.extend(opts.busy.iter().map(|&b| (p.clone(), t, r, b)));
+                                configs.extend(opts.busy.iter().map(|&b| (Config { backend: "cpu".into(), precision: p.clone(), threads: t, busy: b }, r)));
                             }
                         }
                     }
                     configs
                 };
-                for (precision, threads, reorder, busy) in configs {
+                for (config, reorder) in configs {
                     let steps = ((opts.work / n as f64).round() as u64).max(20);
                     let warmup = (steps / 5).max(10);
                     let order = if backend == "gpu" { "" } else if reorder { ", renumbered in cell order" } else { ", in the pour's order" };
-                    let beside = if busy > 0 { format!(", beside {busy} busy thread(s)") } else { String::new() };
-                    say(&format!("{backend} {precision} {threads} thread(s), {n} grains{order}{beside}: {warmup} + {} x {steps} steps", opts.repeats));
-                    let peak_reset = memory::reset_peak();
-                    let row = if backend == "gpu" {
-                        let gpu = crate::gpu::open(opts.adapter.as_deref())?;
-                        let device = gpu.info.name.clone();
-                        let mut engine = {
-                            let scene = bed::bed_of(base()?, n)?;
-                            crate::gpu::GpuEngine::new(gpu, &scene)?
+                    let beside = if config.busy > 0 { format!(", beside {} busy thread(s)", config.busy) } else { String::new() };
+                    say(&format!("{backend} {} {} thread(s), {n} grains{order}{beside}: {warmup} + {} x {steps} steps", config.precision, config.threads, opts.repeats));
+                    let mut scene = bed::bed_of(base()?, n)?;
+                    if backend != "gpu" {
+                        scene = bed::shuffled(&scene);
+                        scene.reorder_every = match (reorder, scene.reorder_every) {
+                            (false, _) => 0,
+                            (true, 0) => crate::scene::DEFAULT_REORDER_EVERY,
+                            (true, every) => every,
                         };
-                        throughput::measure(&mut engine, &device, 1, None, warmup, steps, opts.repeats, peak_reset)?
-                    } else {
-                        pool(threads)?.install(|| -> anyhow::Result<Throughput> {
-                            let mut scene = bed::shuffled(&bed::bed_of(base()?, n)?);
-                            scene.reorder_every = match (reorder, scene.reorder_every) {
-                                (false, _) => 0,
-                                (true, 0) => crate::scene::DEFAULT_REORDER_EVERY,
-                                (true, every) => every,
-                            };
-                            let mut engine = crate::runner::cpu_engine(&scene, &precision)?;
-                            let _busy = busy::Busy::start(busy);
-                            throughput::measure(engine.as_mut(), &machine.cpu, threads, Some(scene.reorder_every), warmup, steps, opts.repeats, peak_reset)
-                        })
-                        .map(|row| Throughput { busy, ..row })?
-                    };
-                    let row = Throughput { scene: base()?.name.clone(), ..row };
+                    }
+                    let row = Throughput { scene: base()?.name.clone(), ..measure_scene(opts, &machine.cpu, &scene, &config, warmup, steps)? };
                     say(&format!("  {:.3e} particle-steps/s, Z = {:.3}, {:.0} B/grain", row.particle_steps_per_second, row.contacts_per_grain, row.bytes_per_grain));
                     rows.push(row);
                 }
