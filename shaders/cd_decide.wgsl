@@ -1,5 +1,6 @@
-// One invocation (the first) sums the blocks in order into the sweep's relative change of the
-// impulses, counts the sweep, and stops the sweeps at the tolerance or at the cap.
+// One invocation (the first) sums the blocks in order into the square of the sweep's quadratic
+// norm, sum |W dr|^2 / sum |W r|^2, counts the sweep, and stops the sweeps at the tolerance or
+// at the cap.
 
 @group(0) @binding(0) var<uniform> cd: CdParams;
 @group(0) @binding(1) var<storage, read> blocks: array<vec2<f32>>;
@@ -15,12 +16,12 @@ fn cd_decide(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_in
         sum = sum + blocks[b];
     }
     sweeps.iterations += 1u;
-    var change = 0.0;
+    var norm2 = 0.0;
     if (sum.y > 0.0) {
-        change = sum.x / sum.y;
+        norm2 = sum.x / sum.y;
     }
-    sweeps.relative_change = change;
-    if (change <= cd.tolerance) {
+    sweeps.sweep_norm2 = norm2;
+    if (norm2 <= cd.tolerance2) {
         sweeps.converged = 1u;
         sweeps.done = 1u;
     } else if (sweeps.iterations >= cd.max_iterations) {

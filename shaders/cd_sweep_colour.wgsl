@@ -18,7 +18,7 @@ fn cd_sweep_colour(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocat
         return;
     }
     let c = contacts[k];
-    let s = solve_contact(c, impulse[k].xyz, Motion(vel[c.a].xyz, omega[c.a].xyz), Motion(vel[c.b].xyz, omega[c.b].xyz));
+    let s = solve_contact(c, impulse[k].xyz, Motion(vel[c.a].xyz, omega[c.a].xyz), Motion(vel[c.b].xyz, omega[c.b].xyz), cd.relaxation);
     impulse[k] = vec4<f32>(s.r, 0.0);
     vel[c.a] = vec4<f32>(s.a.vel, 0.0);
     omega[c.a] = vec4<f32>(s.a.omega, 0.0);

@@ -24,7 +24,7 @@ fn cd_sweep_tail(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         } else {
             b = Motion(vel[c.b].xyz, omega[c.b].xyz);
         }
-        let s = solve_contact(c, impulse[k].xyz, a, b);
+        let s = solve_contact(c, impulse[k].xyz, a, b, cd.relaxation);
         impulse[k] = vec4<f32>(s.r, 0.0);
         vel[c.a] = vec4<f32>(s.a.vel, 0.0);
         omega[c.a] = vec4<f32>(s.a.omega, 0.0);

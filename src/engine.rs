@@ -203,8 +203,9 @@ pub struct SolverStats {
     pub max_iterations: u32,
     /// Mean sweeps per step.
     pub mean_iterations: f64,
-    /// Largest relative change of the impulses a step's solve ended with (-).
-    pub relative_change: f64,
+    /// Largest quadratic norm of the last sweep a step's solve ended with (-; the stopping
+    /// test's measure, `grains::cd`).
+    pub sweep_norm: f64,
     /// The last step's force balance (see `grains::cd::SolveReport::unbalanced`).
     pub unbalanced: f64,
     /// Steps solved since the run started.
@@ -217,7 +218,32 @@ pub struct SolverStats {
     /// last read: the solver's work.
     #[serde(default)]
     pub contact_updates: u64,
+    /// The largest residuals a step's solve ended with since the last read.
+    #[serde(default)]
+    pub residuals: Residuals,
 }
+
+/// How far a contact-dynamics step's impulses are from the contact laws (`grains::cd`'s
+/// residual module): each contact's correction its local problem would still make, in velocity.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Residuals {
+    /// Largest normal residual: interpenetration (or pull) speed left at a contact (m/s).
+    pub normal: f64,
+    /// Largest tangential residual: slip speed left against Coulomb's law (m/s).
+    pub tangential: f64,
+    /// Quadratic norm (-).
+    pub quadratic: f64,
+    /// Maximum norm (-).
+    pub maximum: f64,
+}
+
+impl Residuals {
+    /// The larger of each residual of `self` and `other`.
+    pub fn max(self, other: Residuals) -> Residuals {
+        Residuals { normal: self.normal.max(other.normal), tangential: self.tangential.max(other.tangential), quadratic: self.quadratic.max(other.quadratic), maximum: self.maximum.max(other.maximum) }
+    }
+}
+
 
 /// Grains with fewer contacts than this are rattlers: they carry no load, and a rattler
 /// bouncing in its cage says nothing about whether the packing stands (shared with WGSL

@@ -16,7 +16,7 @@ use grains::scene::Scene;
 const EXACT: f64 = 1e-9;
 
 /// Tight solver settings for exact answers.
-const PARAMS: CdParams = CdParams { theta: 0.5, tolerance: 1e-13, max_iterations: 10_000, gap_allowance: 1e-6, wall_mass: None };
+const PARAMS: CdParams = CdParams { theta: 0.5, tolerance: 1e-13, max_iterations: 10_000, relaxation: 1.0, gap_allowance: 1e-6, wall_mass: None };
 
 const G: f64 = 9.81;
 const RADIUS: f64 = 0.5e-3;
@@ -143,6 +143,73 @@ fn a_column_of_spheres_carries_the_weight_above_each_contact() {
     assert_eq!(cd.contacts().len(), n);
     for k in 0..n {
         assert!(relative(cd.position(k)[2], height(k)) < EXACT);
+    }
+}
+
+/// Relative error of a contact's load allowed per unit of the solver's tolerance on a column:
+/// the impulses' error is the residual magnified by the Delassus operator's conditioning,
+/// which grows as the square of the column's length (about 1e2 for 16 grains).
+const COLUMN_CONDITIONING: f64 = 1e3;
+
+#[test]
+fn a_frictionless_column_converges_to_its_unique_impulses_within_the_tolerance_at_every_relaxation() {
+    // A frictionless column has one solution: each contact carries the weight above it. The
+    // first step starts cold, so the sweeps must build the whole load; at tolerance t each load
+    // lands within COLUMN_CONDITIONING t of the exact one, plain or over-relaxed.
+    let n = 16;
+    let dt = 1e-4;
+    let height = |k: usize| RADIUS * (1.0 + 2.0 * k as f64);
+    let grains: String = (0..n).map(|k| grain([0.0, 0.0, height(k) + 1e-6 * k as f64], [0.0; 3])).collect();
+    let mut s = scene(0.0, 0.5, [0.0, 0.0, -G], true, dt, &grains);
+    for (k, x) in s.grains.position.iter_mut().enumerate() {
+        x[2] = height(k);
+    }
+    for relaxation in [1.0, 1.5] {
+        for tolerance in [1e-4, 1e-6, 1e-8] {
+            let mut cd = ContactDynamics::<f64>::new(&s, CdParams { tolerance, relaxation, ..PARAMS }).unwrap();
+            for _ in 0..20 {
+                cd.step().unwrap();
+            }
+            let report = cd.report();
+            let worst = cd.contacts().iter().map(|c| {
+                let k = c.a as usize + if matches!(c.b, Partner::Wall(_)) { 0 } else { 1 };
+                relative(c.r.dot(c.n) / dt, (n - k) as f64 * mass() * G)
+            }).fold(0.0, f64::max);
+            println!("relaxation {relaxation}, tolerance {tolerance:e}: {} sweeps, worst load error {worst:.2e}, residuals {:?}", report.iterations, report.residuals);
+            assert!(report.converged && cd.contacts().len() == n);
+            assert!(worst < COLUMN_CONDITIONING * tolerance, "load error {worst:e} at tolerance {tolerance:e}");
+            assert!(report.residuals.quadratic < COLUMN_CONDITIONING * tolerance, "{:?}", report.residuals);
+        }
+    }
+}
+
+#[test]
+fn the_residuals_fall_as_the_sweeps_run_in_a_loaded_packing() {
+    // 1,000 grains landed in a box (900 loaded contacts): one step solved again and again from the same state with
+    // more sweeps each time; how far the impulses end from the contact laws (the residuals,
+    // measured on the final velocities) must fall with the sweeps, plain and over-relaxed.
+    let s = common::cd::falling_box(1000, [12.0e-3, 12.0e-3, 16.0e-3]);
+    let grains::scene::Method::ContactDynamics(params) = s.method else { panic!("falling_box is a contact-dynamics scene") };
+    let mut cd = ContactDynamics::<f64>::new(&s, params).unwrap();
+    for _ in 0..900 {
+        cd.step().unwrap();
+    }
+    let state = cd.save().unwrap();
+    for relaxation in [1.0, 1.5] {
+        let residuals: Vec<(u32, f64, f64)> = [4, 16, 64, 256]
+            .into_iter()
+            .map(|sweeps| {
+                let mut again = ContactDynamics::<f64>::new(&s, CdParams { tolerance: 1e-12, max_iterations: sweeps, relaxation, ..params }).unwrap();
+                again.restore(&state).unwrap();
+                again.step().unwrap();
+                let r = again.report();
+                assert_eq!(r.iterations, sweeps);
+                (sweeps, r.residuals.quadratic, r.residuals.normal)
+            })
+            .collect();
+        println!("relaxation {relaxation}, (sweeps, quadratic norm, largest normal residual m/s): {residuals:?}, {} loaded contacts", cd.report().loaded);
+        assert!(residuals.windows(2).all(|w| w[1].1 < w[0].1 && w[1].2 < w[0].2), "residuals must fall: {residuals:?}");
+        assert!(residuals[3].1 < 0.1 * residuals[0].1, "64 times the sweeps must cut the quadratic norm tenfold: {residuals:?}");
     }
 }
 

@@ -34,8 +34,8 @@ struct CdParams {
     tail: u32,           // first contact of the serial tail (walls, uncoloured pairs)
     n_blocks: u32,       // blocks of the convergence measure
     max_iterations: u32, // sweeps at most
-    tolerance: f32,      // relative change of the impulses at which the sweeps stop (-)
-    _pad0: f32,
+    tolerance2: f32,     // square of the quadratic norm at which the sweeps stop (-)
+    relaxation: f32,     // over-relaxation factor (-; 1: plain Gauss-Seidel)
     _pad1: f32,
     _pad2: f32,
 }
@@ -51,10 +51,10 @@ struct CdColour {
 // Where the sweeps stand; every kernel does nothing once done is set.
 struct CdControl {
     iterations: u32,      // sweeps run
-    converged: u32,       // 1: the relative change fell to the tolerance
+    converged: u32,       // 1: the sweeps' quadratic norm fell to the tolerance
     done: u32,            // 1: converged or at the cap
     _pad0: u32,
-    relative_change: f32, // of the last sweep (-)
+    sweep_norm2: f32,     // square of the last sweep's quadratic norm (-)
     _pad1: f32,
     _pad2: f32,
     _pad3: f32,
@@ -67,7 +67,8 @@ struct Motion {
 }
 
 // A solved contact: its new impulse (N s, on b), both bodies' motions with the change applied,
-// and its share of the convergence measure (|r - r_old|, |r|).
+// and its share of the convergence measure (|W dr|^2, |W r|^2): the squared velocity correction
+// its solve made and the squared velocity its impulse gives it.
 struct Solved {
     r: vec3<f32>,
     a: Motion,
@@ -85,6 +86,16 @@ fn cross3(p: vec3<f32>, q: vec3<f32>) -> vec3<f32> {
 
 fn norm3(p: vec3<f32>) -> f32 {
     return sqrt(dot3(p, p));
+}
+
+// |W v|^2 ((m/s)^2): the squared velocity an impulse v (N s) gives contact c through its local
+// Delassus diagonal, (w_n v_n)^2 + w_t^2 |v_t|^2.
+fn weighted2(c: CdContact, v: vec3<f32>) -> f32 {
+    let n = c.n.xyz;
+    let v_n = dot3(v, n);
+    let normal = c.w_n * v_n;
+    let tangential = (v - n * v_n) * c.w_t;
+    return normal * normal + dot3(tangential, tangential);
 }
 
 // Velocity of b against a at the contact point (m/s).
@@ -117,11 +128,32 @@ fn local_impulse(c: CdContact, r_old: vec3<f32>, a: Motion, b: Motion) -> vec3<f
     return n * r_n + r_t;
 }
 
+// The impulse a sweep leaves at contact c from its local solution star: star itself when omega
+// is 1, else over-relaxed from r_old, r_old + omega (star - r_old), and put back in the
+// admissible set (r_n >= 0, the tangential part clipped to the cone mu r_n along itself).
+fn relax(c: CdContact, r_old: vec3<f32>, star: vec3<f32>, omega: f32) -> vec3<f32> {
+    if (omega == 1.0) {
+        return star;
+    }
+    let n = c.n.xyz;
+    let x = r_old + (star - r_old) * omega;
+    let x_n = dot3(x, n);
+    let r_n = max(x_n, 0.0);
+    var r_t = x - n * x_n;
+    let cap = c.mu * r_n;
+    let norm2 = dot3(r_t, r_t);
+    if (!(norm2 <= cap * cap)) {
+        r_t = r_t * (cap / sqrt(norm2));
+    }
+    return n * r_n + r_t;
+}
+
 // Solves contact c between a and b and applies the change of its impulse to both; a wall (b)
 // moves along the normal only.
-fn solve_contact(c: CdContact, r_old: vec3<f32>, a: Motion, b: Motion) -> Solved {
+fn solve_contact(c: CdContact, r_old: vec3<f32>, a: Motion, b: Motion, omega: f32) -> Solved {
     let n = c.n.xyz;
-    let r = local_impulse(c, r_old, a, b);
+    let star = local_impulse(c, r_old, a, b);
+    let r = relax(c, r_old, star, omega);
     let dr = r - r_old;
     var out: Solved;
     out.r = r;
@@ -131,6 +163,6 @@ fn solve_contact(c: CdContact, r_old: vec3<f32>, a: Motion, b: Motion) -> Solved
     } else {
         out.b = Motion(b.vel + dr * c.inv_mass_b, b.omega + cross3(n * -c.radius_b, dr) * c.inv_inertia_b);
     }
-    out.measure = vec2<f32>(norm3(r - r_old), norm3(r));
+    out.measure = vec2<f32>(weighted2(c, star - r_old), weighted2(c, r));
     return out;
 }

@@ -189,7 +189,9 @@ impl<T: Real> Engine for ContactDynamics<T> {
         // statistics are the uninterrupted run's.
         let r = &self.since_read;
         s.put_ints("solver_counts", [r.steps, r.unconverged_steps, r.max_iterations as u64, r.steps_total, r.unconverged_total, r.contact_updates]);
-        s.put_reals("solver_reals", [r.mean_iterations, r.relative_change, r.unbalanced, self.report.unbalanced]);
+        s.put_reals("solver_reals", [r.mean_iterations, r.sweep_norm, r.unbalanced, self.report.unbalanced]);
+        let q = &r.residuals;
+        s.put_reals("solver_residuals", [q.normal, q.tangential, q.quadratic, q.maximum]);
         Ok(s)
     }
 
@@ -235,8 +237,16 @@ impl<T: Real> Engine for ContactDynamics<T> {
             unconverged_total: counts[4],
             contact_updates: counts.get(5).copied().unwrap_or(0),
             mean_iterations: reals[0],
-            relative_change: reals[1],
+            sweep_norm: reals[1],
             unbalanced: reals[2],
+            // Checkpoints from before the residuals were measured resume with none recorded.
+            residuals: match s.reals.get("solver_residuals") {
+                Some(_) => {
+                    let q = s.reals("solver_residuals", 4)?;
+                    crate::engine::Residuals { normal: q[0], tangential: q[1], quadratic: q[2], maximum: q[3] }
+                }
+                None => Default::default(),
+            },
         };
         self.report.unbalanced = reals[3];
         Ok(())

@@ -25,8 +25,12 @@
 //!    * tangential (Coulomb with `mu`): the sticking impulse `-u'_t / w_t` when it lies in the
 //!      cone `|r_t| <= mu r_n`, else `-mu r_n u'_t / |u'_t|` (sliding against `u'_t`).
 //!
-//!    The sweep repeats until the impulses' relative change `sum |r - r_prev| / sum |r|`
-//!    falls to the tolerance or the iteration cap is reached; the statistics say which.
+//!    The sweep repeats until its quadratic norm, LMGC90's for nonsmooth Gauss-Seidel,
+//!    `sqrt(sum |W dr|^2 / sum |W r|^2)` (the velocity corrections `W dr` the sweep's local
+//!    solves made, that is how far each contact was from its laws, against the velocities
+//!    `W r` the impulses give; `W` the local Delassus diagonal), falls to the tolerance or
+//!    the iteration cap is reached; the statistics say which, and the step's residuals
+//!    (`residual`) say how far the final impulses are from the laws.
 //!    Impulses start from the previous step's (warm start), carried per contact by (grain
 //!    id, partner id or wall) like the DEM engine's history.
 //! 4. Positions by the theta-method: `x += h (theta v^+ + (1 - theta) v^-)`, the servo box's
@@ -50,10 +54,12 @@ use std::collections::HashMap;
 
 mod colour;
 mod engine;
+mod residual;
 mod servo;
 mod solve;
 
 pub use colour::{Schedule, MAX_COLOURS};
+pub use crate::engine::Residuals;
 pub use solve::{CpuSweeps, MEASURE_BLOCK};
 
 /// The second body of a contact.
@@ -116,10 +122,10 @@ pub struct WallMotion<T> {
 pub struct SolveReport {
     /// Gauss-Seidel sweeps run.
     pub iterations: u32,
-    /// Whether the relative change fell to the tolerance within the cap.
+    /// Whether the sweeps' quadratic norm fell to the tolerance within the cap.
     pub converged: bool,
-    /// Relative change of the impulses in the last sweep (-).
-    pub relative_change: f64,
+    /// Quadratic norm of the last sweep (-).
+    pub sweep_norm: f64,
     /// Contacts in the system.
     pub contacts: usize,
     /// Contacts carrying a normal impulse.
@@ -134,6 +140,8 @@ pub struct SolveReport {
     /// leave on a grain, `|m (v^+ - v^-)|`, over the mean normal impulse of the loaded
     /// contacts (-; 0 when every grain is in equilibrium).
     pub unbalanced: f64,
+    /// How far the impulses are from the contact laws at the step's end.
+    pub residuals: Residuals,
 }
 
 /// What the sweeps of one step did.
@@ -141,10 +149,22 @@ pub struct SolveReport {
 pub struct Solved {
     /// Sweeps run.
     pub iterations: u32,
-    /// Whether the relative change fell to the tolerance within the cap.
+    /// Whether the sweeps' quadratic norm fell to the tolerance within the cap.
     pub converged: bool,
-    /// Relative change of the impulses in the last sweep (-).
-    pub relative_change: f64,
+    /// Quadratic norm of the last sweep (-).
+    pub sweep_norm: f64,
+}
+
+/// What a step's sweeps aim at and may spend.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SweepSettings<T> {
+    /// Quadratic norm of a sweep at which the sweeps stop (-).
+    pub tolerance: T,
+    /// Most sweeps.
+    pub max_iterations: u32,
+    /// Over-relaxation factor `omega` (-; 1: plain Gauss-Seidel): each local solution `r*` is
+    /// taken as `r + omega (r* - r)`, put back in the cone (`solve::relax`).
+    pub relaxation: T,
 }
 
 /// Where a step's Gauss-Seidel sweeps run: on the CPU's threads ([`CpuSweeps`]) or on a GPU
@@ -156,10 +176,10 @@ pub trait Sweeps<T: Real>: Send {
     /// "cpu" or "gpu".
     fn backend(&self) -> &'static str;
     /// Sweeps the contacts, whose impulses (the warm start) the bodies' velocities already
-    /// hold, until the impulses' relative change falls to `tolerance` or `max_iterations`
-    /// sweeps have run; leaves the impulses in `contacts` and the velocities in `body` and
+    /// hold, until a sweep's quadratic norm falls to the settings' tolerance or their cap of
+    /// sweeps has run; leaves the impulses in `contacts` and the velocities in `body` and
     /// `walls`.
-    fn solve(&mut self, contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], tolerance: T, max_iterations: u32) -> Result<Solved, SimError>;
+    fn solve(&mut self, contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], settings: SweepSettings<T>) -> Result<Solved, SimError>;
 }
 
 /// A contact-dynamics system: rigid spheres, static walls, the step's contacts.
@@ -433,10 +453,12 @@ impl<T: Real> ContactDynamics<T> {
         self.clock.stop(CdPhase::Detect, started);
         let started = self.clock.start();
         let mut report = SolveReport { contacts: contacts.len(), colours: self.schedule.starts.len().saturating_sub(1), largest_colour: self.schedule.colours().map(|r| r.len()).max().unwrap_or(0), serial: contacts.len() - self.schedule.tail(), ..Default::default() };
-        let solved = self.sweeps.solve(&mut contacts, &self.schedule, &mut self.body, &mut self.wall_motion, T::of(self.params.tolerance), self.params.max_iterations)?;
-        (report.iterations, report.converged, report.relative_change) = (solved.iterations, solved.converged, solved.relative_change);
+        let settings = SweepSettings { tolerance: T::of(self.params.tolerance), max_iterations: self.params.max_iterations, relaxation: T::of(self.params.relaxation) };
+        let solved = self.sweeps.solve(&mut contacts, &self.schedule, &mut self.body, &mut self.wall_motion, settings)?;
+        (report.iterations, report.converged, report.sweep_norm) = (solved.iterations, solved.converged, solved.sweep_norm);
         self.clock.stop(CdPhase::Sweeps, started);
         let started = self.clock.start();
+        report.residuals = residual::residuals(&contacts, &self.body, &self.wall_motion);
         // Force balance of the grains, and the warm start of the next step.
         let loaded: Vec<T> = contacts.iter().map(|c| c.r.dot(c.n)).filter(|&r_n| r_n > T::ZERO).collect();
         report.loaded = loaded.len();
@@ -454,8 +476,9 @@ impl<T: Real> ContactDynamics<T> {
         r.unconverged_total += u64::from(!report.converged);
         r.max_iterations = r.max_iterations.max(report.iterations);
         r.contact_updates += report.contacts as u64 * u64::from(report.iterations);
-        r.relative_change = r.relative_change.max(report.relative_change);
+        r.sweep_norm = r.sweep_norm.max(report.sweep_norm);
         r.unbalanced = report.unbalanced;
+        r.residuals = r.residuals.max(report.residuals);
         // Positions by the theta-method.
         for (i, b0) in before.iter().enumerate() {
             let b = &mut self.body[i];

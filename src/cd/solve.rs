@@ -2,7 +2,7 @@
 //! module text of [`super`]), colour by colour in parallel, then the serial tail.
 
 use super::colour::Schedule;
-use super::{Contact, Partner, Solved, Sweeps, WallMotion};
+use super::{Contact, Partner, Solved, SweepSettings, Sweeps, WallMotion};
 use crate::engine::SimError;
 use crate::state::reduce::PAR_MIN_PAIRS;
 use crate::state::Body;
@@ -34,7 +34,7 @@ pub(super) fn apply_b<T: Real>(c: &Contact<T>, b: &mut Body<T>, dr: Vec3<T>) {
 
 /// Contact `c`'s impulse (N s, on `b`) solving its local problem exactly against the other
 /// contacts' impulses, which the bodies' velocities hold with its own.
-fn local<T: Real>(c: &Contact<T>, a: &Body<T>, b: &Body<T>) -> Vec3<T> {
+pub(super) fn local<T: Real>(c: &Contact<T>, a: &Body<T>, b: &Body<T>) -> Vec3<T> {
     let r_old = c.r;
     // The contact's velocity without its own impulse.
     let u = relative_velocity(c, a, b);
@@ -59,29 +59,60 @@ fn local<T: Real>(c: &Contact<T>, a: &Body<T>, b: &Body<T>) -> Vec3<T> {
     c.n * r_n + r_t
 }
 
-/// Solves contact `c` between bodies `a` and `b` one after the other: its new impulse, applied;
-/// returns its share of the convergence measure.
-fn solve_serial<T: Real>(c: &mut Contact<T>, a: &mut Body<T>, b: &mut Body<T>) -> (T, T) {
-    let r = local(c, a, b);
+/// The impulse a sweep leaves at contact `c` from its local solution `star`: `star` itself
+/// when `omega` is 1, else over-relaxed from the impulse before, `r + omega (star - r)`, and
+/// put back in the admissible set (`r_n >= 0`, the tangential part clipped to the cone
+/// `mu r_n` along itself).
+pub(super) fn relax<T: Real>(c: &Contact<T>, star: Vec3<T>, omega: T) -> Vec3<T> {
+    if omega == T::ONE {
+        return star;
+    }
+    let x = c.r + (star - c.r) * omega;
+    let x_n = x.dot(c.n);
+    let r_n = x_n.max(T::ZERO);
+    let r_t = x - c.n * x_n;
+    let cap = c.mu * r_n;
+    let norm2 = r_t.norm2();
+    let r_t = if norm2 <= cap * cap { r_t } else { r_t * (cap / norm2.sqrt()) };
+    c.n * r_n + r_t
+}
+
+/// Solves contact `c` between bodies `a` and `b` one after the other: its new impulse
+/// (relaxed by `omega`), applied; returns its share of the convergence measure.
+fn solve_serial<T: Real>(c: &mut Contact<T>, a: &mut Body<T>, b: &mut Body<T>, omega: T) -> (T, T) {
+    let star = local(c, a, b);
+    let r = relax(c, star, omega);
     apply_a(c, a, r - c.r);
     apply_b(c, b, r - c.r);
-    let sum = measure(r, c.r);
+    let sum = measure(c, star - c.r, r);
     c.r = r;
     sum
 }
 
-/// `(|r - r_old|, |r|)` (N s), a contact's share of the convergence measure.
-fn measure<T: Real>(r: Vec3<T>, r_old: Vec3<T>) -> (T, T) {
-    ((r - r_old).norm(), r.norm())
+/// `|W v|^2` ((m/s)^2): the squared velocity an impulse `v` (N s) gives contact `c` through its
+/// local Delassus diagonal, `(w_n v_n)^2 + w_t^2 |v_t|^2`.
+pub(super) fn weighted2<T: Real>(c: &Contact<T>, v: Vec3<T>) -> T {
+    let v_n = v.dot(c.n);
+    let normal = c.w_n * v_n;
+    let tangential = (v - c.n * v_n) * c.w_t;
+    normal * normal + tangential.norm2()
+}
+
+/// `(|W dr|^2, |W r|^2)`, a contact's share of the convergence measure: the squared velocity
+/// correction its local solve made (`dr`, N s: how far it was from its law) and the squared
+/// velocity its new impulse `r` gives it.
+fn measure<T: Real>(c: &Contact<T>, dr: Vec3<T>, r: Vec3<T>) -> (T, T) {
+    (weighted2(c, dr), weighted2(c, r))
 }
 
 /// Contacts per block of the convergence measure's sum: each block is summed in contact order,
 /// then the blocks' sums in order (the GPU's `cd_measure` and `cd_decide` add the same way).
 pub const MEASURE_BLOCK: usize = 256;
 
-/// The relative change `sum |r - r_old| / sum |r|` of a sweep's per-contact measures, summed
-/// block by block ([`MEASURE_BLOCK`]) in contact order; 0 when no contact carries an impulse.
-pub(super) fn relative_change<T: Real>(sums: &[(T, T)]) -> T {
+/// The square of a sweep's quadratic norm, `sum |W dr|^2 / sum |W r|^2` over its per-contact
+/// measures, summed block by block ([`MEASURE_BLOCK`]) in contact order; 0 when no contact
+/// carries an impulse.
+pub(super) fn quadratic_norm2<T: Real>(sums: &[(T, T)]) -> T {
     let add = |(c, t): (T, T), &(dc, dt): &(T, T)| (c + dc, t + dt);
     let blocks: Vec<(T, T)> = sums.chunks(MEASURE_BLOCK).map(|b| b.iter().fold((T::ZERO, T::ZERO), add)).collect();
     let (change, total) = blocks.iter().fold((T::ZERO, T::ZERO), add);
@@ -98,20 +129,20 @@ const APPLY_CHUNK: usize = 4096;
 /// A sweep's per-contact scratch.
 #[derive(Default)]
 pub(super) struct Scratch<T> {
-    /// `(|r - r_old|, |r|)` (N s).
+    /// `(|W dr|^2, |W r|^2)` ((m/s)^2).
     sums: Vec<(T, T)>,
     /// `r - r_old` (N s).
     change: Vec<Vec3<T>>,
 }
 
-/// One sweep over every contact in the schedule's order; returns the relative change of the
-/// impulses ([`relative_change`]), summed in the schedule's order whatever the thread count.
+/// One sweep over every contact in the schedule's order; returns the square of its quadratic
+/// norm ([`quadratic_norm2`]), summed in the schedule's order whatever the thread count.
 ///
 /// A colour large enough to share is solved in two passes: every contact's new impulse from the bodies as the colour
 /// found them (in parallel over the contacts), then the changes applied (in parallel over
 /// chunks of grains, each grain touched by one contact of the colour at most). Since no two
 /// contacts of a colour share a grain, this gives the bits of solving them one after the other.
-pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], scratch: &mut Scratch<T>) -> T {
+pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], omega: T, scratch: &mut Scratch<T>) -> T {
     let n = contacts.len();
     scratch.sums.clear();
     scratch.sums.resize(n, (T::ZERO, T::ZERO));
@@ -123,15 +154,16 @@ pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, b
             for (c, sum) in contacts[range.clone()].iter_mut().zip(&mut scratch.sums[range]) {
                 let Partner::Grain(j) = c.b else { unreachable!("colours hold grain pairs") };
                 let (a, b) = two(body, c.a as usize, j as usize);
-                *sum = solve_serial(c, a, b);
+                *sum = solve_serial(c, a, b, omega);
             }
             continue;
         }
         let grains: &[Body<T>] = body;
         contacts[range.clone()].par_iter_mut().zip(scratch.sums[range.clone()].par_iter_mut()).zip(scratch.change[range].par_iter_mut()).with_min_len(PAR_MIN_PAIRS).for_each(|((c, sum), change)| {
             let Partner::Grain(j) = c.b else { unreachable!("colours hold grain pairs") };
-            let r = local(c, &grains[c.a as usize], &grains[j as usize]);
-            (*sum, *change) = (measure(r, c.r), r - c.r);
+            let star = local(c, &grains[c.a as usize], &grains[j as usize]);
+            let r = relax(c, star, omega);
+            (*sum, *change) = (measure(c, star - c.r, r), r - c.r);
             c.r = r;
         });
         let touches = schedule.touches(k);
@@ -155,18 +187,18 @@ pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, b
         *sum = match c.b {
             Partner::Grain(j) => {
                 let (a, b) = two(body, c.a as usize, j as usize);
-                solve_serial(c, a, b)
+                solve_serial(c, a, b, omega)
             }
             Partner::Wall(w) => {
                 let wall = &mut walls[w as usize];
                 let mut b = Body { pos: Vec3::ZERO, vel: wall.vel, omega: Vec3::ZERO };
-                let sum = solve_serial(c, &mut body[c.a as usize], &mut b);
+                let sum = solve_serial(c, &mut body[c.a as usize], &mut b, omega);
                 wall.vel = b.vel;
                 sum
             }
         };
     }
-    relative_change(&scratch.sums)
+    quadratic_norm2(&scratch.sums)
 }
 
 /// The sweeps on the CPU's threads.
@@ -180,13 +212,13 @@ impl<T: Real> Sweeps<T> for CpuSweeps<T> {
         "cpu"
     }
 
-    fn solve(&mut self, contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], tolerance: T, max_iterations: u32) -> Result<Solved, SimError> {
+    fn solve(&mut self, contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], settings: SweepSettings<T>) -> Result<Solved, SimError> {
         let mut solved = Solved::default();
-        while solved.iterations < max_iterations {
+        while solved.iterations < settings.max_iterations {
             solved.iterations += 1;
-            let change = sweep(contacts, schedule, body, walls, &mut self.scratch);
-            solved.relative_change = change.f64();
-            if change <= tolerance {
+            let norm2 = sweep(contacts, schedule, body, walls, settings.relaxation, &mut self.scratch);
+            solved.sweep_norm = norm2.f64().sqrt();
+            if norm2 <= settings.tolerance * settings.tolerance {
                 solved.converged = true;
                 break;
             }

@@ -399,10 +399,10 @@ pub struct CdParams {
     pub n_blocks: u32,
     /// Sweeps at most.
     pub max_iterations: u32,
-    /// Relative change at which the sweeps stop (-).
-    pub tolerance: f32,
-    /// Padding.
-    pub _pad0: f32,
+    /// Square of the quadratic norm at which the sweeps stop (-).
+    pub tolerance2: f32,
+    /// Over-relaxation factor (-; 1: plain Gauss-Seidel).
+    pub relaxation: f32,
     /// Padding.
     pub _pad1: f32,
     /// Padding.
@@ -429,14 +429,14 @@ pub struct CdColour {
 pub struct CdControl {
     /// Sweeps run.
     pub iterations: u32,
-    /// 1: the relative change fell to the tolerance.
+    /// 1: the sweeps' quadratic norm fell to the tolerance.
     pub converged: u32,
     /// 1: converged or at the cap.
     pub done: u32,
     /// Padding.
     pub _pad0: u32,
-    /// Relative change of the last sweep (-).
-    pub relative_change: f32,
+    /// Square of the last sweep's quadratic norm (-).
+    pub sweep_norm2: f32,
     /// Padding.
     pub _pad1: f32,
     /// Padding.

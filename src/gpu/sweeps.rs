@@ -13,7 +13,7 @@
 use super::device::Gpu;
 use super::layout::{CdColour, CdContact, CdControl, CdParams};
 use super::pipeline::{bind_group, compute_pipeline, read_back, Buffers};
-use crate::cd::{Contact, Partner, Schedule, Solved, Sweeps, WallMotion, MAX_COLOURS, MEASURE_BLOCK};
+use crate::cd::{Contact, Partner, Schedule, Solved, SweepSettings, Sweeps, WallMotion, MAX_COLOURS, MEASURE_BLOCK};
 use crate::state::Body;
 use crate::engine::SimError;
 use crate::gpu::kernels::{Buf, CdKernel, CD_KERNELS};
@@ -149,14 +149,14 @@ impl Sweeps<f32> for GpuSweeps {
         "gpu"
     }
 
-    fn solve(&mut self, contacts: &mut [Contact<f32>], schedule: &Schedule, body: &mut [Body<f32>], walls: &mut [WallMotion<f32>], tolerance: f32, max_iterations: u32) -> Result<Solved, SimError> {
+    fn solve(&mut self, contacts: &mut [Contact<f32>], schedule: &Schedule, body: &mut [Body<f32>], walls: &mut [WallMotion<f32>], settings: SweepSettings<f32>) -> Result<Solved, SimError> {
         let n = contacts.len() as u64;
         if n > self.capacity {
             self.grow(n.next_power_of_two());
         }
         let blocks = n.div_ceil(MEASURE_BLOCK as u64);
         let tail = schedule.tail();
-        let params = CdParams { n_contacts: n as u32, tail: tail as u32, n_blocks: blocks as u32, max_iterations, tolerance, ..Default::default() };
+        let params = CdParams { n_contacts: n as u32, tail: tail as u32, n_blocks: blocks as u32, max_iterations: settings.max_iterations, tolerance2: settings.tolerance * settings.tolerance, relaxation: settings.relaxation, ..Default::default() };
         self.write(Buf::Cd, 0, &[params]);
         let colour_sizes: Vec<usize> = schedule.colours().map(|r| r.len()).collect();
         for (k, range) in schedule.colours().enumerate() {
@@ -189,6 +189,6 @@ impl Sweeps<f32> for GpuSweeps {
         for (m, v) in walls.iter_mut().zip(out[3].chunks_exact(4)) {
             m.vel = vec3(v);
         }
-        Ok(Solved { iterations: control.iterations, converged: control.converged != 0, relative_change: control.relative_change as f64 })
+        Ok(Solved { iterations: control.iterations, converged: control.converged != 0, sweep_norm: (control.sweep_norm2 as f64).sqrt() })
     }
 }

@@ -37,7 +37,7 @@ fn stats_header(s: &Stats) -> String {
 }
 
 /// Contact dynamics' columns of `stats.csv`, after the walls' (see [`crate::engine::SolverStats`]).
-const SOLVER_COLUMNS: &str = ",cd_steps,cd_unconverged_steps,cd_max_iterations,cd_mean_iterations,cd_relative_change,cd_unbalanced,cd_contact_updates";
+const SOLVER_COLUMNS: &str = ",cd_steps,cd_unconverged_steps,cd_max_iterations,cd_mean_iterations,cd_sweep_norm,cd_unbalanced,cd_contact_updates,cd_normal_residual,cd_tangential_residual,cd_quadratic_residual,cd_maximum_residual";
 
 fn stats_row(stage: &str, s: &Stats) -> String {
     let (pz, pp) = s.piston.as_ref().map_or((String::new(), String::new()), |p| (format!("{:e}", p.z), format!("{:e}", p.pressure)));
@@ -68,7 +68,8 @@ fn stats_row(stage: &str, s: &Stats) -> String {
         row.push_str(&format!(",{:e},{:e},{:e}", w.force[0], w.force[1], w.force[2]));
     }
     if let Some(c) = &s.solver {
-        row.push_str(&format!(",{},{},{},{:e},{:e},{:e},{}", c.steps, c.unconverged_steps, c.max_iterations, c.mean_iterations, c.relative_change, c.unbalanced, c.contact_updates));
+        let q = &c.residuals;
+        row.push_str(&format!(",{},{},{},{:e},{:e},{:e},{},{:e},{:e},{:e},{:e}", c.steps, c.unconverged_steps, c.max_iterations, c.mean_iterations, c.sweep_norm, c.unbalanced, c.contact_updates, q.normal, q.tangential, q.quadratic, q.maximum));
     }
     row
 }

@@ -155,8 +155,12 @@ impl Summary {
                 st.name, st.kind, st.steps, st.time_end, st.ke_per_grain, st.unbalanced_force, st.stats.coordination, 100.0 * st.stats.sliding_fraction(), st.stats.max_overlap);
         }
         // Contact dynamics says how many steps its solver left at the iteration cap.
-        if let Some(c) = self.stages.last().and_then(|st| st.stats.solver).filter(|c| c.unconverged_total > 0) {
-            let _ = writeln!(s, "  contact dynamics: {} of {} steps stopped at contact_dynamics.max_iterations before the tolerance (stats.csv: cd_unconverged_steps)", c.unconverged_total, c.steps_total);
+        if let Some(c) = self.stages.last().and_then(|st| st.stats.solver) {
+            if c.unconverged_total > 0 {
+                let _ = writeln!(s, "  contact dynamics: {} of {} steps stopped at contact_dynamics.max_iterations before the tolerance (stats.csv: cd_unconverged_steps)", c.unconverged_total, c.steps_total);
+            }
+            let q = &c.residuals;
+            let _ = writeln!(s, "  contact dynamics' residuals over the last statistics interval (largest): normal {:.2e} m/s, tangential {:.2e} m/s, quadratic norm {:.2e}, maximum norm {:.2e}", q.normal, q.tangential, q.quadratic, q.maximum);
         }
         if !self.compression.is_empty() {
             let _ = writeln!(s, "  oedometer: p (kPa), e, sigma_zz from particle stresses (kPa), K0 = lateral / vertical stress, Z");

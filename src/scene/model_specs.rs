@@ -86,18 +86,22 @@ pub(super) fn validate_method(c: &Complainer, sim: &SimulationSpec, spec: Option
             }
             let tolerance = given.tolerance.unwrap_or(CdParams::default().tolerance);
             if !(tolerance > 0.0 && tolerance < 1.0) {
-                return Err(c.invalid("contact_dynamics.tolerance", tolerance, "must lie in (0, 1)", "give a relative change such as 1e-6"));
+                return Err(c.invalid("contact_dynamics.tolerance", tolerance, "must lie in (0, 1)", "give a quadratic norm such as 1e-4"));
             }
             let max_iterations = given.max_iterations.unwrap_or(CdParams::default().max_iterations);
             if max_iterations == 0 {
                 return Err(c.invalid("contact_dynamics.max_iterations", 0, "must be at least 1", "give a number of sweeps, e.g. 1000"));
+            }
+            let relaxation = given.relaxation.unwrap_or(CdParams::default().relaxation);
+            if !(relaxation > 0.0 && relaxation < 2.0) {
+                return Err(c.invalid("contact_dynamics.relaxation", relaxation, "must lie in (0, 2)", "use 1 (plain Gauss-Seidel) or an over-relaxation such as 1.5"));
             }
             let gap_allowance = match given.gap_allowance {
                 Some(v) => non_negative(c, "contact_dynamics.gap_allowance", v, "give a length in metres, e.g. 0.1 x the mean diameter")?,
                 None => 0.1 * d_mean,
             };
             let wall_mass = given.wall_mass.map(|m| positive(c, "contact_dynamics.wall_mass", m, "give a mass in kg, or leave it out for the grains' total mass")).transpose()?;
-            Ok(Method::ContactDynamics(CdParams { theta, tolerance, max_iterations, gap_allowance, wall_mass }))
+            Ok(Method::ContactDynamics(CdParams { theta, tolerance, max_iterations, relaxation, gap_allowance, wall_mass }))
         }
         other => Err(c.invalid("simulation.method", format!("\"{other}\""), "unknown method", "use \"dem\" or \"contact_dynamics\"")),
     }

@@ -57,10 +57,13 @@ pub struct SceneFile {
 pub struct ContactDynamicsSpec {
     /// Weight of the end-of-step velocity in the position update, in [0.5, 1]. Default 0.5.
     pub theta: Option<f64>,
-    /// Relative change of the impulses between sweeps at which a step's solve stops. Default 1e-6.
+    /// Quadratic norm of a sweep (its velocity corrections against the impulses' velocities)
+    /// at which a step's solve stops. Default 1e-6.
     pub tolerance: Option<f64>,
     /// Most Gauss-Seidel sweeps per step. Default 1000.
     pub max_iterations: Option<u32>,
+    /// Over-relaxation factor of the sweeps, in (0, 2). Default 1 (plain Gauss-Seidel).
+    pub relaxation: Option<f64>,
     /// Surfaces closer than this (m) are contacts of a step. Default 0.1 x the mean diameter.
     pub gap_allowance: Option<f64>,
     /// Mass of each servo wall (kg). Default: the grains' total mass.

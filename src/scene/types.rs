@@ -322,10 +322,13 @@ pub enum Method {
 pub struct CdParams {
     /// Weight of the end-of-step velocity in the position update (-), in [0.5, 1].
     pub theta: f64,
-    /// Relative change of the impulses between two sweeps at which a step's solve stops (-).
+    /// Quadratic norm of a sweep (`grains::cd`: its velocity corrections against the impulses'
+    /// velocities) at which a step's solve stops (-).
     pub tolerance: f64,
     /// Most Gauss-Seidel sweeps per step.
     pub max_iterations: u32,
+    /// Over-relaxation factor of the sweeps (-), in (0, 2); 1 is plain Gauss-Seidel.
+    pub relaxation: f64,
     /// Surfaces closer than this are contacts of the step (m).
     pub gap_allowance: f64,
     /// Mass of each servo wall (kg); `None`: the grains' total mass.
@@ -334,7 +337,7 @@ pub struct CdParams {
 
 impl Default for CdParams {
     fn default() -> Self {
-        CdParams { theta: 0.5, tolerance: 1e-6, max_iterations: 1000, gap_allowance: 0.0, wall_mass: None }
+        CdParams { theta: 0.5, tolerance: 1e-6, max_iterations: 1000, relaxation: 1.0, gap_allowance: 0.0, wall_mass: None }
     }
 }
 
