@@ -21,7 +21,7 @@ const CD_ROUNDOFF_VELOCITY_TOLERANCE: f64 = 2e-5;
 /// largest speed: the solver's tolerance (1e-4 in these scenes) times what the impulses'
 /// change moves (its positions follow, by the step times that velocity).
 const CD_VELOCITY_TOLERANCE: f64 = 5e-4;
-/// Steps whose solves took different numbers of sweeps, over the steps: a relative change
+/// Steps whose solves took different numbers of sweeps, over the steps: a sweep's norm
 /// within round-off of the tolerance may stop one backend a sweep before the other.
 const CD_SWEEPS_TOLERANCE: f64 = 0.05;
 

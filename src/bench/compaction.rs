@@ -1,9 +1,10 @@
 //! Contact dynamics against DEM on the same packing: Richefeu et al.'s isotropic compaction
 //! (`dry_iso_100pa.toml` and `cd_iso_100pa.toml`, the same grains, friction, servo box and
-//! pressure), shrunk to a given grain count, run by each method to its scene's settle criteria
-//! on each backend; the wall time of each, and contact dynamics' sweeps: how many a step took,
-//! how many steps stopped at the cap, and contact updates (one contact's local problem solved
-//! once) per second of sweeping.
+//! pressure), shrunk to a given grain count, run by each method (contact dynamics by each of
+//! the compared solvers, [`RELAXATIONS`]) to its scene's settle criteria on each backend; the
+//! wall time of each, and contact dynamics' sweeps: how many a step took, how many steps
+//! stopped at the cap, the residual left, and contact updates (one contact's local problem
+//! solved once) per second of sweeping.
 
 use crate::engine::{Engine, Frame, Stats};
 use crate::protocol::{Progress, Recorder, StageResult};
@@ -14,6 +15,9 @@ use std::time::Instant;
 /// The MD sample's scene, and the same sample by contact dynamics.
 const DEM_SCENE: (&str, &str) = ("dry_iso_100pa.toml", include_str!("../../scenes/dry_iso_100pa.toml"));
 const CD_SCENE: (&str, &str) = ("cd_iso_100pa.toml", include_str!("../../scenes/cd_iso_100pa.toml"));
+/// The contact-dynamics solvers compared: over-relaxation factors of the Gauss-Seidel sweeps
+/// (1: plain), each at the scene's tolerance and cap.
+pub const RELAXATIONS: [f64; 2] = [1.0, 1.5];
 /// Grains and box side (m) of `dry_iso_100pa.toml`, the packing both scenes are scaled from.
 const SAMPLE_GRAINS: f64 = 8000.0;
 const SAMPLE_SIDE: f64 = 28.0e-3;
@@ -23,6 +27,8 @@ const SAMPLE_SIDE: f64 = 28.0e-3;
 pub struct Compaction {
     /// "dem" or "contact_dynamics".
     pub method: String,
+    /// Contact dynamics: the sweeps' over-relaxation factor (1: plain Gauss-Seidel).
+    pub relaxation: Option<f64>,
     /// The scene it was scaled from.
     pub scene: String,
     /// "cpu" or "gpu".
@@ -53,6 +59,9 @@ pub struct Compaction {
     pub contact_updates_per_second: Option<f64>,
     /// Contact dynamics: the sweeps' share of the wall time.
     pub sweep_share: Option<f64>,
+    /// Contact dynamics: the quadratic norm of the residuals over the last statistics
+    /// interval (the largest a step ended with; `grains::cd`'s residual).
+    pub residual: Option<f64>,
 }
 
 /// Sums what the statistics reads say of the solver.
@@ -62,6 +71,7 @@ struct Tally {
     sweeps: f64,
     capped: u64,
     contact_updates: u64,
+    residual: f64,
     last: Option<StageResult>,
 }
 
@@ -72,6 +82,7 @@ impl Recorder for Tally {
             self.sweeps += c.mean_iterations * c.steps as f64;
             self.capped += c.unconverged_steps;
             self.contact_updates += c.contact_updates;
+            self.residual = c.residuals.quadratic;
         }
         Ok(())
     }
@@ -103,14 +114,26 @@ pub fn scaled((name, text): (&str, &str), grains: usize) -> anyhow::Result<Scene
     Ok(scene)
 }
 
-/// Both scenes at `grains` grains.
+/// Both scenes at `grains` grains: DEM, then contact dynamics with each of [`RELAXATIONS`].
 pub fn scenes(grains: usize) -> anyhow::Result<Vec<Scene>> {
-    [DEM_SCENE, CD_SCENE].into_iter().map(|s| scaled(s, grains)).collect()
+    let mut scenes = vec![scaled(DEM_SCENE, grains)?];
+    for omega in RELAXATIONS {
+        let mut cd = scaled(CD_SCENE, grains)?;
+        if let crate::scene::Method::ContactDynamics(params) = &mut cd.method {
+            params.relaxation = omega;
+        }
+        scenes.push(cd);
+    }
+    Ok(scenes)
 }
 
 /// Compacts `scene` on `engine` to its settle criteria (the scene's stages) and times it.
 pub fn measure(scene: &Scene, engine: &mut dyn Engine) -> anyhow::Result<Compaction> {
-    let rigid = matches!(scene.method, crate::scene::Method::ContactDynamics(_));
+    let relaxation = match scene.method {
+        crate::scene::Method::ContactDynamics(p) => Some(p.relaxation),
+        crate::scene::Method::Dem => None,
+    };
+    let rigid = relaxation.is_some();
     engine.set_profiling(true);
     let mut tally = Tally::default();
     let started = Instant::now();
@@ -121,6 +144,7 @@ pub fn measure(scene: &Scene, engine: &mut dyn Engine) -> anyhow::Result<Compact
     let pressures: Vec<f64> = last.stats.walls.iter().filter_map(|w| w.pressure).collect();
     Ok(Compaction {
         method: if rigid { "contact_dynamics" } else { "dem" }.to_string(),
+        relaxation,
         scene: scene.path.display().to_string(),
         backend: engine.backend().to_string(),
         precision: engine.precision().to_string(),
@@ -136,6 +160,7 @@ pub fn measure(scene: &Scene, engine: &mut dyn Engine) -> anyhow::Result<Compact
         capped_steps: rigid.then_some(tally.capped),
         contact_updates_per_second: sweep_seconds.filter(|&s| s > 0.0).map(|s| tally.contact_updates as f64 / s),
         sweep_share: sweep_seconds.map(|s| s / seconds),
+        residual: rigid.then_some(tally.residual),
     })
 }
 
@@ -145,8 +170,9 @@ mod tests {
 
     #[test]
     fn both_methods_compact_the_same_grains_in_the_same_box_to_the_same_pressure() {
-        let [dem, cd] = <[Scene; 2]>::try_from(scenes(1000).unwrap()).unwrap();
-        assert!(matches!(cd.method, crate::scene::Method::ContactDynamics(_)) && !matches!(dem.method, crate::scene::Method::ContactDynamics(_)));
+        let [dem, cd, relaxed] = <[Scene; 3]>::try_from(scenes(1000).unwrap()).unwrap();
+        assert!(matches!(cd.method, crate::scene::Method::ContactDynamics(p) if p.relaxation == 1.0) && matches!(dem.method, crate::scene::Method::Dem));
+        assert!(matches!(relaxed.method, crate::scene::Method::ContactDynamics(p) if p.relaxation == RELAXATIONS[1]));
         assert_eq!(dem.grains.len(), 1000);
         assert_eq!((&dem.grains.position, &dem.grains.radius, &dem.grains.mass), (&cd.grains.position, &cd.grains.radius, &cd.grains.mass));
         let side = SAMPLE_SIDE * (1000.0 / SAMPLE_GRAINS).cbrt();

@@ -394,12 +394,13 @@ impl BenchReport {
         }
         if !self.compaction.is_empty() {
             s.push_str("\nthe same compaction to 100 Pa by DEM and by contact dynamics (Richefeu et al.'s sample scaled to the grains, each scene's settle criteria)\n");
-            s.push_str("method            backend prec thr grains        dt   steps   wall s  settled     Z  pressure Pa  sweeps/step  capped  contact updates/s  sweep share\n");
+            s.push_str("method            omega backend prec thr grains        dt   steps   wall s  settled     Z  pressure Pa  sweeps/step  capped  residual  contact updates/s  sweep share\n");
             let opt = |x: Option<f64>, digits: usize| x.map_or("-".to_string(), |v| format!("{v:.digits$}"));
             for r in &self.compaction {
                 s.push_str(&format!(
-                    "{:<17} {:<7} {:<4} {:>3} {:>6} {:>9.2e} {:>7} {:>8.1} {:>8} {:>5.2} {:>12.1} {:>12} {:>7} {:>18} {:>12}\n",
+                    "{:<17} {:>5} {:<7} {:<4} {:>3} {:>6} {:>9.2e} {:>7} {:>8.1} {:>8} {:>5.2} {:>12.1} {:>12} {:>7} {:>9} {:>18} {:>12}\n",
                     r.method,
+                    opt(r.relaxation, 1),
                     r.backend,
                     r.precision,
                     r.threads,
@@ -412,6 +413,7 @@ impl BenchReport {
                     r.pressure,
                     opt(r.mean_sweeps, 1),
                     r.capped_steps.map_or("-".to_string(), |c| c.to_string()),
+                    r.residual.map_or("-".to_string(), |q| format!("{q:.1e}")),
                     r.contact_updates_per_second.map_or("-".to_string(), |u| format!("{u:.3e}")),
                     r.sweep_share.map_or("-".to_string(), |f| format!("{:.0}%", 100.0 * f)),
                 ));

@@ -58,7 +58,7 @@ pub struct ContactDynamicsSpec {
     /// Weight of the end-of-step velocity in the position update, in [0.5, 1]. Default 0.5.
     pub theta: Option<f64>,
     /// Quadratic norm of a sweep (its velocity corrections against the impulses' velocities)
-    /// at which a step's solve stops. Default 1e-6.
+    /// at which a step's solve stops. Default 1e-3.
     pub tolerance: Option<f64>,
     /// Most Gauss-Seidel sweeps per step. Default 1000.
     pub max_iterations: Option<u32>,

@@ -337,7 +337,7 @@ pub struct CdParams {
 
 impl Default for CdParams {
     fn default() -> Self {
-        CdParams { theta: 0.5, tolerance: 1e-6, max_iterations: 1000, relaxation: 1.0, gap_allowance: 0.0, wall_mass: None }
+        CdParams { theta: 0.5, tolerance: 1e-3, max_iterations: 1000, relaxation: 1.0, gap_allowance: 0.0, wall_mass: None }
     }
 }
 
