@@ -114,17 +114,28 @@ fn a_sphere_on_an_incline_rolls_below_the_slip_angle_and_slides_above_it() {
     }
 }
 
+/// Height of the centre of grain `k` of a column standing on the floor (m).
+fn column_height(k: usize) -> f64 {
+    RADIUS * (1.0 + 2.0 * k as f64)
+}
+
+/// A column of `n` grains of friction `mu` standing in touch on the floor under gravity, at
+/// step `dt`.
+fn column(n: usize, mu: f64, dt: f64) -> Scene {
+    // Listed 1 um apart (the scene refuses touching grains), then put in touch.
+    let grains: String = (0..n).map(|k| grain([0.0, 0.0, column_height(k) + 1e-6 * k as f64], [0.0; 3])).collect();
+    let mut s = scene(mu, 0.5, [0.0, 0.0, -G], true, dt, &grains);
+    for (k, x) in s.grains.position.iter_mut().enumerate() {
+        x[2] = column_height(k);
+    }
+    s
+}
+
 #[test]
 fn a_column_of_spheres_carries_the_weight_above_each_contact() {
     let n = 8;
     let dt = 1e-4;
-    let height = |k: usize| RADIUS * (1.0 + 2.0 * k as f64);
-    // Listed 1 um apart (the scene refuses touching grains), then put in touch.
-    let grains: String = (0..n).map(|k| grain([0.0, 0.0, height(k) + 1e-6 * k as f64], [0.0; 3])).collect();
-    let mut s = scene(0.4, 0.5, [0.0, 0.0, -G], true, dt, &grains);
-    for (k, x) in s.grains.position.iter_mut().enumerate() {
-        x[2] = height(k);
-    }
+    let s = column(n, 0.4, dt);
     let mut cd = ContactDynamics::<f64>::new(&s, PARAMS).unwrap();
     for _ in 0..20 {
         cd.step().unwrap();
@@ -142,7 +153,7 @@ fn a_column_of_spheres_carries_the_weight_above_each_contact() {
     }
     assert_eq!(cd.contacts().len(), n);
     for k in 0..n {
-        assert!(relative(cd.position(k)[2], height(k)) < EXACT);
+        assert!(relative(cd.position(k)[2], column_height(k)) < EXACT);
     }
 }
 
@@ -158,12 +169,7 @@ fn a_frictionless_column_converges_to_its_unique_impulses_within_the_tolerance_a
     // lands within COLUMN_CONDITIONING t of the exact one, plain or over-relaxed.
     let n = 16;
     let dt = 1e-4;
-    let height = |k: usize| RADIUS * (1.0 + 2.0 * k as f64);
-    let grains: String = (0..n).map(|k| grain([0.0, 0.0, height(k) + 1e-6 * k as f64], [0.0; 3])).collect();
-    let mut s = scene(0.0, 0.5, [0.0, 0.0, -G], true, dt, &grains);
-    for (k, x) in s.grains.position.iter_mut().enumerate() {
-        x[2] = height(k);
-    }
+    let s = column(n, 0.0, dt);
     for relaxation in [1.0, 1.5] {
         for tolerance in [1e-4, 1e-6, 1e-8] {
             let mut cd = ContactDynamics::<f64>::new(&s, CdParams { tolerance, relaxation, ..PARAMS }).unwrap();

@@ -355,10 +355,7 @@ impl<T: Real> ContactDynamics<T> {
 
     /// The contact's second body as the solve sees it: a grain, or a wall's motion.
     fn body_b(&self, c: &Contact<T>) -> Body<T> {
-        match c.b {
-            Partner::Grain(j) => self.body[j as usize],
-            Partner::Wall(w) => Body { pos: Vec3::ZERO, vel: self.wall_motion[w as usize].vel, omega: Vec3::ZERO },
-        }
+        solve::second_body(c, &self.body, &self.wall_motion)
     }
 
     /// Normal relative velocity of each contact (m/s).

@@ -14,6 +14,15 @@ pub(super) fn relative_velocity<T: Real>(c: &Contact<T>, a: &Body<T>, b: &Body<T
     (b.vel + b.omega.cross(c.n * -c.radius_b)) - (a.vel + a.omega.cross(c.n * c.radius_a))
 }
 
+/// The second body of contact `c` as the local problem sees it: a grain, or a wall's motion
+/// (a wall has no spin).
+pub(super) fn second_body<T: Real>(c: &Contact<T>, body: &[Body<T>], walls: &[WallMotion<T>]) -> Body<T> {
+    match c.b {
+        Partner::Grain(j) => body[j as usize],
+        Partner::Wall(w) => Body { pos: Vec3::ZERO, vel: walls[w as usize].vel, omega: Vec3::ZERO },
+    }
+}
+
 /// Applies `-dr` to `a`, the first body of contact `c`.
 pub(super) fn apply_a<T: Real>(c: &Contact<T>, a: &mut Body<T>, dr: Vec3<T>) {
     a.vel -= dr * c.inv_mass_a;
@@ -63,7 +72,7 @@ pub(super) fn local<T: Real>(c: &Contact<T>, a: &Body<T>, b: &Body<T>) -> Vec3<T
 /// when `omega` is 1, else over-relaxed from the impulse before, `r + omega (star - r)`, and
 /// put back in the admissible set (`r_n >= 0`, the tangential part clipped to the cone
 /// `mu r_n` along itself).
-pub(super) fn relax<T: Real>(c: &Contact<T>, star: Vec3<T>, omega: T) -> Vec3<T> {
+fn relax<T: Real>(c: &Contact<T>, star: Vec3<T>, omega: T) -> Vec3<T> {
     if omega == T::ONE {
         return star;
     }
