@@ -423,6 +423,8 @@ fn bad_contact_dynamics_input_gets_one_line_naming_the_key_and_the_fix() {
     for (from, to, says) in [
         ("theta = 0.5 ", "theta = 0.2 ", "contact_dynamics.theta = 0.2: must lie in [0.5, 1]; fix:"),
         ("max_iterations = 500 ", "max_iterations = 0 ", "contact_dynamics.max_iterations = 0: must be at least 1; fix:"),
+        ("max_iterations = 500 ", "max_iterations = 500\nrelaxation = 2.0 ", "contact_dynamics.relaxation = 2: must lie in (0, 2); fix:"),
+        ("tolerance = 1.0e-3 ", "tolerance = 0.0 ", "contact_dynamics.tolerance = 0: must lie in (0, 1); fix: give a quadratic norm"),
         ("dt = 1.0e-4 ", "dt = \"auto\" ", "simulation.dt = \"auto\": has no automatic value for rigid grains"),
         ("method = \"contact_dynamics\"", "method = \"lmgc\"", "simulation.method = \"lmgc\": unknown method; fix: use \"dem\" or \"contact_dynamics\""),
     ] {

@@ -86,7 +86,7 @@ pub(super) fn validate_method(c: &Complainer, sim: &SimulationSpec, spec: Option
             }
             let tolerance = given.tolerance.unwrap_or(CdParams::default().tolerance);
             if !(tolerance > 0.0 && tolerance < 1.0) {
-                return Err(c.invalid("contact_dynamics.tolerance", tolerance, "must lie in (0, 1)", "give a quadratic norm such as 1e-4"));
+                return Err(c.invalid("contact_dynamics.tolerance", tolerance, "must lie in (0, 1)", "give a quadratic norm such as 1e-3 (the default)"));
             }
             let max_iterations = given.max_iterations.unwrap_or(CdParams::default().max_iterations);
             if max_iterations == 0 {
