@@ -18,7 +18,14 @@ fn cd_sweep_colour(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocat
         return;
     }
     let c = contacts[k];
-    let s = solve_contact(c, impulse[k].xyz, Motion(vel[c.a].xyz, omega[c.a].xyz), Motion(vel[c.b].xyz, omega[c.b].xyz), cd.relaxation);
+    let r_old = impulse[k].xyz;
+    let a = Motion(vel[c.a].xyz, omega[c.a].xyz);
+    let b = Motion(vel[c.b].xyz, omega[c.b].xyz);
+    if (stays_open(c, r_old, a, b)) {
+        measure[k] = vec2<f32>(0.0);
+        return;
+    }
+    let s = solve_contact(c, r_old, a, b, cd.relaxation);
     impulse[k] = vec4<f32>(s.r, 0.0);
     vel[c.a] = vec4<f32>(s.a.vel, 0.0);
     omega[c.a] = vec4<f32>(s.a.omega, 0.0);

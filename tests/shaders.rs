@@ -204,7 +204,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
 fn contact_dynamics_mirrors_match_the_wgsl_structures() {
     let src = format!("{}\n{}", grains::gpu::kernels::shared("types"), grains::gpu::kernels::shared("cd"));
     let m = module(&format!("{src}\n@group(0) @binding(0) var<storage, read_write> c: array<CdContact>;\n@group(0) @binding(1) var<uniform> p: CdParams;\n@group(0) @binding(2) var<uniform> k: CdColour;\n@group(0) @binding(3) var<storage, read_write> s: CdControl;\n@compute @workgroup_size(1) fn main() {{ s.iterations = p.n_contacts + k.start + c[0].a; }}"), "cd");
-    check_struct!(&m, layout::CdContact, "CdContact", [a, b, to_wall, _pad0, n, radius_a, radius_b, mu, w_n, w_t, inv_mass_a, inv_inertia_a, inv_mass_b, inv_inertia_b, _pad1, _pad2, _pad3]);
+    check_struct!(&m, layout::CdContact, "CdContact", [a, b, to_wall, _pad0, n, radius_a, radius_b, mu, w_n, w_t, inv_mass_a, inv_inertia_a, inv_mass_b, inv_inertia_b, inv_w_n, inv_w_t, _pad1]);
     check_struct!(&m, layout::CdParams, "CdParams", [n_contacts, tail, n_blocks, max_iterations, tolerance2, relaxation, _pad1, _pad2]);
     check_struct!(&m, layout::CdColour, "CdColour", [start, end, _pad0, _pad1]);
     check_struct!(&m, layout::CdControl, "CdControl", [iterations, converged, done, _pad0, sweep_norm2, _pad1, _pad2, _pad3]);

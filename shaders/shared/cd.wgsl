@@ -23,9 +23,9 @@ struct CdContact {
     inv_inertia_a: f32, // 1/(kg m^2)
     inv_mass_b: f32,    // 1/kg (a wall's along its normal; 0 for a wall that does not yield)
     inv_inertia_b: f32, // 1/(kg m^2)
+    inv_w_n: f32,       // 1 / w_n (kg)
+    inv_w_t: f32,       // 1 / w_t (kg)
     _pad1: f32,
-    _pad2: f32,
-    _pad3: f32,
 }
 
 // The solve's constants (uniform).
@@ -104,18 +104,28 @@ fn relative_velocity(c: CdContact, a: Motion, b: Motion) -> vec3<f32> {
     return (b.vel + cross3(b.omega, n * -c.radius_b)) - (a.vel + cross3(a.omega, n * c.radius_a));
 }
 
+// Normal velocity of b against a at the contact (m/s): spin moves no contact point along n.
+fn normal_velocity(c: CdContact, a: Motion, b: Motion) -> f32 {
+    return dot3(b.vel - a.vel, c.n.xyz);
+}
+
+// Whether the contact carries no impulse and its bodies' normal velocity is at least u_min:
+// its local solution is then no impulse, and solving it changes nothing.
+fn stays_open(c: CdContact, r_old: vec3<f32>, a: Motion, b: Motion) -> bool {
+    return all(r_old == vec3<f32>(0.0)) && normal_velocity(c, a, b) >= c.n.w;
+}
+
 // The contact's impulse solving its local problem exactly (Signorini with u_min, Coulomb),
 // against the others' impulses, which the motions hold with its own r_old.
 fn local_impulse(c: CdContact, r_old: vec3<f32>, a: Motion, b: Motion) -> vec3<f32> {
     let n = c.n.xyz;
-    let u = relative_velocity(c, a, b);
     let own_n = dot3(r_old, n);
+    let u_n = normal_velocity(c, a, b) - c.w_n * own_n;
     let own_t = r_old - n * own_n;
-    let u_other = u - n * (c.w_n * own_n) - own_t * c.w_t;
-    let u_n = dot3(u_other, n);
-    let r_n = max((c.n.w - u_n) / c.w_n, 0.0);
+    let u_other = relative_velocity(c, a, b) - n * (c.w_n * own_n) - own_t * c.w_t;
+    let r_n = max((c.n.w - u_n) * c.inv_w_n, 0.0);
     let u_t = u_other - n * u_n;
-    let stick = u_t * (-1.0 / c.w_t);
+    let stick = u_t * -c.inv_w_t;
     let cap = c.mu * r_n;
     var r_t = stick;
     if (!(dot3(stick, stick) <= cap * cap)) {
@@ -151,18 +161,29 @@ fn relax(c: CdContact, r_old: vec3<f32>, star: vec3<f32>, omega: f32) -> vec3<f3
 // Solves contact c between a and b and applies the change of its impulse to both; a wall (b)
 // moves along the normal only.
 fn solve_contact(c: CdContact, r_old: vec3<f32>, a: Motion, b: Motion, omega: f32) -> Solved {
+    var out: Solved;
+    out.r = r_old;
+    out.a = a;
+    out.b = b;
+    out.measure = vec2<f32>(0.0);
+    if (stays_open(c, r_old, a, b)) {
+        return out;
+    }
     let n = c.n.xyz;
     let star = local_impulse(c, r_old, a, b);
     let r = relax(c, r_old, star, omega);
     let dr = r - r_old;
-    var out: Solved;
     out.r = r;
+    out.measure = vec2<f32>(weighted2(c, star - r_old), weighted2(c, r));
+    // A change of exactly zero is not applied, as on the CPU.
+    if (all(dr == vec3<f32>(0.0))) {
+        return out;
+    }
     out.a = Motion(a.vel - dr * c.inv_mass_a, a.omega - cross3(n * c.radius_a, dr) * c.inv_inertia_a);
     if (c.to_wall != 0u) {
         out.b = Motion(b.vel + n * (dot3(n, dr) * c.inv_mass_b), b.omega);
     } else {
         out.b = Motion(b.vel + dr * c.inv_mass_b, b.omega + cross3(n * -c.radius_b, dr) * c.inv_inertia_b);
     }
-    out.measure = vec2<f32>(weighted2(c, star - r_old), weighted2(c, r));
     return out;
 }

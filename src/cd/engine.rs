@@ -62,7 +62,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
     fn stats(&mut self) -> Result<Stats, SimError> {
         let n = self.body.len();
         let g = self.gravity.f64();
-        let mut s = Stats { step: self.steps, time: self.time(), rebuilds: self.steps, external_work: self.external_work, ..Default::default() };
+        let mut s = Stats { step: self.steps, time: self.time(), rebuilds: self.near.searches, external_work: self.external_work, ..Default::default() };
         for (b, p) in self.body.iter().zip(&self.prop) {
             let (m, v, w) = (p.mass.f64(), b.vel.f64(), b.omega.f64());
             s.ke_translational += 0.5 * m * b.vel.norm2().f64();
@@ -177,6 +177,11 @@ impl<T: Real> Engine for ContactDynamics<T> {
         s.put_ints("warm_b", warm.iter().map(|((_, b), _)| code(*b)));
         s.put_reals("warm_r", warm.iter().flat_map(|(_, r)| v3(**r)));
         s.put_ints("steps", [self.steps]);
+        // Where the pairs were last searched, so that a resumed run searches when this one would.
+        let (found_at, skin, searches) = self.near.saved();
+        s.put_reals("near_found_at", found_at.iter().flat_map(|&p| v3(p)));
+        s.put_reals("near_skin", [skin.f64()]);
+        s.put_ints("near_searches", [searches]);
         // The walls that move: planes' points and every wall's velocity; the servo's targets.
         s.put_reals("wall_points", self.walls.iter().flat_map(|(g, _)| match g {
             WallGeom::Plane { point, .. } => v3(*point),
@@ -210,6 +215,16 @@ impl<T: Real> Engine for ContactDynamics<T> {
         let r = s.reals("warm_r", 3 * a.len())?;
         self.warm = a.iter().zip(b).zip(r.chunks_exact(3)).map(|((&a, &b), r)| ((a as u32, if b >= WALL_TAG { Partner::Wall((b - WALL_TAG) as u32) } else { Partner::Grain(b as u32) }), of(r))).collect();
         self.steps = s.ints("steps", Some(1))?[0];
+        // Checkpoints from before the pairs were kept between searches: searched at the first step.
+        self.near = match s.reals.get("near_found_at") {
+            Some(v) => {
+                // Empty when saved before the first step.
+                let found_at: Vec<Vec3<T>> = s.reals("near_found_at", if v.is_empty() { 0 } else { 3 * n })?.chunks_exact(3).map(of).collect();
+                let (skin, searches) = (T::of(s.reals("near_skin", 1)?[0]), s.ints("near_searches", Some(1))?[0]);
+                super::near::Near::resumed(found_at, skin, searches, &self.body, &self.residual, &self.prop, &self.id, self.r_max, T::of(self.params.gap_allowance))
+            }
+            None => Default::default(),
+        };
         let walls = self.walls.len();
         let (points, velocities) = (s.reals("wall_points", 3 * walls)?, s.reals("wall_velocities", 3 * walls)?);
         for (w, ((geom, _), motion)) in self.walls.iter_mut().zip(&mut self.wall_motion).enumerate() {
@@ -272,7 +287,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
     fn memory_bytes(&self) -> u64 {
         use crate::state::allocated;
         let warm = (self.warm.capacity() * std::mem::size_of::<((u32, Partner), Vec3<T>)>()) as u64;
-        allocated(&self.id) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.contacts) + warm
+        allocated(&self.id) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.contacts) + self.near.bytes() + warm
     }
 }
 

@@ -25,6 +25,11 @@
 //!    * tangential (Coulomb with `mu`): the sticking impulse `-u'_t / w_t` when it lies in the
 //!      cone `|r_t| <= mu r_n`, else `-mu r_n u'_t / |u'_t|` (sliding against `u'_t`).
 //!
+//!    A contact without impulse whose normal velocity (`u'_n = (v_b - v_a) . n`; spin moves
+//!    no contact point along `n`) is already at least `u_min` stays open, and its solve is that
+//!    one comparison (`solve::stays_open`): about half the contacts within the gap allowance
+//!    of a dense packing.
+//!
 //!    The sweep repeats until its quadratic norm, LMGC90's for nonsmooth Gauss-Seidel,
 //!    `sqrt(sum |W dr|^2 / sum |W r|^2)` (the velocity corrections `W dr` the sweep's local
 //!    solves made, that is how far each contact was from its laws, against the velocities
@@ -42,7 +47,7 @@
 //! the same bits on any thread count.
 
 use crate::state::profile::{PhaseClock, Phases};
-use crate::state::{Body, PairList, Props};
+use crate::state::{Body, Props};
 use crate::engine::SimError;
 use crate::periodic::Periodic;
 use crate::position;
@@ -54,6 +59,7 @@ use std::collections::HashMap;
 
 mod colour;
 mod engine;
+mod near;
 mod residual;
 mod servo;
 mod solve;
@@ -102,11 +108,19 @@ pub struct Contact<T> {
     pub w_n: T,
     /// Tangential Delassus diagonal `w_t` (1/kg).
     pub w_t: T,
+    /// `1 / w_n` (kg).
+    pub inv_w_n: T,
+    /// `1 / w_t` (kg).
+    pub inv_w_t: T,
     /// Least normal relative velocity at the step's end, `u_min` (m/s).
     pub u_min: T,
     /// Impulse on `b` (N s; `-r` on `a`), world frame.
     pub r: Vec3<T>,
 }
+
+/// The skin of the pairs the contacts are drawn from ([`near`]), in gap allowances: the pairs
+/// are searched again once a grain has moved half of it.
+const NEAR_SKIN: f64 = 1.0;
 
 /// A wall's motion: walls translate along their normal only.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -205,6 +219,8 @@ pub struct ContactDynamics<T: Real> {
     r_max: T,
     contacts: Vec<Contact<T>>,
     schedule: Schedule,
+    /// The pairs the contacts are drawn from.
+    near: near::Near<T>,
     sweeps: Box<dyn Sweeps<T>>,
     /// Last step's impulses by (grain id, partner grain id or wall), for the warm start.
     warm: HashMap<(u32, Partner), Vec3<T>>,
@@ -313,6 +329,7 @@ impl<T: Real> ContactDynamics<T> {
             r_max: T::of(g.radius.iter().copied().fold(0.0, f64::max)),
             contacts: Vec::new(),
             schedule: Schedule::default(),
+            near: near::Near::default(),
             sweeps: Box::new(CpuSweeps::default()),
             warm: HashMap::new(),
             report: SolveReport::default(),
@@ -368,19 +385,24 @@ impl<T: Real> ContactDynamics<T> {
     fn detect(&mut self) {
         let allowance = T::of(self.params.gap_allowance);
         let periodic = Periodic::<T>::of(&[None, None, None]);
-        let cutoff = self.r_max * T::of(2.0) + allowance;
-        // Non-finite positions find no pairs here; the step's own check reports them.
-        let grids = crate::state::Grids::hash(&self.body, &self.prop, cutoff, allowance, &periodic).unwrap_or_default();
-        let pairs = PairList::detect(&self.body, &self.residual, &self.prop, &self.id, &grids, &periodic, allowance, |_| usize::MAX).unwrap_or_default();
+        let mut near = std::mem::take(&mut self.near);
+        let pairs = near.update(&self.body, &self.residual, &self.prop, &self.id, self.r_max, allowance, allowance * T::of(NEAR_SKIN));
         let mut contacts = Vec::with_capacity(pairs.len() + self.walls.len());
         for (a, &b) in pairs.owners_of(0..pairs.len()).zip(&pairs.partner) {
             let b = b as usize;
             let d = position::separation_of(&periodic, |s| self.body[s].pos, &self.residual, b, a);
-            let dist = d.norm();
             let (pa, pb) = (&self.prop[a], &self.prop[b]);
+            // The cell search's test (`state::grid`), on the separation's mirror image, whose
+            // squared length has the same bits.
+            let reach = pa.radius + pb.radius + allowance;
+            if !(d.norm2() < reach * reach) {
+                continue;
+            }
+            let dist = d.norm();
             let (inv_mass_b, inv_inertia_b) = (T::ONE / pb.mass, T::ONE / pb.inertia);
             contacts.push(self.contact(a, Partner::Grain(b as u32), d * (T::ONE / dist), dist - pa.radius - pb.radius, self.material[b], (pb.radius, inv_mass_b, inv_inertia_b)));
         }
+        self.near = near;
         for i in 0..self.body.len() {
             for (w, (geom, material)) in self.walls.iter().enumerate() {
                 let (normal, dist) = geom.frame(self.body[i].pos, position::residual_at(&self.residual, i));
@@ -406,7 +428,7 @@ impl<T: Real> ContactDynamics<T> {
         let w_n = inv_mass_a + inv_mass_b;
         // A wall turns no more than it slides: only its normal motion yields.
         let w_t = inv_mass_a + pa.radius * pa.radius * inv_inertia_a + if matches!(b, Partner::Grain(_)) { inv_mass_b + radius_b * radius_b * inv_inertia_b } else { T::ZERO };
-        Contact { a: a as u32, b, n, gap, mu, e, radius_a: pa.radius, radius_b, inv_mass_a, inv_inertia_a, inv_mass_b, inv_inertia_b, w_n, w_t, u_min: T::ZERO, r: Vec3::ZERO }
+        Contact { a: a as u32, b, n, gap, mu, e, radius_a: pa.radius, radius_b, inv_mass_a, inv_inertia_a, inv_mass_b, inv_inertia_b, w_n, w_t, inv_w_n: T::ONE / w_n, inv_w_t: T::ONE / w_t, u_min: T::ZERO, r: Vec3::ZERO }
     }
 
     /// Each contact's least normal velocity at the step's end, from its normal velocity before

@@ -379,12 +379,12 @@ pub struct CdContact {
     pub inv_mass_b: f32,
     /// 1/(kg m^2).
     pub inv_inertia_b: f32,
+    /// `1 / w_n` (kg).
+    pub inv_w_n: f32,
+    /// `1 / w_t` (kg).
+    pub inv_w_t: f32,
     /// Padding.
     pub _pad1: f32,
-    /// Padding.
-    pub _pad2: f32,
-    /// Padding.
-    pub _pad3: f32,
 }
 
 /// The sweeps' constants (WGSL `CdParams`, a uniform).

@@ -128,6 +128,8 @@ fn pack(c: &Contact<f32>) -> CdContact {
         mu: c.mu,
         w_n: c.w_n,
         w_t: c.w_t,
+        inv_w_n: c.inv_w_n,
+        inv_w_t: c.inv_w_t,
         inv_mass_a: c.inv_mass_a,
         inv_inertia_a: c.inv_inertia_a,
         inv_mass_b: c.inv_mass_b,
