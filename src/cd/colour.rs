@@ -18,32 +18,14 @@ pub struct Schedule {
     /// Colour `k` is `contacts[starts[k]..starts[k + 1]]`; the serial tail runs from the last
     /// entry to the end.
     pub starts: Vec<usize>,
-    /// The grains each colour touches, colour after colour, each colour's by grain (a grain
-    /// appears once in a colour at most); colour `k` is `touch[touch_starts[k]..touch_starts[k + 1]]`.
-    touch: Vec<Touch>,
-    touch_starts: Vec<usize>,
-}
-
-/// A grain touched by a contact of a colour.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub struct Touch {
-    /// The grain's slot.
-    pub grain: u32,
-    /// The contact's index in the schedule's order.
-    pub contact: u32,
-    /// Whether the grain is the contact's second body.
-    pub second: bool,
+    /// Each scheduled contact's index in detection order.
+    pub order: Vec<u32>,
 }
 
 impl Schedule {
     /// Colour ranges, then the tail's start.
     pub fn colours(&self) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
         self.starts.windows(2).map(|w| w[0]..w[1])
-    }
-
-    /// The grains colour `k` touches, by grain.
-    pub fn touches(&self, k: usize) -> &[Touch] {
-        &self.touch[self.touch_starts[k]..self.touch_starts[k + 1]]
     }
 
     /// Where the serial tail starts.
@@ -86,23 +68,13 @@ pub fn schedule<T: Real>(contacts: &mut Vec<Contact<T>>, grains: usize) -> Sched
     let mut next: Vec<usize> = starts.clone();
     next.push(at);
     let mut sorted = vec![None; contacts.len()];
-    for (c, &k) in contacts.iter().zip(&colour) {
+    let mut order = vec![0u32; contacts.len()];
+    for (i, (c, &k)) in contacts.iter().zip(&colour).enumerate() {
         let slot = &mut next[(k as usize).min(colours)];
         sorted[*slot] = Some(*c);
+        order[*slot] = i as u32;
         *slot += 1;
     }
     *contacts = sorted.into_iter().map(|c| c.expect("every slot filled")).collect();
-    let (mut touch, mut touch_starts) = (Vec::with_capacity(2 * at), vec![0]);
-    for w in starts.windows(2) {
-        let from = touch.len();
-        for (k, c) in contacts[w[0]..w[1]].iter().enumerate() {
-            let Partner::Grain(j) = c.b else { unreachable!("colours hold grain pairs") };
-            let contact = (w[0] + k) as u32;
-            touch.push(Touch { grain: c.a, contact, second: false });
-            touch.push(Touch { grain: j, contact, second: true });
-        }
-        touch[from..].sort_unstable();
-        touch_starts.push(touch.len());
-    }
-    Schedule { starts, touch, touch_starts }
+    Schedule { starts, order }
 }

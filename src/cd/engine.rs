@@ -1,14 +1,11 @@
 //! Contact dynamics behind the host loop's [`Engine`]: statistics, frames and checkpoints of
 //! rigid grains, whose contact forces are the step's impulses over the step.
 
+use super::warm::WarmStart;
 use super::{ContactDynamics, Partner};
 use crate::engine::{ContactRecord, Engine, EngineState, Frame, SimError, Stats, WallContactRecord, WallStats, RATTLER_CONTACTS};
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
-
-/// Encodes a contact's second body for a checkpoint: a grain as its slot, a wall as
-/// `WALL_TAG + index`.
-const WALL_TAG: u64 = 1 << 32;
 
 impl<T: Real> ContactDynamics<T> {
     /// Force on `b` (N; `-force` on `a`) and normal force (N) of a contact at the last step.
@@ -50,8 +47,15 @@ impl<T: Real> Engine for ContactDynamics<T> {
     }
 
     fn advance(&mut self, n: u64) -> Result<(), SimError> {
+        let timed = rayon::current_num_threads() > 1;
         for _ in 0..n {
+            if timed {
+                self.crew.step_starts();
+            }
             self.step()?;
+            if timed {
+                self.crew.step_ends_with(Some(self.report.contacts as f64 * self.report.iterations as f64));
+            }
         }
         match self.first_non_finite() {
             Some(grain) => Err(SimError::Unstable { step: self.steps, time: self.time(), what: "the state is not finite".into(), grain, suggested_dt: 0.5 * self.h.f64(), also: ", or raise contact_dynamics.max_iterations" }),
@@ -170,12 +174,11 @@ impl<T: Real> Engine for ContactDynamics<T> {
         s.put_reals("residual", self.residual.iter().flat_map(|&r| v3(r)));
         s.put_reals("velocity", self.body.iter().flat_map(|b| v3(b.vel)));
         s.put_reals("omega", self.body.iter().flat_map(|b| v3(b.omega)));
-        // The warm start, in a fixed order.
-        let mut warm: Vec<(&(u32, Partner), &Vec3<T>)> = self.warm.iter().collect();
-        warm.sort_by_key(|((a, b), _)| (*a, code(*b)));
-        s.put_ints("warm_a", warm.iter().map(|((a, _), _)| *a as u64));
-        s.put_ints("warm_b", warm.iter().map(|((_, b), _)| code(*b)));
-        s.put_reals("warm_r", warm.iter().flat_map(|(_, r)| v3(**r)));
+        // The warm start, in detection order; a partner as a grain's slot or a wall's tagged index.
+        let warm = self.warm.entries();
+        s.put_ints("warm_a", warm.iter().map(|&(a, _, _)| a as u64));
+        s.put_ints("warm_b", warm.iter().map(|&(_, b, _)| b));
+        s.put_reals("warm_r", warm.iter().flat_map(|&(_, _, r)| v3(r)));
         s.put_ints("steps", [self.steps]);
         // Where the pairs were last searched, so that a resumed run searches when this one would.
         let (found_at, skin, searches) = self.near.saved();
@@ -213,7 +216,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
         }
         let (a, b) = (s.ints("warm_a", None)?, s.ints("warm_b", None)?);
         let r = s.reals("warm_r", 3 * a.len())?;
-        self.warm = a.iter().zip(b).zip(r.chunks_exact(3)).map(|((&a, &b), r)| ((a as u32, if b >= WALL_TAG { Partner::Wall((b - WALL_TAG) as u32) } else { Partner::Grain(b as u32) }), of(r))).collect();
+        self.warm = WarmStart::of(a.iter().zip(b).zip(r.chunks_exact(3)).map(|((&a, &b), r)| (a as u32, b, of(r))).collect());
         self.steps = s.ints("steps", Some(1))?[0];
         // Checkpoints from before the pairs were kept between searches: searched at the first step.
         self.near = match s.reals.get("near_found_at") {
@@ -286,16 +289,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
 
     fn memory_bytes(&self) -> u64 {
         use crate::state::allocated;
-        let warm = (self.warm.capacity() * std::mem::size_of::<((u32, Partner), Vec3<T>)>()) as u64;
-        allocated(&self.id) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.contacts) + self.near.bytes() + warm
-    }
-}
-
-/// A contact's second body as a checkpoint integer (see [`WALL_TAG`]).
-fn code(b: Partner) -> u64 {
-    match b {
-        Partner::Grain(j) => j as u64,
-        Partner::Wall(w) => WALL_TAG + w as u64,
+        allocated(&self.id) + allocated(&self.body) + allocated(&self.residual) + allocated(&self.prop) + allocated(&self.contacts) + self.near.bytes() + self.warm.bytes()
     }
 }
 

@@ -42,10 +42,12 @@
 //!    walls' too (`servo`: they are bodies pushed by the target pressure).
 //!
 //! The sweep solves the grain pairs colour by colour (`colour`: no two contacts of a colour
-//! share a grain), each colour's contacts at once on the engine's threads, then the wall
+//! share a grain), each colour's contacts shared by the engine's threads (`parallel`, when
+//! the run's crew finds that faster than one thread: `crate::state::crew`), then the wall
 //! contacts one after the other; the schedule depends on the contacts alone, so a step gives
 //! the same bits on any thread count.
 
+use crate::state::crew::{Crew, Who};
 use crate::state::profile::{PhaseClock, Phases};
 use crate::state::{Body, Props};
 use crate::engine::SimError;
@@ -55,17 +57,19 @@ use crate::real::{Real, Vec3};
 pub use crate::scene::CdParams;
 use crate::scene::{Scene, WallShape};
 use crate::walls::WallGeom;
-use std::collections::HashMap;
 
 mod colour;
 mod engine;
 mod near;
+mod parallel;
 mod residual;
 mod servo;
 mod solve;
+mod warm;
 
 pub use colour::{Schedule, MAX_COLOURS};
 pub use crate::engine::Residuals;
+pub use parallel::THREADS_MIN_CONTACTS;
 pub use solve::{CpuSweeps, MEASURE_BLOCK};
 
 /// The second body of a contact.
@@ -179,6 +183,9 @@ pub struct SweepSettings<T> {
     /// Over-relaxation factor `omega` (-; 1: plain Gauss-Seidel): each local solution `r*` is
     /// taken as `r + omega (r* - r)`, put back in the cone (`solve::relax`).
     pub relaxation: T,
+    /// Whether the CPU's pool may share the sweeps (its crew's choice, [`crate::state::crew`];
+    /// the same bits either way); the GPU ignores it.
+    pub shared: bool,
 }
 
 /// Where a step's Gauss-Seidel sweeps run: on the CPU's threads ([`CpuSweeps`]) or on a GPU
@@ -223,7 +230,7 @@ pub struct ContactDynamics<T: Real> {
     near: near::Near<T>,
     sweeps: Box<dyn Sweeps<T>>,
     /// Last step's impulses by (grain id, partner grain id or wall), for the warm start.
-    warm: HashMap<(u32, Partner), Vec3<T>>,
+    warm: warm::WarmStart<T>,
     report: SolveReport,
     /// The solver's record since the last statistics read.
     since_read: crate::engine::SolverStats,
@@ -231,6 +238,8 @@ pub struct ContactDynamics<T: Real> {
     wall_names: Vec<String>,
     /// Time per phase of the step, when profiling.
     clock: PhaseClock<CdPhase>,
+    /// Whether the steps' sweeps go on the pool or on the calling thread alone.
+    crew: Crew,
 }
 
 /// The phases of a contact-dynamics step, for `grains bench`.
@@ -331,12 +340,13 @@ impl<T: Real> ContactDynamics<T> {
             schedule: Schedule::default(),
             near: near::Near::default(),
             sweeps: Box::new(CpuSweeps::default()),
-            warm: HashMap::new(),
+            warm: Default::default(),
             report: SolveReport::default(),
             since_read: Default::default(),
             steps: 0,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
             clock: PhaseClock::default(),
+            crew: Crew::default(),
         })
     }
 
@@ -412,10 +422,8 @@ impl<T: Real> ContactDynamics<T> {
                 }
             }
         }
+        self.warm.start(&mut contacts, &self.id);
         self.schedule = colour::schedule(&mut contacts, self.body.len());
-        for c in &mut contacts {
-            c.r = self.warm.get(&(self.id[c.a as usize], c.b)).copied().unwrap_or(Vec3::ZERO);
-        }
         self.contacts = contacts;
     }
 
@@ -472,7 +480,7 @@ impl<T: Real> ContactDynamics<T> {
         self.clock.stop(CdPhase::Detect, started);
         let started = self.clock.start();
         let mut report = SolveReport { contacts: contacts.len(), colours: self.schedule.starts.len().saturating_sub(1), largest_colour: self.schedule.colours().map(|r| r.len()).max().unwrap_or(0), serial: contacts.len() - self.schedule.tail(), ..Default::default() };
-        let settings = SweepSettings { tolerance: T::of(self.params.tolerance), max_iterations: self.params.max_iterations, relaxation: T::of(self.params.relaxation) };
+        let settings = SweepSettings { tolerance: T::of(self.params.tolerance), max_iterations: self.params.max_iterations, relaxation: T::of(self.params.relaxation), shared: self.crew.who() == Who::Pool };
         let solved = self.sweeps.solve(&mut contacts, &self.schedule, &mut self.body, &mut self.wall_motion, settings)?;
         (report.iterations, report.converged, report.sweep_norm) = (solved.iterations, solved.converged, solved.sweep_norm);
         self.clock.stop(CdPhase::Sweeps, started);
@@ -484,7 +492,7 @@ impl<T: Real> ContactDynamics<T> {
         let mean_r = loaded.iter().map(|r| r.f64()).sum::<f64>() / loaded.len().max(1) as f64;
         let net: f64 = self.body.iter().zip(&before).zip(&self.prop).map(|((b, b0), p)| ((b.vel - b0.vel) * p.mass).norm().f64()).sum();
         report.unbalanced = if mean_r > 0.0 { net / self.body.len() as f64 / mean_r } else { 0.0 };
-        self.warm = contacts.iter().filter(|c| c.r != Vec3::ZERO).map(|c| ((self.id[c.a as usize], c.b), c.r)).collect();
+        self.warm = warm::WarmStart::record(&contacts, &self.schedule.order, &self.id);
         self.contacts = contacts;
         self.report = report;
         let r = &mut self.since_read;

@@ -2,12 +2,10 @@
 //! module text of [`super`]), colour by colour in parallel, then the serial tail.
 
 use super::colour::Schedule;
-use super::{Contact, Partner, Solved, SweepSettings, Sweeps, WallMotion};
+use super::{parallel, Contact, Partner, Solved, SweepSettings, Sweeps, WallMotion};
 use crate::engine::SimError;
-use crate::state::reduce::PAR_MIN_PAIRS;
 use crate::state::Body;
 use crate::real::{Real, Vec3};
-use rayon::prelude::*;
 
 /// Velocity of `b` against `a` at contact `c` (m/s): `v_b + w_b x (-R_b n) - v_a - w_a x (R_a n)`.
 pub(super) fn relative_velocity<T: Real>(c: &Contact<T>, a: &Body<T>, b: &Body<T>) -> Vec3<T> {
@@ -103,7 +101,7 @@ fn relax<T: Real>(c: &Contact<T>, star: Vec3<T>, omega: T) -> Vec3<T> {
 
 /// Solves contact `c` between bodies `a` and `b` one after the other: its new impulse
 /// (relaxed by `omega`), applied; returns its share of the convergence measure.
-fn solve_serial<T: Real>(c: &mut Contact<T>, a: &mut Body<T>, b: &mut Body<T>, omega: T) -> (T, T) {
+pub(super) fn solve_serial<T: Real>(c: &mut Contact<T>, a: &mut Body<T>, b: &mut Body<T>, omega: T) -> (T, T) {
     if stays_open(c, a, b) {
         return (T::ZERO, T::ZERO);
     }
@@ -155,74 +153,27 @@ pub(super) fn quadratic_norm2<T: Real>(sums: &[(T, T)]) -> T {
     }
 }
 
-/// Grains per task when a colour's impulse changes are applied.
-const APPLY_CHUNK: usize = 4096;
-
-/// A sweep's per-contact scratch.
-#[derive(Default)]
-pub(super) struct Scratch<T> {
-    /// `(|W dr|^2, |W r|^2)` ((m/s)^2).
-    sums: Vec<(T, T)>,
-    /// `r - r_old` (N s).
-    change: Vec<Vec3<T>>,
-}
-
-/// One sweep over every contact in the schedule's order; returns the square of its quadratic
-/// norm ([`quadratic_norm2`]), summed in the schedule's order whatever the thread count.
-///
-/// A colour large enough to share is solved in two passes: every contact's new impulse from the bodies as the colour
-/// found them (in parallel over the contacts), then the changes applied (in parallel over
-/// chunks of grains, each grain touched by one contact of the colour at most). Since no two
-/// contacts of a colour share a grain, this gives the bits of solving them one after the other.
-pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], omega: T, scratch: &mut Scratch<T>) -> T {
-    // Every contact's entries are written below, so the scratch is only sized, not cleared.
-    let n = contacts.len();
-    scratch.sums.resize(n, (T::ZERO, T::ZERO));
-    scratch.change.resize(n, Vec3::ZERO);
-    for (k, range) in schedule.colours().enumerate() {
-        if range.len() < PAR_MIN_PAIRS || rayon::current_num_threads() == 1 {
-            // One thread: solved and applied contact by contact, the same bits.
-            for (c, sum) in contacts[range.clone()].iter_mut().zip(&mut scratch.sums[range]) {
-                let Partner::Grain(j) = c.b else { unreachable!("colours hold grain pairs") };
-                let (a, b) = two(body, c.a as usize, j as usize);
-                *sum = solve_serial(c, a, b, omega);
-            }
-            continue;
-        }
-        let grains: &[Body<T>] = body;
-        contacts[range.clone()].par_iter_mut().zip(scratch.sums[range.clone()].par_iter_mut()).zip(scratch.change[range].par_iter_mut()).with_min_len(PAR_MIN_PAIRS).for_each(|((c, sum), change)| {
+/// One sweep over every contact in the schedule's order on the calling thread; returns the
+/// square of its quadratic norm ([`quadratic_norm2`]). `sums` holds each contact's share of
+/// it; every entry is written, so it is only sized.
+pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], omega: T, sums: &mut Vec<(T, T)>) -> T {
+    sums.resize(contacts.len(), (T::ZERO, T::ZERO));
+    for range in schedule.colours() {
+        for (c, sum) in contacts[range.clone()].iter_mut().zip(&mut sums[range]) {
             let Partner::Grain(j) = c.b else { unreachable!("colours hold grain pairs") };
-            let (a, b) = (&grains[c.a as usize], &grains[j as usize]);
-            if stays_open(c, a, b) {
-                (*sum, *change) = ((T::ZERO, T::ZERO), Vec3::ZERO);
-                return;
-            }
-            let star = local(c, a, b);
-            let r = relax(c, star, omega);
-            (*sum, *change) = (measure(c, star - c.r, r), r - c.r);
-            c.r = r;
-        });
-        let touches = schedule.touches(k);
-        let (contacts, change) = (&*contacts, &scratch.change);
-        body.par_chunks_mut(APPLY_CHUNK).enumerate().for_each(|(chunk, grains)| {
-            let lo = chunk * APPLY_CHUNK;
-            let first = touches.partition_point(|t| (t.grain as usize) < lo);
-            let last = touches.partition_point(|t| (t.grain as usize) < lo + grains.len());
-            for t in &touches[first..last] {
-                let (c, dr, g) = (&contacts[t.contact as usize], change[t.contact as usize], &mut grains[t.grain as usize - lo]);
-                if dr == Vec3::ZERO {
-                    continue;
-                }
-                if t.second {
-                    apply_b(c, g, dr);
-                } else {
-                    apply_a(c, g, dr);
-                }
-            }
-        });
+            let (a, b) = two(body, c.a as usize, j as usize);
+            *sum = solve_serial(c, a, b, omega);
+        }
     }
     let tail = schedule.tail();
-    for (c, sum) in contacts[tail..].iter_mut().zip(&mut scratch.sums[tail..]) {
+    solve_tail(&mut contacts[tail..], body, walls, &mut sums[tail..], omega);
+    quadratic_norm2(sums)
+}
+
+/// Solves the serial tail's contacts (the wall contacts and any uncoloured pair) one after the
+/// other, each share of the measure into `sums`.
+pub(super) fn solve_tail<T: Real>(tail: &mut [Contact<T>], body: &mut [Body<T>], walls: &mut [WallMotion<T>], sums: &mut [(T, T)], omega: T) {
+    for (c, sum) in tail.iter_mut().zip(sums) {
         *sum = match c.b {
             Partner::Grain(j) => {
                 let (a, b) = two(body, c.a as usize, j as usize);
@@ -237,13 +188,15 @@ pub(super) fn sweep<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, b
             }
         };
     }
-    quadratic_norm2(&scratch.sums)
 }
 
-/// The sweeps on the CPU's threads.
+/// The sweeps on the CPU's threads: on the calling thread, or shared by the pool's threads
+/// ([`super::parallel`]) when the settings allow it, there are several and the solve has at
+/// least [`parallel::THREADS_MIN_CONTACTS`] contacts; the same bits either way.
 #[derive(Default)]
 pub struct CpuSweeps<T> {
-    scratch: Scratch<T>,
+    /// `(|W dr|^2, |W r|^2)` of each contact's last solve ((m/s)^2).
+    sums: Vec<(T, T)>,
 }
 
 impl<T: Real> Sweeps<T> for CpuSweeps<T> {
@@ -252,10 +205,13 @@ impl<T: Real> Sweeps<T> for CpuSweeps<T> {
     }
 
     fn solve(&mut self, contacts: &mut [Contact<T>], schedule: &Schedule, body: &mut [Body<T>], walls: &mut [WallMotion<T>], settings: SweepSettings<T>) -> Result<Solved, SimError> {
+        if settings.shared && rayon::current_num_threads() > 1 && contacts.len() >= parallel::THREADS_MIN_CONTACTS && settings.max_iterations > 0 {
+            return Ok(parallel::solve(contacts, schedule, body, walls, settings, &mut self.sums));
+        }
         let mut solved = Solved::default();
         while solved.iterations < settings.max_iterations {
             solved.iterations += 1;
-            let norm2 = sweep(contacts, schedule, body, walls, settings.relaxation, &mut self.scratch);
+            let norm2 = sweep(contacts, schedule, body, walls, settings.relaxation, &mut self.sums);
             solved.sweep_norm = norm2.f64().sqrt();
             if norm2 <= settings.tolerance * settings.tolerance {
                 solved.converged = true;

@@ -12,7 +12,6 @@ mod built_at;
 mod forces;
 mod gather;
 mod controllers;
-mod crew;
 mod integrate;
 mod lanes;
 mod pair_force;
@@ -54,7 +53,7 @@ use crate::schedule::{Op, Schedule, Sweep, Trace};
 use crate::scene::{Scene, WallShape};
 use crate::walls::{WallGeom, SERVO_RELAXATION};
 use controllers::{Piston, Servo};
-use crew::{Crew, Who};
+use crate::state::crew::{Crew, Who};
 use gather::gather_block;
 use crate::state::{CellGrid, Grids};
 use pair_force::{owner_block, OwnerBlock, TaskScratch};
@@ -162,7 +161,7 @@ pub struct CpuEngine<T: Real> {
     external_work: f64,
     /// Time per phase, when profiling.
     clock: PhaseClock<Phase>,
-    /// Whether a run's steps go on the pool or on the calling thread alone ([`crew`]).
+    /// Whether a run's steps go on the pool or on the calling thread alone ([`crate::state::crew`]).
     crew: Crew,
 }
 

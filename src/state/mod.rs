@@ -1,7 +1,8 @@
 //! The state the engines share, beneath them all: the grains' arrays ([`Body`], [`Props`],
 //! loads, periodic image counts), the per-contact history's slots, the pair list with the
 //! cell grid and pair detection that build it, the force evaluation's context with the
-//! grain-wall contact it evaluates, deterministic chunked reductions, and the per-phase clock.
+//! grain-wall contact it evaluates, deterministic chunked reductions, the per-phase clock, and
+//! the choice of threads for a run's steps (`crew`).
 //!
 //! The CPU engine (`crate::cpu`) runs the step on these; the GPU engine reads its state back
 //! into them for frames and reports; contact dynamics (`crate::cd`) detects its contacts with
@@ -9,6 +10,7 @@
 
 mod arrays;
 mod context;
+pub mod crew;
 mod grid;
 mod levels;
 mod pairs;

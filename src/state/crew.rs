@@ -4,14 +4,15 @@
 //! a step's parallel loops waits for all of its tasks, and a task the kernel has parked with
 //! its thread (for a time slice, milliseconds, against a step of a millisecond) holds every
 //! other thread at the loop's end; one thread on the core the other program leaves it loses
-//! nothing. Which threads run a step never changes a result (see [`super::split`]), so the
+//! nothing. Which threads run a step never changes a result (see `cpu::split`), so the
 //! choice is free to follow the machine.
 //!
 //! The choice is remade by trying both: [`PROBE`] of steps on each (after [`SETTLE`]), then
 //! the pool if it was [`FASTER`], else the caller, for [`HOLD`] times as long, or until the
 //! pool's steps slow by [`SLOWED`] against its probe (a program started beside the run).
 //! Steps that rebuild the neighbour list are not timed: they cost several ordinary steps and
-//! come at no fixed interval.
+//! come at no fixed interval. Contact dynamics' steps cost as many sweeps as each solve
+//! needs, so it times them per contact sweep ([`Crew::step_ends_with`]).
 //!
 //! Measured (the bench bed, 10^4 grains, f64, the 2-core Intel KVM guest, beside `sh -c
 //! 'while :; do :; done'`): the pool's probes gave 1.3-2.3 ms a step, the caller's 1.24 ms
@@ -72,7 +73,7 @@ pub struct Crew {
     stage: Stage,
     /// Timed steps and their wall time in the current window.
     window: Window,
-    /// Seconds per step of the last probe of each way (`[pool, caller]`).
+    /// Seconds per unit of work of the last probe of each way (`[pool, caller]`).
     probed: [f64; 2],
     /// Wall seconds of the last probes' timed steps.
     probing: f64,
@@ -99,14 +100,17 @@ enum Stage {
 struct Window {
     steps: u32,
     seconds: f64,
+    /// The steps' work, in the caller's units (1 a step where steps cost alike).
+    work: f64,
 }
 
 impl Window {
     fn full(&self) -> bool {
         self.steps >= PROBE_STEPS && self.seconds >= PROBE.as_secs_f64()
     }
-    fn per_step(&self) -> f64 {
-        self.seconds / self.steps as f64
+    /// Seconds per unit of work.
+    fn per_work(&self) -> f64 {
+        self.seconds / self.work
     }
 }
 
@@ -127,40 +131,49 @@ impl Crew {
         self.step_started = Some(Instant::now());
     }
 
-    /// The step started last ended; it rebuilt the neighbour list if `rebuilt`.
+    /// The step started last ended; it rebuilt the neighbour list if `rebuilt` (and is not
+    /// timed). Steps that cost alike.
     pub fn step_ends(&mut self, rebuilt: bool) {
+        self.step_ends_with((!rebuilt).then_some(1.0));
+    }
+
+    /// The step started last ended, having done `work` (in units of the caller's choosing,
+    /// the same for both ways: contact dynamics' contacts times sweeps); `None`: not timed.
+    pub fn step_ends_with(&mut self, work: Option<f64>) {
         if let Some(started) = self.step_started.take() {
             let now = Instant::now();
-            self.step_took(now.duration_since(started).as_secs_f64(), rebuilt, now);
+            self.step_took(now.duration_since(started).as_secs_f64(), work, now);
         }
     }
 
-    /// A step took `seconds`, ending at `now`.
-    fn step_took(&mut self, seconds: f64, rebuilt: bool, now: Instant) {
-        if rebuilt || self.timed_from.is_some_and(|t| now < t) {
+    /// A step took `seconds` for `work` (untimed when `None`), ending at `now`.
+    fn step_took(&mut self, seconds: f64, work: Option<f64>, now: Instant) {
+        let Some(work) = work.filter(|&w| w > 0.0) else { return };
+        if self.timed_from.is_some_and(|t| now < t) {
             return;
         }
         self.window.steps += 1;
         self.window.seconds += seconds;
+        self.window.work += work;
         if !self.window.full() {
             return;
         }
-        let per_step = self.window.per_step();
+        let per_work = self.window.per_work();
         match self.stage {
             Stage::ProbePool => {
-                self.probed[0] = per_step;
+                self.probed[0] = per_work;
                 self.probing = self.window.seconds;
                 self.begin(Who::Caller, Stage::ProbeCaller, now);
             }
             Stage::ProbeCaller => {
-                self.probed[1] = per_step;
+                self.probed[1] = per_work;
                 self.probing += self.window.seconds;
                 let (who, stretch) = if self.probed[0] * FASTER < self.probed[1] { (Who::Pool, self.stretch) } else { (Who::Caller, 1) };
                 self.stretch = if who == Who::Pool { (2 * stretch).min(MAX_STRETCH) } else { 1 };
                 self.begin(who, Stage::Hold(now + Duration::from_secs_f64((HOLD * stretch) as f64 * self.probing)), now);
             }
             Stage::Hold(until) => {
-                let slowed = self.who == Who::Pool && per_step > SLOWED * self.probed[0];
+                let slowed = self.who == Who::Pool && per_work > SLOWED * self.probed[0];
                 if slowed || now >= until {
                     self.begin(Who::Pool, Stage::ProbePool, now);
                 } else {
@@ -197,7 +210,7 @@ mod tests {
             };
             ran[who] += 1;
             now += Duration::from_secs_f64(took);
-            crew.step_took(took, k % 10 == 9, now);
+            crew.step_took(took, (k % 10 != 9).then_some(1.0), now);
         }
         (ran, now)
     }
