@@ -47,15 +47,8 @@ impl<T: Real> Engine for ContactDynamics<T> {
     }
 
     fn advance(&mut self, n: u64) -> Result<(), SimError> {
-        let timed = rayon::current_num_threads() > 1;
         for _ in 0..n {
-            if timed {
-                self.crew.step_starts();
-            }
             self.step()?;
-            if timed {
-                self.crew.step_ends_with(Some(self.report.contacts as f64 * self.report.iterations as f64));
-            }
         }
         match self.first_non_finite() {
             Some(grain) => Err(SimError::Unstable { step: self.steps, time: self.time(), what: "the state is not finite".into(), grain, suggested_dt: 0.5 * self.h.f64(), also: ", or raise contact_dynamics.max_iterations" }),

@@ -481,7 +481,16 @@ impl<T: Real> ContactDynamics<T> {
         let started = self.clock.start();
         let mut report = SolveReport { contacts: contacts.len(), colours: self.schedule.starts.len().saturating_sub(1), largest_colour: self.schedule.colours().map(|r| r.len()).max().unwrap_or(0), serial: contacts.len() - self.schedule.tail(), ..Default::default() };
         let settings = SweepSettings { tolerance: T::of(self.params.tolerance), max_iterations: self.params.max_iterations, relaxation: T::of(self.params.relaxation), shared: self.crew.who() == Who::Pool };
+        // The crew times the sweeps alone, per contact sweep: the rest of the step runs on one
+        // thread either way.
+        let timed = rayon::current_num_threads() > 1;
+        if timed {
+            self.crew.step_starts();
+        }
         let solved = self.sweeps.solve(&mut contacts, &self.schedule, &mut self.body, &mut self.wall_motion, settings)?;
+        if timed {
+            self.crew.step_ends_with(Some(contacts.len() as f64 * solved.iterations as f64));
+        }
         (report.iterations, report.converged, report.sweep_norm) = (solved.iterations, solved.converged, solved.sweep_norm);
         self.clock.stop(CdPhase::Sweeps, started);
         let started = self.clock.start();

@@ -11,8 +11,8 @@
 //! the pool if it was [`FASTER`], else the caller, for [`HOLD`] times as long, or until the
 //! pool's steps slow by [`SLOWED`] against its probe (a program started beside the run).
 //! Steps that rebuild the neighbour list are not timed: they cost several ordinary steps and
-//! come at no fixed interval. Contact dynamics' steps cost as many sweeps as each solve
-//! needs, so it times them per contact sweep ([`Crew::step_ends_with`]).
+//! come at no fixed interval. Contact dynamics times its solves alone (the rest of its step runs
+//! on one thread either way), per contact sweep ([`Crew::step_ends_with`]).
 //!
 //! Measured (the bench bed, 10^4 grains, f64, the 2-core Intel KVM guest, beside `sh -c
 //! 'while :; do :; done'`): the pool's probes gave 1.3-2.3 ms a step, the caller's 1.24 ms
