@@ -82,9 +82,12 @@ unsafe impl<T: Send> Send for Shared<T> {}
 unsafe impl<T: Send> Sync for Shared<T> {}
 
 /// The `part`-th of `parts` contiguous shares of `range`. (Shares by the grains' place in the
-/// packing, x slabs, so that a thread's grains stayed in its core's cache, ran slower: the
-/// threads' contacts then interleaved in the arrays, and their impulses and measures shared
-/// cache lines; S_1 at 8,000 grains on two threads took 119 s so against 105 s.)
+/// packing, slabs along x so that a thread's grains stayed in its core's cache, ran slower:
+/// the threads' contacts then interleaved in the arrays, and their impulses and measures
+/// shared cache lines; S_1 at 8,000 grains on two threads took 119 s that way against 105 s.)
+///
+/// A panic on one thread (none is reachable: a colour holds grain pairs of two grains) would
+/// leave the others at the barrier.
 fn share(range: std::ops::Range<usize>, part: usize, parts: usize) -> std::ops::Range<usize> {
     let len = range.len();
     range.start + len * part / parts..range.start + len * (part + 1) / parts
