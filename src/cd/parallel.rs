@@ -128,11 +128,7 @@ pub(super) fn solve<T: Real>(contacts: &mut [Contact<T>], schedule: &Schedule, b
                 let (contacts, body, walls, sums) = unsafe { (std::slice::from_raw_parts_mut(s.contacts, s.n_contacts), std::slice::from_raw_parts_mut(s.body, s.n_body), std::slice::from_raw_parts_mut(s.walls, s.n_walls), std::slice::from_raw_parts_mut(s.sums, s.n_contacts)) };
                 solve_tail(&mut contacts[tail..], body, walls, &mut sums[tail..], omega);
                 let norm2 = quadratic_norm2(sums);
-                let mut out = solved.lock().expect("only this thread locks it");
-                out.iterations += 1;
-                out.sweep_norm = norm2.f64().sqrt();
-                out.converged = norm2 <= settings.tolerance * settings.tolerance;
-                if out.converged || out.iterations >= settings.max_iterations {
+                if solved.lock().expect("only this thread locks it").after_sweep(norm2, &settings) {
                     stop.store(true, Ordering::Release);
                 }
             }

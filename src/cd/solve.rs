@@ -1,5 +1,6 @@
 //! One sweep of nonsmooth Gauss-Seidel: each contact's local problem solved exactly (see the
-//! module text of [`super`]), colour by colour in parallel, then the serial tail.
+//! module text of [`super`]), colour by colour, then the serial tail; on the calling thread
+//! here, shared by the pool's threads in [`super::parallel`].
 
 use super::colour::Schedule;
 use super::{parallel, Contact, Partner, Solved, SweepSettings, Sweeps, WallMotion};
@@ -109,7 +110,7 @@ pub(super) fn solve_serial<T: Real>(c: &mut Contact<T>, a: &mut Body<T>, b: &mut
     let r = relax(c, star, omega);
     let dr = r - c.r;
     // A change of exactly zero is not applied (it could only turn a velocity of -0 into +0),
-    // on every path, so that the bits do not depend on the path.
+    // as the WGSL twin does not apply it, so that both give the same bits.
     if dr != Vec3::ZERO {
         apply_a(c, a, dr);
         apply_b(c, b, dr);
@@ -210,15 +211,23 @@ impl<T: Real> Sweeps<T> for CpuSweeps<T> {
         }
         let mut solved = Solved::default();
         while solved.iterations < settings.max_iterations {
-            solved.iterations += 1;
             let norm2 = sweep(contacts, schedule, body, walls, settings.relaxation, &mut self.sums);
-            solved.sweep_norm = norm2.f64().sqrt();
-            if norm2 <= settings.tolerance * settings.tolerance {
-                solved.converged = true;
+            if solved.after_sweep(norm2, &settings) {
                 break;
             }
         }
         Ok(solved)
+    }
+}
+
+impl Solved {
+    /// Counts a sweep whose quadratic norm squared was `norm2`; returns whether the sweeps stop:
+    /// the norm fell to the settings' tolerance, or the cap of sweeps has run.
+    pub(super) fn after_sweep<T: Real>(&mut self, norm2: T, settings: &SweepSettings<T>) -> bool {
+        self.iterations += 1;
+        self.sweep_norm = norm2.f64().sqrt();
+        self.converged = norm2 <= settings.tolerance * settings.tolerance;
+        self.converged || self.iterations >= settings.max_iterations
     }
 }
 
