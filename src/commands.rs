@@ -48,7 +48,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             }
         }
         Command::Export { run, format, out } => {
-            let (_, scene, frame) = run_summary(&run)?;
+            let (_, scene, frame) = grains::runner::read_finished_run(&run)?;
             let atoms = grains::output::lammps::atoms(&scene, &frame);
             let (text, default) = match format {
                 ExportFormat::LammpsData => (grains::lammps::data::write(&atoms, &format!("{} at t = {:e} s", scene.name, frame.time)), "grains.data"),
@@ -145,11 +145,11 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
             Ok(())
         }
         Command::Analyze { run, beside, json } => {
-            let (summary, scene, frame) = finished_run(&run)?;
-            let stats: grains::engine::Stats = serde_json::from_value(summary["stages"].as_array().and_then(|s| s.last()).map(|s| s["stats"].clone()).context("summary.json has no stages")?)?;
+            let (summary, scene, frame) = grains::runner::read_finished_run_with_contacts(&run)?;
+            let stats = grains::runner::last_stage_stats(&summary)?;
             let a = grains::output::network::write(&scene, &frame, &stats, &run)?;
             if let Some(other) = &beside {
-                let (_, other_scene, other_frame) = finished_run(other)?;
+                let (_, other_scene, other_frame) = grains::runner::read_finished_run_with_contacts(other)?;
                 grains::output::network::write_beside(&scene, &a, &other_scene, &other_frame, &run)?;
             }
             if json {
@@ -230,24 +230,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
 }
 
 /// A progress bar on a terminal, not with --json.
-/// A finished run's summary, scene and last frame.
-fn run_summary(run: &Path) -> anyhow::Result<(serde_json::Value, Scene, grains::engine::Frame)> {
-    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).with_context(|| format!("{}: no summary.json; fix: give the --out directory of a finished run", run.display()))?)?;
-    let scene_file = summary["file"].as_str().with_context(|| format!("{}: summary.json names no scene file", run.display()))?;
-    let scene = scene::load(Path::new(scene_file))?;
-    let frame = grains::output::mcap::last_frame(&run.join("frames.mcap"))?;
-    Ok((summary, scene, frame))
-}
-
-/// A finished run's summary, scene and last frame (which must hold the contact forces).
-fn finished_run(run: &Path) -> anyhow::Result<(serde_json::Value, Scene, grains::engine::Frame)> {
-    let (summary, scene, frame) = run_summary(run)?;
-    if frame.contacts.is_none() {
-        anyhow::bail!("{}: the frames hold no contact forces; fix: set output.contact_forces = true in the scene and run it again", run.display());
-    }
-    Ok((summary, scene, frame))
-}
-
 fn progress_bar(json: bool) -> bool {
     !json && std::io::stderr().is_terminal()
 }

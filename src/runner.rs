@@ -6,10 +6,10 @@ use crate::checkpoint::{CheckpointHeader, EngineState, RunIdentity};
 use crate::cpu::CpuEngine;
 use crate::engine::Engine;
 use crate::output::{RunRecorder, Summary};
-use crate::protocol::Progress;
+use crate::protocol::{Progress, Recorder, StageResult};
 use crate::scene::{self, Method, Scene};
 use anyhow::Context;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// What a checkpoint of this run belongs to.
@@ -71,25 +71,89 @@ fn engine_of(scene: &Scene, id: &RunIdentity, adapter: Option<&str>) -> anyhow::
 /// end), and writes `summary.json` last: a directory with a summary holds a finished run.
 /// In a run over several processes every process runs this alike, and rank 0 alone writes.
 pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start: Progress, identity: RunIdentity, resumed_from: Option<&CheckpointHeader>, progress_bar: bool) -> anyhow::Result<Summary> {
-    let writes = is_root();
-    let (out, progress_bar) = (out.filter(|_| writes), progress_bar && writes);
-    let rec = match (out, resumed_from) {
-        (Some(dir), Some(header)) => RunRecorder::resume(dir, header, progress_bar)?,
-        _ => RunRecorder::new(out, progress_bar)?,
+    let mut run = Run::start(scene, engine, out, start, identity, resumed_from, progress_bar)?;
+    let mut stages = || -> anyhow::Result<()> {
+        while run.next_stage(scene, engine)?.is_some() {}
+        Ok(())
     };
-    let mut rec = match out {
-        Some(dir) => rec.with_checkpoints(dir, identity).with_vtk(dir, scene, resumed_from.map(|_| engine.time()))?,
-        None => rec,
-    };
-    let started = Instant::now();
-    let result = crate::protocol::run_from(scene, engine, &mut rec, start);
-    let wall_seconds = started.elapsed().as_secs_f64();
-    // Whatever happened, keep what was recorded.
-    rec.finish()?;
-    let stages = result?;
-    let threads = if engine.backend() == "cpu" { rayon::current_num_threads() } else { 1 };
-    let summary = Summary::new(scene, engine, threads, wall_seconds, stages)?;
-    if let Some(dir) = out {
+    match stages() {
+        Ok(()) => run.finish(scene, engine),
+        Err(e) => {
+            // Whatever happened, keep what was recorded.
+            run.close()?;
+            Err(e)
+        }
+    }
+}
+
+/// A run with its outputs, driven a stage at a time ([`execute`] runs every stage; the Python
+/// module lets its caller step between them).
+pub struct Run {
+    rec: RunRecorder,
+    /// The output directory, on the process that writes.
+    out: Option<PathBuf>,
+    progress: Progress,
+    progress_bar: bool,
+    /// Wall-clock seconds spent in the stages so far.
+    wall_seconds: f64,
+}
+
+impl Run {
+    /// Opens the outputs of a run from `start` (into `out` when given, continuing those of a
+    /// run resumed from `resumed_from`), with a checkpoint into `out` at every stage end.
+    pub fn start(scene: &Scene, engine: &dyn Engine, out: Option<&Path>, start: Progress, identity: RunIdentity, resumed_from: Option<&CheckpointHeader>, progress_bar: bool) -> anyhow::Result<Run> {
+        let writes = is_root();
+        let (out, progress_bar) = (out.filter(|_| writes), progress_bar && writes);
+        let rec = match (out, resumed_from) {
+            (Some(dir), Some(header)) => RunRecorder::resume(dir, header, progress_bar)?,
+            _ => RunRecorder::new(out, progress_bar)?,
+        };
+        let rec = match out {
+            Some(dir) => rec.with_checkpoints(dir, identity).with_vtk(dir, scene, resumed_from.map(|_| engine.time()))?,
+            None => rec,
+        };
+        Ok(Run { rec, out: out.map(Path::to_path_buf), progress: start, progress_bar, wall_seconds: 0.0 })
+    }
+
+    /// Where the run stands.
+    pub fn progress(&self) -> &Progress {
+        &self.progress
+    }
+
+    /// Runs the next stage; its result, or `None` when every stage has run.
+    pub fn next_stage(&mut self, scene: &Scene, engine: &mut dyn Engine) -> anyhow::Result<Option<&StageResult>> {
+        self.next_stage_unless(scene, engine, &mut || Ok(()))
+    }
+
+    /// [`Self::next_stage`], asking `stop` at every statistics read whether to go on: its error
+    /// ends the stage there (a user's interrupt), with what was recorded kept.
+    pub fn next_stage_unless(&mut self, scene: &Scene, engine: &mut dyn Engine, stop: &mut dyn FnMut() -> anyhow::Result<()>) -> anyhow::Result<Option<&StageResult>> {
+        let started = Instant::now();
+        let mut rec = Watched { rec: &mut self.rec, stop };
+        let result = crate::protocol::run_next_stage(scene, engine, &mut rec, &mut self.progress);
+        self.wall_seconds += started.elapsed().as_secs_f64();
+        result
+    }
+
+    /// Writes a checkpoint of where the run stands now (between stages or inside one, at a
+    /// statistics read) into the output directory; nothing without one.
+    pub fn checkpoint(&mut self, engine: &dyn Engine) -> anyhow::Result<()> {
+        self.rec.checkpoint(&self.progress, engine)
+    }
+
+    /// Flushes and closes the output files, keeping what was recorded (a run stopped early).
+    pub fn close(self) -> anyhow::Result<()> {
+        self.rec.finish()
+    }
+
+    /// Closes the outputs and writes what a finished run leaves: `compression.csv` and its
+    /// plots, the force-transmission analysis when the scene asks for it, and `summary.json`.
+    pub fn finish(self, scene: &Scene, engine: &mut dyn Engine) -> anyhow::Result<Summary> {
+        let Run { rec, out, progress, progress_bar, wall_seconds } = self;
+        rec.finish()?;
+        let threads = if engine.backend() == "cpu" { rayon::current_num_threads() } else { 1 };
+        let summary = Summary::new(scene, engine, threads, wall_seconds, progress.results)?;
+        let Some(dir) = out.as_deref() else { return Ok(summary) };
         if !summary.compression.is_empty() {
             let path = dir.join("compression.csv");
             std::fs::write(&path, summary.compression_csv()).with_context(|| format!("cannot write {}", path.display()))?;
@@ -116,8 +180,33 @@ pub fn execute(scene: &Scene, engine: &mut dyn Engine, out: Option<&Path>, start
         }
         let path = dir.join("summary.json");
         std::fs::write(&path, serde_json::to_string_pretty(&summary)?).with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(summary)
     }
-    Ok(summary)
+}
+
+/// A recorder that asks `stop` before each statistics row it records ([`Run::next_stage_unless`]).
+struct Watched<'a> {
+    rec: &'a mut RunRecorder,
+    stop: &'a mut dyn FnMut() -> anyhow::Result<()>,
+}
+
+impl Recorder for Watched<'_> {
+    fn stats(&mut self, stage: &str, s: &crate::engine::Stats) -> anyhow::Result<()> {
+        self.rec.stats(stage, s)?;
+        (self.stop)()
+    }
+    fn frame(&mut self, f: &crate::engine::Frame) -> anyhow::Result<()> {
+        self.rec.frame(f)
+    }
+    fn stage_end(&mut self, r: &StageResult) -> anyhow::Result<()> {
+        self.rec.stage_end(r)
+    }
+    fn checkpoint(&mut self, progress: &Progress, engine: &dyn Engine) -> anyhow::Result<()> {
+        self.rec.checkpoint(progress, engine)
+    }
+    fn progress(&mut self, stage: &str, done: u64, total: u64) {
+        self.rec.progress(stage, done, total)
+    }
 }
 
 /// True on the process that writes outputs and prints: always, unless this is a run over
@@ -150,6 +239,27 @@ pub fn run_cpu(scene_file: &Path, precision: &str, out: Option<&Path>, progress_
 /// that wrote it (a GPU checkpoint on the adapter `adapter` names, or the best one). The scene
 /// is the one the checkpoint names unless `scene_file` is given; it must be unchanged.
 pub fn resume(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, adapter: Option<&str>, progress_bar: bool) -> anyhow::Result<Summary> {
+    let mut r = open_checkpoint(dir, scene_file, precision, adapter)?;
+    execute(&r.scene, r.engine.as_mut(), Some(dir), r.header.progress.clone(), r.identity, Some(&r.header), progress_bar)
+}
+
+/// A run's checkpoint opened to continue it ([`open_checkpoint`]).
+pub struct Resumed {
+    /// The scene, as the run recorded it (VTK files kept on where the run wrote them).
+    pub scene: Scene,
+    /// The scene's file.
+    pub scene_file: PathBuf,
+    /// The engine, restored to the checkpoint's state.
+    pub engine: Box<dyn Engine>,
+    /// The checkpoint's header: where the run stands and the files it continues.
+    pub header: CheckpointHeader,
+    /// What the continued run's checkpoints belong to.
+    pub identity: RunIdentity,
+}
+
+/// Opens the checkpoint in `dir` (see [`resume`]): checks that the scene is unchanged and the
+/// precision the one that wrote it, and restores the engine.
+pub fn open_checkpoint(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, adapter: Option<&str>) -> anyhow::Result<Resumed> {
     let (header, state): (CheckpointHeader, EngineState) = crate::checkpoint::read(&dir.join(crate::checkpoint::FILE))?;
     let id = &header.identity;
     let path = scene_file.map(Path::to_path_buf).unwrap_or_else(|| id.scene_file.clone().into());
@@ -166,5 +276,31 @@ pub fn resume(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, ad
     let mut engine = engine_of(&scene, id, adapter)?;
     engine.restore(&state).with_context(|| format!("cannot resume from {}", dir.display()))?;
     let identity = identity(&path, engine.as_ref())?;
-    execute(&scene, engine.as_mut(), Some(dir), header.progress.clone(), identity, Some(&header), progress_bar)
+    Ok(Resumed { scene, scene_file: path, engine, header, identity })
+}
+
+/// A finished run directory's summary (`summary.json`), scene (the file the summary names) and
+/// last recorded frame (`frames.mcap`).
+pub fn read_finished_run(run: &Path) -> anyhow::Result<(serde_json::Value, Scene, crate::engine::Frame)> {
+    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(run.join("summary.json")).with_context(|| format!("{}: no summary.json; fix: give the --out directory of a finished run", run.display()))?)?;
+    let scene_file = summary["file"].as_str().with_context(|| format!("{}: summary.json names no scene file", run.display()))?;
+    let scene = scene::load(Path::new(scene_file))?;
+    let frame = crate::output::mcap::last_frame(&run.join("frames.mcap"))?;
+    Ok((summary, scene, frame))
+}
+
+/// [`read_finished_run`], whose last frame must hold the contact forces (the force-transmission
+/// analysis reads them).
+pub fn read_finished_run_with_contacts(run: &Path) -> anyhow::Result<(serde_json::Value, Scene, crate::engine::Frame)> {
+    let (summary, scene, frame) = read_finished_run(run)?;
+    if frame.contacts.is_none() {
+        anyhow::bail!("{}: the frames hold no contact forces; fix: set output.contact_forces = true in the scene and run it again", run.display());
+    }
+    Ok((summary, scene, frame))
+}
+
+/// The statistics at the end of a finished run's last stage, from its summary.
+pub fn last_stage_stats(summary: &serde_json::Value) -> anyhow::Result<crate::engine::Stats> {
+    let last = summary["stages"].as_array().and_then(|s| s.last()).context("summary.json has no stages")?;
+    Ok(serde_json::from_value(last["stats"].clone())?)
 }

@@ -90,42 +90,12 @@ pub fn load(file: &Path) -> anyhow::Result<Sweep> {
     Ok(sweep)
 }
 
-/// Sets `path` (dotted) to `value` in a TOML document.
-pub(crate) fn set(doc: &mut toml::Table, path: &str, value: toml::Value) -> Result<(), String> {
-    let parts: Vec<&str> = path.split('.').collect();
-    let mut here: &mut toml::Table = doc;
-    let mut i = 0;
-    while i + 1 < parts.len() {
-        let key = parts[i];
-        let entry = here.get_mut(key).ok_or_else(|| format!("the scene has no `{key}`"))?;
-        here = match entry {
-            toml::Value::Table(t) => t,
-            toml::Value::Array(items) => {
-                i += 1;
-                let sel = parts[i];
-                let found = match sel.parse::<usize>() {
-                    Ok(k) => items.get_mut(k),
-                    Err(_) => items.iter_mut().find(|it| it.get("name").and_then(|n| n.as_str()) == Some(sel)),
-                };
-                match found {
-                    Some(toml::Value::Table(t)) => t,
-                    _ => return Err(format!("`{key}` has no entry named or numbered `{sel}`")),
-                }
-            }
-            _ => return Err(format!("`{key}` is not a table")),
-        };
-        i += 1;
-    }
-    here.insert(parts[parts.len() - 1].to_string(), value);
-    Ok(())
-}
-
 impl Sweep {
     /// The scene text of a point (the sweep's scene with the point's values set).
     pub fn scene_for(&self, p: &Point) -> anyhow::Result<String> {
         let mut doc: toml::Table = toml::from_str(&self.scene_text).with_context(|| format!("{}: not valid TOML", self.scene.display()))?;
         for (path, v) in &p.values {
-            set(&mut doc, path, v.clone()).map_err(|e| anyhow::anyhow!("{}: parameters.\"{path}\": {e}; fix: name a key of the scene (tables by key, [[arrays]] by name or index)", self.file.display()))?;
+            crate::scene::dotted::set(&mut doc, path, v.clone()).map_err(|e| anyhow::anyhow!("{}: parameters.\"{path}\": {e}; fix: name a key of the scene (tables by key, [[arrays]] by name or index)", self.file.display()))?;
         }
         let text = toml::to_string(&doc)?;
         crate::scene::parse(&self.scene, &text).map_err(|e| anyhow::anyhow!("{} point {}: {e}", self.file.display(), p.index))?;

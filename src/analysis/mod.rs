@@ -7,7 +7,7 @@ pub mod oquendo;
 pub mod richefeu;
 pub mod tail;
 
-use crate::engine::Frame;
+use crate::engine::{ContactRecord, Frame};
 use glam::{DMat3, DVec3};
 use crate::periodic::Periodic;
 use crate::real::Vec3;
@@ -122,6 +122,28 @@ pub fn container_volume(scene: &Scene, piston_z: f64) -> Option<f64> {
     Some(area * (piston_z - floor))
 }
 
+/// The unit vector from grain j's centre to grain i's (nearest periodic images) of a touching
+/// pair of `frame`: the direction a compressive normal force pushes grain i.
+pub fn contact_normal(frame: &Frame, periodic: &Periodic<f64>, c: &ContactRecord) -> Vec3<f64> {
+    let d = periodic.min_image(Vec3::of(frame.position[c.i as usize]) - Vec3::of(frame.position[c.j as usize]));
+    d * (1.0 / d.norm())
+}
+
+/// Per grain, the net force of its contacts (N): grain-grain pairs (each end's own force)
+/// and walls, summed in the frame's order. Indexed like the frame's grains (slot = permanent
+/// id); zero for every grain of a frame taken without contacts.
+pub fn contact_forces(frame: &Frame) -> Vec<DVec3> {
+    let mut f = vec![DVec3::ZERO; frame.radius.len()];
+    for r in frame.contacts.as_deref().unwrap_or(&[]) {
+        f[r.i as usize] += r.force;
+        f[r.j as usize] += r.force_j;
+    }
+    for w in frame.wall_contacts.as_deref().unwrap_or(&[]) {
+        f[w.grain as usize] += w.force;
+    }
+    f
+}
+
 /// Per grain, the sum over its contacts of `f (x) c` (N m): `f` the force on the grain, `c`
 /// the vector from its centre to the contact point (Richefeu et al. (2009) eq. 11 before the division by
 /// the grain's volume). Grain-grain and grain-wall contacts of the frame count; the frame
@@ -131,8 +153,7 @@ pub fn contact_moments(frame: &Frame, periodic: &Periodic<f64>) -> Vec<Tensor> {
     let add = |t: &mut Tensor, f: DVec3, c: DVec3| *t += outer(f, c);
     for r in frame.contacts.as_deref().unwrap_or(&[]) {
         let (i, j) = (r.i as usize, r.j as usize);
-        let d = periodic.min_image(Vec3::of(frame.position[i]) - Vec3::of(frame.position[j]));
-        let n = d * (1.0 / d.norm());
+        let n = contact_normal(frame, periodic, r);
         let (ri, rj) = (frame.radius[i], frame.radius[j]);
         let rp_i = ri - r.overlap * rj / (ri + rj);
         let rp_j = rj - r.overlap * ri / (ri + rj);

@@ -7,7 +7,6 @@ use super::{contact_moments, outer, trace, Tensor};
 use glam::DMat3;
 use crate::engine::Frame;
 use crate::periodic::Periodic;
-use crate::real::Vec3;
 use serde::Serialize;
 
 /// Histogram bins of the force and pressure PDFs.
@@ -227,8 +226,7 @@ pub fn analyze(frame: &Frame, periodic: &Periodic<f64>, bounds: Bounds, f0: Opti
     let mut fabric = DMat3::ZERO;
     let mut n_bonds = 0.0f64;
     for c in contacts.iter().filter(|c| c.normal_force != 0.0) {
-        let d = periodic.min_image(Vec3::of(frame.position[c.i as usize]) - Vec3::of(frame.position[c.j as usize]));
-        let u = (d * (1.0 / d.norm())).f64();
+        let u = super::contact_normal(frame, periodic, c).f64();
         fabric += outer(u, u);
         n_bonds += 1.0;
     }

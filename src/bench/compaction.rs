@@ -106,7 +106,7 @@ pub fn scaled((name, text): (&str, &str), grains: usize) -> anyhow::Result<Scene
     let side = SAMPLE_SIDE * (grains as f64 / SAMPLE_GRAINS).cbrt();
     let corner = toml::Value::Array(vec![toml::Value::Float(side); 3]);
     for (key, value) in [("generate.0.count", toml::Value::Integer(grains as i64)), ("generate.0.region.max", corner.clone()), ("wall.0.max", corner)] {
-        crate::sweep::set(&mut doc, key, value).map_err(|e| anyhow::anyhow!("{name}: {key}: {e}"))?;
+        crate::scene::dotted::set(&mut doc, key, value).map_err(|e| anyhow::anyhow!("{name}: {key}: {e}"))?;
     }
     doc.remove("output");
     let mut scene = crate::scene::parse(std::path::Path::new(name), &toml::to_string(&doc)?)?;

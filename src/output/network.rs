@@ -12,15 +12,26 @@ use crate::scene::Scene;
 use anyhow::Context;
 use std::path::Path;
 
+/// The force-transmission analysis of `frame` (taken with contacts) of `scene`, over the
+/// sample the scene's walls bound (what `analysis.json` holds).
+pub fn analyze_scene(scene: &Scene, frame: &Frame, stats: &Stats) -> NetworkAnalysis {
+    analyze(frame, &Periodic::of(&scene.periodic), sample_bounds(scene, stats, frame), capillary_scale(scene))
+}
+
+/// The capillary force scale `f0 = kappa R_max` (N) of a wet scene, the forces' unit there.
+fn capillary_scale(scene: &Scene) -> Option<f64> {
+    match scene.model.cohesion {
+        CohesionLaw::Capillary { kappa, .. } => Some(kappa * scene.grains.radius.iter().copied().fold(0.0, f64::max)),
+        CohesionLaw::None => None,
+    }
+}
+
 /// Analyses `frame` (taken with contacts) and writes `analysis.json`, `force_pdf`,
 /// `pressure_pdf`, `force_network` and `pressure_map` (PNG and SVG) into `dir`. Plots that
 /// cannot be drawn (no font) give a warning, not an error.
 pub fn write(scene: &Scene, frame: &Frame, stats: &Stats, dir: &Path) -> anyhow::Result<NetworkAnalysis> {
-    let f0 = match scene.model.cohesion {
-        CohesionLaw::Capillary { kappa, .. } => Some(kappa * scene.grains.radius.iter().copied().fold(0.0, f64::max)),
-        CohesionLaw::None => None,
-    };
-    let a = analyze(frame, &Periodic::of(&scene.periodic), sample_bounds(scene, stats, frame), f0);
+    let a = analyze_scene(scene, frame, stats);
+    let f0 = capillary_scale(scene);
     let path = dir.join("analysis.json");
     std::fs::write(&path, serde_json::to_string_pretty(&a)?).with_context(|| format!("cannot write {}", path.display()))?;
     let x_label = format!("normal force / ({})", a.force_scale_is);

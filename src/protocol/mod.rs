@@ -146,6 +146,12 @@ impl CheckpointClock {
 }
 
 impl Progress {
+    /// Checks statistics read outside the stages (a caller's own steps) as every read inside
+    /// them is: an error names what went unstable and a time step to try.
+    pub fn check_stable(&self, stats: &Stats) -> Result<(), SimError> {
+        self.guard.check(stats)
+    }
+
     /// The start of a run on a freshly set-up engine.
     pub fn start(scene: &Scene, engine: &mut dyn Engine) -> Result<Self, SimError> {
         let stats = engine.stats()?;
@@ -169,15 +175,22 @@ pub fn run(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn Recorder) -> an
 /// checkpoint to the recorder after each, and inside a stage every
 /// `output.checkpoint_interval` seconds of wall-clock time.
 pub fn run_from(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn Recorder, mut progress: Progress) -> anyhow::Result<Vec<StageResult>> {
-    let mut clock = CheckpointClock::new(scene.output.checkpoint_interval);
-    while let Some(stage) = scene.stages.get(progress.next_stage) {
-        let result = run_stage(scene, stage, engine, rec, &mut progress, &mut clock)?;
-        progress.results.push(result);
-        progress.next_stage += 1;
-        rec.checkpoint(&progress, engine)?;
-        clock.reset();
-    }
+    while run_next_stage(scene, engine, rec, &mut progress)?.is_some() {}
     Ok(progress.results)
+}
+
+/// Runs the next stage from where `progress` stands (its start, or inside it where a
+/// checkpoint left it), offering a checkpoint to the recorder at its end and inside it every
+/// `output.checkpoint_interval` seconds of wall-clock time; returns its result, or `None`
+/// when every stage has run.
+pub fn run_next_stage<'p>(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn Recorder, progress: &'p mut Progress) -> anyhow::Result<Option<&'p StageResult>> {
+    let Some(stage) = scene.stages.get(progress.next_stage) else { return Ok(None) };
+    let mut clock = CheckpointClock::new(scene.output.checkpoint_interval);
+    let result = run_stage(scene, stage, engine, rec, progress, &mut clock)?;
+    progress.results.push(result);
+    progress.next_stage += 1;
+    rec.checkpoint(progress, engine)?;
+    Ok(progress.results.last())
 }
 
 /// Sets stage `stage` up on the engine (pressures, liquid, the piston lowered), returning
@@ -280,8 +293,10 @@ fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dy
     Ok(result)
 }
 
-/// Measures the sample at the end of a pressure step.
-fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, settled: bool) -> Result<CompressionPoint, SimError> {
+/// Measures the sample at the end of a pressure step (`stats` read just before; `settled`
+/// whether the step met its criteria): the void ratio between the floor and the piston, the
+/// particle stress over that volume, the coordination.
+pub fn compression_point(scene: &Scene, engine: &mut dyn Engine, stats: &Stats, settled: bool) -> Result<CompressionPoint, SimError> {
     let piston = stats.piston.clone().unwrap_or_default();
     let frame = engine.frame(true)?;
     let volume = container_volume(scene, piston.z).unwrap_or(f64::NAN);

@@ -1,6 +1,7 @@
 //! Scenes: the TOML schema ([`schema`]), its validation into a [`Scene`] (whose types are in
 //! [`types`]), and grain generation.
 
+pub mod dotted;
 mod error;
 mod generate;
 mod model_specs;
