@@ -96,7 +96,7 @@ def main() -> None:
     ax.set_xscale("log")
     ax.set_xlabel("vertical pressure on the piston (kPa)")
     ax.set_ylabel("void ratio e")
-    ax.set_title("280-grain oedometer: load to 400 kPa, unload to 25 kPa, reload to 1.6 MPa")
+    ax.set_title("280-grain oedometer: loaded, unloaded, reloaded")
     ax.legend()
     fig.tight_layout()
     png = args.out / "cyclic_oedometer.png"
