@@ -360,6 +360,12 @@ impl Simulation {
         Ok(self.lock()?.scene.stats_interval)
     }
 
+    /// The time step (s).
+    #[getter]
+    fn dt(&self) -> PyResult<f64> {
+        Ok(self.lock()?.scene.time_step.dt)
+    }
+
     /// Simulated time (s).
     #[getter]
     fn time(&self) -> PyResult<f64> {

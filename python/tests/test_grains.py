@@ -189,6 +189,13 @@ def test_ctrl_c_stops_an_advance_after_whole_steps(tmp_path: Path) -> None:
     assert 0 < stopped < 10**9 and stopped % sim.stats_interval == 0, (stopped, sim.stats_interval)
     sim.advance(steps=100)
     assert sim.steps == stopped + 100
+    # By time: whole steps, rounded up.
+    before, t0 = sim.steps, sim.time
+    sim.advance(time=1e-4)
+    assert sim.steps - before == math.ceil(1e-4 / sim.dt)
+    assert abs((sim.time - t0) - (sim.steps - before) * sim.dt) < 1e-12
+    with pytest.raises(ValueError):
+        sim.advance(steps=10, time=1e-4)
 
 
 def test_checkpoints_pass_between_python_and_the_cli(tmp_path: Path) -> None:
