@@ -236,7 +236,7 @@ fn progress_bar(json: bool) -> bool {
 
 /// The engine `--backend` and `--precision` ask for.
 fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision: Option<Precision>, quiet: bool) -> anyhow::Result<Box<dyn Engine>> {
-    let gpu = |gpu| grains::runner::gpu_engine(gpu, scene);
+    let gpu = |gpu| -> anyhow::Result<Box<dyn Engine>> { Ok(grains::runner::gpu_engine(gpu, scene)?) };
     let cpu = |precision: Option<Precision>| grains::runner::cpu_engine(scene, if precision == Some(Precision::F32) { "f32" } else { "f64" });
     let rigid = matches!(scene.method, grains::scene::Method::ContactDynamics(_));
     if grains::runner::processes() > 1 {

@@ -444,9 +444,8 @@ fn missing(name: &str) -> String {
     format!("the checkpoint has no `{name}`: another version of grains wrote it; fix: run the scene again from its start with this version")
 }
 
-/// A backend the host loop can drive. `Send`, so that a caller can hand a run to another
-/// thread (the Python module steps it with the interpreter's lock released).
-pub trait Engine: Send {
+/// A backend the host loop can drive.
+pub trait Engine {
     /// "cpu" or "gpu".
     fn backend(&self) -> &'static str;
     /// "f32" or "f64".

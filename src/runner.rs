@@ -23,21 +23,29 @@ pub fn identity(scene_file: &Path, engine: &dyn Engine) -> anyhow::Result<RunIde
     })
 }
 
-/// A CPU engine of precision "f32" or "f64".
+/// A CPU engine of precision "f32" or "f64": under mpirun (feature `mpi`) a DEM engine over
+/// every process, else [`local_cpu_engine`].
 pub fn cpu_engine(scene: &Scene, precision: &str) -> anyhow::Result<Box<dyn Engine>> {
+    #[cfg(feature = "mpi")]
+    if processes() > 1 && !matches!(scene.method, Method::ContactDynamics(_)) {
+        return Ok(match precision {
+            "f32" => Box::new(crate::cpu::ranks::Distributed::<f32>::new(scene)?),
+            "f64" => Box::new(crate::cpu::ranks::Distributed::<f64>::new(scene)?),
+            other => anyhow::bail!("precision `{other}`: the CPU engine computes in f32 or f64; fix: give --precision f32 or f64"),
+        });
+    }
+    Ok(local_cpu_engine(scene, precision)?)
+}
+
+/// A CPU engine of precision "f32" or "f64" on this process alone: `Send`, so that a caller
+/// can step it on another thread (the Python module does, with the interpreter's lock
+/// released; an engine over several processes holds MPI handles, which are not).
+pub fn local_cpu_engine(scene: &Scene, precision: &str) -> anyhow::Result<Box<dyn Engine + Send>> {
     if let Method::ContactDynamics(params) = scene.method {
         return Ok(match precision {
             "f32" => Box::new(ContactDynamics::<f32>::new(scene, params)?),
             "f64" => Box::new(ContactDynamics::<f64>::new(scene, params)?),
             other => anyhow::bail!("precision `{other}`: contact dynamics computes in f32 or f64; fix: give --precision f32 or f64"),
-        });
-    }
-    #[cfg(feature = "mpi")]
-    if processes() > 1 {
-        return Ok(match precision {
-            "f32" => Box::new(crate::cpu::ranks::Distributed::<f32>::new(scene)?),
-            "f64" => Box::new(crate::cpu::ranks::Distributed::<f64>::new(scene)?),
-            other => anyhow::bail!("precision `{other}`: the CPU engine computes in f32 or f64; fix: give --precision f32 or f64"),
         });
     }
     Ok(match precision {
@@ -49,7 +57,7 @@ pub fn cpu_engine(scene: &Scene, precision: &str) -> anyhow::Result<Box<dyn Engi
 
 /// A GPU engine on an opened device (f32): the DEM kernels, or for a contact-dynamics scene
 /// the host's contact detection with the sweeps on the device.
-pub fn gpu_engine(gpu: crate::gpu::Gpu, scene: &Scene) -> anyhow::Result<Box<dyn Engine>> {
+pub fn gpu_engine(gpu: crate::gpu::Gpu, scene: &Scene) -> anyhow::Result<Box<dyn Engine + Send>> {
     if let Method::ContactDynamics(params) = scene.method {
         let sweeps = crate::gpu::GpuSweeps::new(gpu, scene.grains.len(), scene.walls.len());
         return Ok(Box::new(ContactDynamics::<f32>::new(scene, params)?.with_sweeps(Box::new(sweeps))));
@@ -59,9 +67,17 @@ pub fn gpu_engine(gpu: crate::gpu::Gpu, scene: &Scene) -> anyhow::Result<Box<dyn
 
 /// The engine a checkpoint was written by: its backend ("cpu" or "gpu", on the adapter whose
 /// name contains `adapter`, or the best one) and precision.
-fn engine_of(scene: &Scene, id: &RunIdentity, adapter: Option<&str>) -> anyhow::Result<Box<dyn Engine>> {
+pub fn engine_of(scene: &Scene, id: &RunIdentity, adapter: Option<&str>) -> anyhow::Result<Box<dyn Engine>> {
     match id.backend.as_str() {
         "cpu" => cpu_engine(scene, &id.precision),
+        _ => Ok(local_engine_of(scene, id, adapter)?),
+    }
+}
+
+/// [`engine_of`] on this process alone (`Send`: see [`local_cpu_engine`]).
+pub fn local_engine_of(scene: &Scene, id: &RunIdentity, adapter: Option<&str>) -> anyhow::Result<Box<dyn Engine + Send>> {
+    match id.backend.as_str() {
+        "cpu" => local_cpu_engine(scene, &id.precision),
         "gpu" => gpu_engine(crate::gpu::open(adapter)?, scene),
         other => anyhow::bail!("the checkpoint was written by a `{other}` backend, which this grains lacks; fix: resume with the grains that wrote it"),
     }
@@ -122,14 +138,13 @@ impl Run {
 
     /// Runs the next stage; its result, or `None` when every stage has run.
     pub fn next_stage(&mut self, scene: &Scene, engine: &mut dyn Engine) -> anyhow::Result<Option<&StageResult>> {
-        self.next_stage_unless(scene, engine, &mut || Ok(()))
+        self.next_stage_watched(scene, engine, &mut Unwatched)
     }
 
-    /// [`Self::next_stage`], asking `stop` at every statistics read whether to go on: its error
-    /// ends the stage there (a user's interrupt), with what was recorded kept.
-    pub fn next_stage_unless(&mut self, scene: &Scene, engine: &mut dyn Engine, stop: &mut dyn FnMut() -> anyhow::Result<()>) -> anyhow::Result<Option<&StageResult>> {
+    /// [`Self::next_stage`], telling `watch` of each statistics read ([`Watch`]).
+    pub fn next_stage_watched(&mut self, scene: &Scene, engine: &mut dyn Engine, watch: &mut dyn Watch) -> anyhow::Result<Option<&StageResult>> {
         let started = Instant::now();
-        let mut rec = Watched { rec: &mut self.rec, stop };
+        let mut rec = Watched { rec: &mut self.rec, watch };
         let result = crate::protocol::run_next_stage(scene, engine, &mut rec, &mut self.progress);
         self.wall_seconds += started.elapsed().as_secs_f64();
         result
@@ -184,16 +199,36 @@ impl Run {
     }
 }
 
-/// A recorder that asks `stop` before each statistics row it records ([`Run::next_stage_unless`]).
+/// What a caller driving a [`Run`] hears at every statistics read of a stage
+/// ([`Run::next_stage_watched`]).
+pub trait Watch {
+    /// Whether to go on: an error ends the stage there (a user's interrupt), with what was
+    /// recorded kept.
+    fn go_on(&mut self) -> anyhow::Result<()>;
+    /// `done` steps of stage `stage` taken, of at most `total`.
+    fn progress(&mut self, stage: &str, done: u64, total: u64);
+}
+
+/// Nobody watching.
+struct Unwatched;
+
+impl Watch for Unwatched {
+    fn go_on(&mut self) -> anyhow::Result<()> {
+        Ok(())
+    }
+    fn progress(&mut self, _: &str, _: u64, _: u64) {}
+}
+
+/// A run's recorder, with a [`Watch`] told of each statistics read.
 struct Watched<'a> {
     rec: &'a mut RunRecorder,
-    stop: &'a mut dyn FnMut() -> anyhow::Result<()>,
+    watch: &'a mut dyn Watch,
 }
 
 impl Recorder for Watched<'_> {
     fn stats(&mut self, stage: &str, s: &crate::engine::Stats) -> anyhow::Result<()> {
         self.rec.stats(stage, s)?;
-        (self.stop)()
+        self.watch.go_on()
     }
     fn frame(&mut self, f: &crate::engine::Frame) -> anyhow::Result<()> {
         self.rec.frame(f)
@@ -205,7 +240,8 @@ impl Recorder for Watched<'_> {
         self.rec.checkpoint(progress, engine)
     }
     fn progress(&mut self, stage: &str, done: u64, total: u64) {
-        self.rec.progress(stage, done, total)
+        self.rec.progress(stage, done, total);
+        self.watch.progress(stage, done, total);
     }
 }
 
@@ -239,18 +275,20 @@ pub fn run_cpu(scene_file: &Path, precision: &str, out: Option<&Path>, progress_
 /// that wrote it (a GPU checkpoint on the adapter `adapter` names, or the best one). The scene
 /// is the one the checkpoint names unless `scene_file` is given; it must be unchanged.
 pub fn resume(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, adapter: Option<&str>, progress_bar: bool) -> anyhow::Result<Summary> {
-    let mut r = open_checkpoint(dir, scene_file, precision, adapter)?;
+    let mut r = open_checkpoint(dir, scene_file, precision, |scene, id| engine_of(scene, id, adapter))?;
     execute(&r.scene, r.engine.as_mut(), Some(dir), r.header.progress.clone(), r.identity, Some(&r.header), progress_bar)
 }
 
-/// A run's checkpoint opened to continue it ([`open_checkpoint`]).
-pub struct Resumed {
+/// A run's checkpoint opened to continue it ([`open_checkpoint`]), with its engine `E`.
+pub struct Resumed<E> {
     /// The scene, as the run recorded it (VTK files kept on where the run wrote them).
     pub scene: Scene,
-    /// The scene's file.
+    /// The scene's file and its text.
     pub scene_file: PathBuf,
-    /// The engine, restored to the checkpoint's state.
-    pub engine: Box<dyn Engine>,
+    /// The scene file's text.
+    pub scene_text: String,
+    /// The engine `make` gave, restored to the checkpoint's state.
+    pub engine: E,
     /// The checkpoint's header: where the run stands and the files it continues.
     pub header: CheckpointHeader,
     /// What the continued run's checkpoints belong to.
@@ -258,25 +296,31 @@ pub struct Resumed {
 }
 
 /// Opens the checkpoint in `dir` (see [`resume`]): checks that the scene is unchanged and the
-/// precision the one that wrote it, and restores the engine.
-pub fn open_checkpoint(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, adapter: Option<&str>) -> anyhow::Result<Resumed> {
+/// precision the one that wrote it, and restores the engine `make` builds for the scene and
+/// the checkpoint's identity ([`engine_of`], [`local_engine_of`]).
+pub fn open_checkpoint<E>(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, make: impl FnOnce(&Scene, &RunIdentity) -> anyhow::Result<E>) -> anyhow::Result<Resumed<E>>
+where
+    E: std::ops::DerefMut,
+    E::Target: Engine,
+{
     let (header, state): (CheckpointHeader, EngineState) = crate::checkpoint::read(&dir.join(crate::checkpoint::FILE))?;
     let id = &header.identity;
     let path = scene_file.map(Path::to_path_buf).unwrap_or_else(|| id.scene_file.clone().into());
     let mut scene = scene::load(&path)?;
     // A run that wrote VTK files (`grains run --vtk`) goes on writing them.
     scene.output.vtk |= dir.join(crate::output::vtk::DIR).join("grains.pvd").exists();
-    let text = std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?;
-    if crate::checkpoint::fnv1a(&text) != id.scene_hash {
+    let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    if crate::checkpoint::fnv1a(text.as_bytes()) != id.scene_hash {
         anyhow::bail!("{}: the scene differs from the one the checkpoint in {} was written for; fix: restore the scene or start the run afresh", path.display(), dir.display());
     }
     if precision.is_some_and(|p| p != id.precision) {
         anyhow::bail!("the checkpoint was written in {}; fix: drop --precision or give --precision {}", id.precision, id.precision);
     }
-    let mut engine = engine_of(&scene, id, adapter)?;
+    let mut engine = make(&scene, id)?;
     engine.restore(&state).with_context(|| format!("cannot resume from {}", dir.display()))?;
-    let identity = identity(&path, engine.as_ref())?;
-    Ok(Resumed { scene, scene_file: path, engine, header, identity })
+    // The engine is the identity's backend and precision; the scene file is the one read.
+    let identity = RunIdentity { scene_file: path.display().to_string(), ..id.clone() };
+    Ok(Resumed { scene, scene_file: path, scene_text: text, engine, header, identity })
 }
 
 /// A finished run directory's summary (`summary.json`), scene (the file the summary names) and

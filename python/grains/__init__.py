@@ -21,7 +21,7 @@ import math
 import os
 import sys
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 
@@ -50,8 +50,11 @@ class Simulation:
     on the CPU, f32 on the GPU); ``threads`` the CPU's worker threads (None: one per core; the
     results are the same bits on any count); ``out`` a directory that receives what
     ``grains run --out`` writes (``stats.csv``, ``stages.csv``, ``frames.mcap``, checkpoints,
-    ``summary.json``); ``progress`` draws the progress bar on a terminal (default: when stderr
-    is one); ``force`` skips the practicality checks, as ``grains run --force`` does.
+    ``summary.json``); ``progress``: True draws the command line's progress bar on a terminal
+    and a line of text elsewhere (a notebook), False nothing, a callable is called as
+    ``progress(stage, done, total)`` at every statistics read inside a stage (default: the bar
+    when stderr is a terminal); ``force`` skips the practicality checks, as
+    ``grains run --force`` does.
     """
 
     def __init__(
@@ -61,7 +64,7 @@ class Simulation:
         precision: Optional[str] = None,
         threads: Optional[int] = None,
         out: Optional[PathLike] = None,
-        progress: Optional[bool] = None,
+        progress: Union[None, bool, Callable[[str, int, int], Any]] = None,
         adapter: Optional[str] = None,
         force: bool = False,
         *,
@@ -72,15 +75,17 @@ class Simulation:
             return
         if not isinstance(scene, Scene):
             scene = Scene.load(os.fspath(scene))
+        bar, on_progress = _progress(progress)
         self._sim = _grains.Simulation(
             scene,
             backend,
             precision,
             threads,
             None if out is None else os.fspath(out),
-            _progress(progress),
+            bar,
             adapter,
             force,
+            on_progress,
         )
 
     @classmethod
@@ -88,11 +93,12 @@ class Simulation:
         cls,
         dir: PathLike,
         threads: Optional[int] = None,
-        progress: Optional[bool] = None,
+        progress: Union[None, bool, Callable[[str, int, int], Any]] = None,
         adapter: Optional[str] = None,
     ) -> "Simulation":
         """Continues the run in ``dir`` from its checkpoint (``grains run --resume DIR``)."""
-        return cls(None, _native=_grains.Simulation.resume(os.fspath(dir), threads, _progress(progress), adapter))  # type: ignore[arg-type]
+        bar, on_progress = _progress(progress)
+        return cls(None, _native=_grains.Simulation.resume(os.fspath(dir), threads, bar, adapter, on_progress))  # type: ignore[arg-type]
 
     def run(self) -> Dict[str, Any]:
         """Runs every stage left; returns the summary (``summary.json``'s content)."""
@@ -204,8 +210,20 @@ class Simulation:
         return None if s is None else json.loads(s)
 
 
-def _progress(progress: Optional[bool]) -> bool:
-    return sys.stderr.isatty() if progress is None else bool(progress)
+def _progress(progress: Union[None, bool, Callable[[str, int, int], Any]]) -> Tuple[bool, Optional[Callable[[str, int, int], Any]]]:
+    """The command line's bar (on a terminal) and the callback a `progress` argument asks for."""
+    if callable(progress):
+        return False, progress
+    terminal = sys.stderr.isatty()
+    if progress is None or not progress:
+        return bool(progress is None and terminal), None
+    return (True, None) if terminal else (False, _text_progress)
+
+
+def _text_progress(stage: str, done: int, total: int) -> None:
+    """A progress line rewritten in place where there is no terminal (a notebook's output)."""
+    end = "\n" if done >= total else ""
+    print(f"\r{stage:>14}: {done}/{total} steps ({100 * done / max(total, 1):.0f}%)", end=end, flush=True)
 
 
 def _read_csv(path: Path) -> Dict[str, np.ndarray]:

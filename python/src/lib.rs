@@ -8,7 +8,7 @@ use grains::checkpoint::{CheckpointHeader, RunIdentity};
 use grains::engine::{Engine, Frame};
 use grains::periodic::Periodic;
 use grains::protocol::Progress;
-use grains::runner::Run;
+use grains::runner::{Run, Watch};
 use grains::scene::dotted;
 use numpy::{PyArray1, PyArrayMethods};
 use pyo3::create_exception;
@@ -218,7 +218,7 @@ struct Simulation {
 
 struct Sim {
     scene: grains::scene::Scene,
-    engine: Box<dyn Engine>,
+    engine: Box<dyn Engine + Send>,
     /// The worker threads every engine call runs on, as `grains run --threads` does.
     pool: rayon::ThreadPool,
     /// The run with its outputs, until its last stage has finished (then `None`).
@@ -234,6 +234,8 @@ struct Sim {
     summary: Option<String>,
     /// Why the run stopped early (an interrupt or an error), when it did.
     stopped: Option<String>,
+    /// Told of each statistics read inside a stage, as `on_progress(stage, done, total)`.
+    on_progress: Option<Py<PyAny>>,
 }
 
 /// A pool of `threads` workers (0: one per core).
@@ -264,11 +266,12 @@ fn identity(scene_file: &Path, text: &str, engine: &dyn Engine) -> RunIdentity {
 impl Simulation {
     /// An engine on `scene` (`backend` "cpu" or "gpu"; `precision` "f32" or "f64", the CPU's
     /// default f64 and the GPU's f32) on `threads` worker threads (None: one per core),
-    /// recording into `out` as `grains run --out` does. `force` skips the practicality
-    /// checks `grains run --force` skips.
+    /// recording into `out` as `grains run --out` does. `progress` draws the command line's
+    /// bar on a terminal; `on_progress(stage, done, total)` is called at every statistics
+    /// read inside a stage. `force` skips the practicality checks `grains run --force` skips.
     #[new]
-    #[pyo3(signature = (scene, backend = "cpu", precision = None, threads = None, out = None, progress = false, adapter = None, force = false))]
-    fn new(py: Python<'_>, scene: &Scene, backend: &str, precision: Option<&str>, threads: Option<usize>, out: Option<PathBuf>, progress: bool, adapter: Option<String>, force: bool) -> PyResult<Simulation> {
+    #[pyo3(signature = (scene, backend = "cpu", precision = None, threads = None, out = None, progress = false, adapter = None, force = false, on_progress = None))]
+    fn new(py: Python<'_>, scene: &Scene, backend: &str, precision: Option<&str>, threads: Option<usize>, out: Option<PathBuf>, progress: bool, adapter: Option<String>, force: bool, on_progress: Option<Py<PyAny>>) -> PyResult<Simulation> {
         let validated = scene.validated()?;
         if !force {
             validated.check_practical().map_err(scene_err)?;
@@ -280,7 +283,7 @@ impl Simulation {
         let sim = py.detach(|| {
             pool.install(|| -> anyhow::Result<_> {
                 let mut engine = match (backend.as_str(), precision.as_deref()) {
-                    ("cpu", p) => grains::runner::cpu_engine(&validated, p.unwrap_or("f64"))?,
+                    ("cpu", p) => grains::runner::local_cpu_engine(&validated, p.unwrap_or("f64"))?,
                     ("gpu", None | Some("f32")) => grains::runner::gpu_engine(grains::gpu::open(adapter.as_deref())?, &validated)?,
                     ("gpu", Some(p)) => anyhow::bail!("precision {p:?}: the GPU computes in f32; fix: give precision=\"f32\" or leave it out"),
                     (b, _) => anyhow::bail!("backend {b:?}: unknown; fix: give \"cpu\" or \"gpu\""),
@@ -292,25 +295,24 @@ impl Simulation {
             })
         });
         let (scene, engine, run, guard) = sim.map_err(sim_err)?;
-        Ok(Simulation { inner: Mutex::new(Sim { scene, engine, pool, run: Some(run), guard, scene_file, scene_text, out, summary: None, stopped: None }) })
+        Ok(Simulation { inner: Mutex::new(Sim { scene, engine, pool, run: Some(run), guard, scene_file, scene_text, out, summary: None, stopped: None, on_progress }) })
     }
 
     /// Continues the run in `dir` from its checkpoint, on the backend and precision that wrote
     /// it, recording into `dir` as `grains run --resume` does.
     #[staticmethod]
-    #[pyo3(signature = (dir, threads = None, progress = false, adapter = None))]
-    fn resume(py: Python<'_>, dir: PathBuf, threads: Option<usize>, progress: bool, adapter: Option<String>) -> PyResult<Simulation> {
+    #[pyo3(signature = (dir, threads = None, progress = false, adapter = None, on_progress = None))]
+    fn resume(py: Python<'_>, dir: PathBuf, threads: Option<usize>, progress: bool, adapter: Option<String>, on_progress: Option<Py<PyAny>>) -> PyResult<Simulation> {
         let pool = pool(threads.unwrap_or(0))?;
         let sim = py.detach(|| {
             pool.install(|| -> anyhow::Result<_> {
-                let r = grains::runner::open_checkpoint(&dir, None, None, adapter.as_deref())?;
-                let text = std::fs::read_to_string(&r.scene_file)?;
+                let r = grains::runner::open_checkpoint(&dir, None, None, |scene, id| grains::runner::local_engine_of(scene, id, adapter.as_deref()))?;
                 let run = Run::start(&r.scene, r.engine.as_ref(), Some(&dir), r.header.progress.clone(), r.identity, Some(&r.header), progress)?;
-                Ok((r.scene, r.engine, run, r.header.progress, r.scene_file, text))
+                Ok((r.scene, r.engine, run, r.header.progress, r.scene_file, r.scene_text))
             })
         });
         let (scene, engine, run, guard, scene_file, scene_text) = sim.map_err(sim_err)?;
-        Ok(Simulation { inner: Mutex::new(Sim { scene, engine, pool, run: Some(run), guard, scene_file, scene_text, out: Some(dir), summary: None, stopped: None }) })
+        Ok(Simulation { inner: Mutex::new(Sim { scene, engine, pool, run: Some(run), guard, scene_file, scene_text, out: Some(dir), summary: None, stopped: None, on_progress }) })
     }
 
     /// Runs the next stage (recording into `out`); its result as JSON, or None when every
@@ -528,8 +530,13 @@ impl Simulation {
 }
 
 impl Simulation {
+    /// The simulation, or an error while a call is running it: waiting would hold the
+    /// interpreter's lock that the running call needs for its progress callback and Ctrl-C.
     fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, Sim>> {
-        self.inner.lock().map_err(|_| SimulationError::new_err("an earlier call panicked inside the engine; fix: start a new Simulation"))
+        self.inner.try_lock().map_err(|e| match e {
+            std::sync::TryLockError::WouldBlock => SimulationError::new_err("the simulation is running a call already (this one came from its progress callback or another thread); fix: call it once that call has returned"),
+            std::sync::TryLockError::Poisoned(_) => SimulationError::new_err("an earlier call panicked inside the engine; fix: start a new Simulation"),
+        })
     }
 }
 
@@ -547,23 +554,10 @@ impl Sim {
             return Err(SimulationError::new_err(format!("the run stopped: {why}; fix: continue it with Simulation.resume(out) from its last checkpoint, or start a new Simulation")));
         }
         let Some(run) = self.run.as_mut() else { return Ok(None) };
-        let Sim { engine, pool, scene, .. } = self;
-        let mut interrupted = None;
-        let result = py.detach(|| {
-            pool.install(|| {
-                run.next_stage_unless(scene, engine.as_mut(), &mut || {
-                    // Ctrl-C: Python's handler runs on the main thread with the lock held.
-                    match Python::attach(|py| py.check_signals()) {
-                        Ok(()) => Ok(()),
-                        Err(e) => {
-                            interrupted = Some(e);
-                            anyhow::bail!("interrupted")
-                        }
-                    }
-                })
-                .map(|r| r.map(serde_json::to_string))
-            })
-        });
+        let Sim { engine, pool, scene, on_progress, .. } = self;
+        let mut watch = PyWatch { on_progress: on_progress.as_ref(), failed: None };
+        let result = py.detach(|| pool.install(|| run.next_stage_watched(scene, engine.as_mut(), &mut watch).map(|r| r.map(serde_json::to_string))));
+        let interrupted = watch.failed;
         match result {
             Ok(Some(json)) => json.map(Some).map_err(sim_err),
             Ok(None) => {
@@ -579,6 +573,32 @@ impl Sim {
                 run.close().map_err(sim_err)?;
                 Err(interrupted.unwrap_or_else(|| sim_err(e)))
             }
+        }
+    }
+}
+
+/// Ctrl-C and the caller's progress callback, at every statistics read of a stage.
+struct PyWatch<'a> {
+    /// Called as `on_progress(stage, done, total)`.
+    on_progress: Option<&'a Py<PyAny>>,
+    /// The interrupt, or what the callback raised: the stage stops at the next read.
+    failed: Option<PyErr>,
+}
+
+impl Watch for PyWatch<'_> {
+    fn go_on(&mut self) -> anyhow::Result<()> {
+        if self.failed.is_none() {
+            // Python's signal handlers run on the main thread with the lock held.
+            self.failed = Python::attach(|py| py.check_signals()).err();
+        }
+        match &self.failed {
+            Some(e) => anyhow::bail!("stopped from Python: {e}"),
+            None => Ok(()),
+        }
+    }
+    fn progress(&mut self, stage: &str, done: u64, total: u64) {
+        if let (Some(f), None) = (self.on_progress, &self.failed) {
+            self.failed = Python::attach(|py| f.call1(py, (stage, done, total)).map(drop)).err();
         }
     }
 }

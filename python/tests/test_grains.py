@@ -277,3 +277,41 @@ def test_a_finished_runs_force_transmission_is_grains_analyzes(tmp_path: Path) -
     assert ours == json.loads(done.stdout)
     # A settled bed's force network: most contacts carry less than the mean force.
     assert ours["force_scale_is"] == "mean force" and 0.5 < ours["below_mean"] < 0.75, ours["below_mean"]
+
+
+def test_a_progress_callback_hears_every_statistics_read_and_can_stop_the_run(tmp_path: Path) -> None:
+    """`progress=callable` is called at every statistics read inside a stage with the steps
+    done and the stage's most; one that raises stops the stage there with that exception,
+    keeping the files, and the run then says how to continue."""
+    path = small_scene(tmp_path)
+    heard = []
+    sim = grains.Simulation(grains.Scene.load(path), progress=lambda stage, done, total: heard.append((stage, done, total)))
+    sim.run()
+    stages = sim.summary["stages"]
+    assert [s["name"] for s in stages] == ["pour", "hold"]
+    for s in stages:
+        reads = [(d, t) for name, d, t in heard if name == s["name"]]
+        assert reads[-1][0] == s["steps"] and all(d % sim.stats_interval == 0 or d == s["steps"] for d, _ in reads)
+        assert len(reads) == math.ceil(s["steps"] / sim.stats_interval)
+
+    class Enough(Exception):
+        pass
+
+    interval = sim.stats_interval
+
+    def stop(stage: str, done: int, total: int) -> None:
+        # The running simulation refuses calls from its own callback rather than deadlock.
+        with pytest.raises(grains.SimulationError, match="running a call already"):
+            sim2.steps
+        if done >= 10 * interval:
+            raise Enough(stage)
+
+    out = tmp_path / "stopped"
+    sim2 = grains.Simulation(grains.Scene.load(path), out=out, progress=stop)
+    with pytest.raises(Enough):
+        sim2.run()
+    # It stops at the read after the one whose callback raised, with the rows up to it kept.
+    assert sim2.steps == 11 * sim2.stats_interval
+    assert (out / "stats.csv").read_text().count("\n") == 1 + 11
+    with pytest.raises(grains.SimulationError, match="resume"):
+        sim2.run_stage()
