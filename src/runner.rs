@@ -15,12 +15,17 @@ use std::time::Instant;
 /// What a checkpoint of this run belongs to.
 pub fn identity(scene_file: &Path, engine: &dyn Engine) -> anyhow::Result<RunIdentity> {
     let text = std::fs::read(scene_file).with_context(|| format!("cannot read {}", scene_file.display()))?;
-    Ok(RunIdentity {
+    Ok(identity_of(scene_file, &text, engine))
+}
+
+/// [`identity`] of a run whose scene file holds `text`.
+pub fn identity_of(scene_file: &Path, text: &[u8], engine: &dyn Engine) -> RunIdentity {
+    RunIdentity {
         scene_file: scene_file.display().to_string(),
-        scene_hash: crate::checkpoint::fnv1a(&text),
+        scene_hash: crate::checkpoint::fnv1a(text),
         backend: engine.backend().to_string(),
         precision: engine.precision().to_string(),
-    })
+    }
 }
 
 /// A CPU engine of precision "f32" or "f64": under mpirun (feature `mpi`) a DEM engine over
@@ -67,7 +72,7 @@ pub fn gpu_engine(gpu: crate::gpu::Gpu, scene: &Scene) -> anyhow::Result<Box<dyn
 
 /// The engine a checkpoint was written by: its backend ("cpu" or "gpu", on the adapter whose
 /// name contains `adapter`, or the best one) and precision.
-pub fn engine_of(scene: &Scene, id: &RunIdentity, adapter: Option<&str>) -> anyhow::Result<Box<dyn Engine>> {
+fn engine_of(scene: &Scene, id: &RunIdentity, adapter: Option<&str>) -> anyhow::Result<Box<dyn Engine>> {
     match id.backend.as_str() {
         "cpu" => cpu_engine(scene, &id.precision),
         _ => Ok(local_engine_of(scene, id, adapter)?),

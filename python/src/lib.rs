@@ -4,7 +4,7 @@
 //! back as NumPy arrays in SI units. What crosses as JSON (summaries, statistics, stage results,
 //! analyses) is turned into dictionaries by the pure-Python package `grains`.
 
-use grains::checkpoint::{CheckpointHeader, RunIdentity};
+use grains::checkpoint::CheckpointHeader;
 use grains::engine::{Engine, Frame};
 use grains::periodic::Periodic;
 use grains::protocol::Progress;
@@ -17,6 +17,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 create_exception!(_grains, GrainsError, PyException, "Any error grains reports.");
 create_exception!(_grains, SceneError, GrainsError, "A scene that does not parse or validate: the message names the file, the key, the value and the fix, as the command line's does.");
@@ -258,10 +259,6 @@ fn scene_file_for(scene: &Scene, dir: Option<&Path>) -> PyResult<PathBuf> {
     }
 }
 
-fn identity(scene_file: &Path, text: &str, engine: &dyn Engine) -> RunIdentity {
-    RunIdentity { scene_file: scene_file.display().to_string(), scene_hash: grains::checkpoint::fnv1a(text.as_bytes()), backend: engine.backend().into(), precision: engine.precision().into() }
-}
-
 #[pymethods]
 impl Simulation {
     /// An engine on `scene` (`backend` "cpu" or "gpu"; `precision` "f32" or "f64", the CPU's
@@ -289,7 +286,7 @@ impl Simulation {
                     (b, _) => anyhow::bail!("backend {b:?}: unknown; fix: give \"cpu\" or \"gpu\""),
                 };
                 let start = Progress::start(&validated, engine.as_mut())?;
-                let id = identity(&scene_file, &scene_text, engine.as_ref());
+                let id = grains::runner::identity_of(&scene_file, scene_text.as_bytes(), engine.as_ref());
                 let run = Run::start(&validated, engine.as_ref(), out.as_deref(), start.clone(), id, None, progress)?;
                 Ok((validated, engine, run, start))
             })
@@ -516,7 +513,7 @@ impl Simulation {
                 std::fs::write(&f, &scene_text)?;
                 f
             };
-            let header = CheckpointHeader { identity: identity(&file, scene_text, engine), progress, files: Vec::new() };
+            let header = CheckpointHeader { identity: grains::runner::identity_of(&file, scene_text.as_bytes(), engine), progress, files: Vec::new() };
             grains::checkpoint::write(&dir.join(grains::checkpoint::FILE), &header, &engine.save()?)
         }))
         .map_err(sim_err)?;
@@ -555,9 +552,32 @@ impl Sim {
         }
         let Some(run) = self.run.as_mut() else { return Ok(None) };
         let Sim { engine, pool, scene, on_progress, .. } = self;
-        let mut watch = PyWatch { on_progress: on_progress.as_ref(), failed: None };
-        let result = py.detach(|| pool.install(|| run.next_stage_watched(scene, engine.as_mut(), &mut watch).map(|r| r.map(serde_json::to_string))));
-        let interrupted = watch.failed;
+        let interrupt = AtomicBool::new(false);
+        let mut watch = PyWatch { on_progress: on_progress.as_ref(), interrupt: &interrupt, failed: None };
+        // The stage runs on the pool while this (the main) thread waits, looking for Ctrl-C:
+        // Python runs its signal handlers on the main thread alone.
+        let mut signal = None;
+        let result = py.detach(|| {
+            let (tx, rx) = std::sync::mpsc::channel();
+            pool.in_place_scope(|s| {
+                s.spawn(|_| {
+                    let r = run.next_stage_watched(scene, engine.as_mut(), &mut watch).map(|r| r.map(serde_json::to_string));
+                    // The receiver waits below until this arrives.
+                    let _ = tx.send(r);
+                });
+                loop {
+                    match rx.recv_timeout(SIGNAL_CHECK) {
+                        Ok(r) => return r,
+                        Err(_) if signal.is_none() => {
+                            signal = Python::attach(|py| py.check_signals()).err();
+                            interrupt.store(signal.is_some(), Ordering::Relaxed);
+                        }
+                        Err(_) => {}
+                    }
+                }
+            })
+        });
+        let interrupted = signal.or(watch.failed);
         match result {
             Ok(Some(json)) => json.map(Some).map_err(sim_err),
             Ok(None) => {
@@ -577,22 +597,26 @@ impl Sim {
     }
 }
 
+/// How often the main thread looks for Ctrl-C while a stage runs on the pool.
+const SIGNAL_CHECK: std::time::Duration = std::time::Duration::from_millis(50);
+
 /// Ctrl-C and the caller's progress callback, at every statistics read of a stage.
 struct PyWatch<'a> {
     /// Called as `on_progress(stage, done, total)`.
     on_progress: Option<&'a Py<PyAny>>,
-    /// The interrupt, or what the callback raised: the stage stops at the next read.
+    /// Set by the main thread on Ctrl-C.
+    interrupt: &'a AtomicBool,
+    /// What the callback raised.
     failed: Option<PyErr>,
 }
 
 impl Watch for PyWatch<'_> {
     fn go_on(&mut self) -> anyhow::Result<()> {
-        if self.failed.is_none() {
-            // Python's signal handlers run on the main thread with the lock held.
-            self.failed = Python::attach(|py| py.check_signals()).err();
+        if self.interrupt.load(Ordering::Relaxed) {
+            anyhow::bail!("interrupted (Ctrl-C)");
         }
         match &self.failed {
-            Some(e) => anyhow::bail!("stopped from Python: {e}"),
+            Some(e) => anyhow::bail!("stopped by the progress callback: {e}"),
             None => Ok(()),
         }
     }

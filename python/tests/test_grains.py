@@ -315,3 +315,32 @@ def test_a_progress_callback_hears_every_statistics_read_and_can_stop_the_run(tm
     assert (out / "stats.csv").read_text().count("\n") == 1 + 11
     with pytest.raises(grains.SimulationError, match="resume"):
         sim2.run_stage()
+
+
+def test_ctrl_c_stops_a_run_which_resumes_from_its_last_checkpoint(tmp_path: Path) -> None:
+    """SIGINT inside the second stage of `run()` raises KeyboardInterrupt with the files kept;
+    the run then refuses to go on in place, and `Simulation.resume(out)` continues it from the
+    first stage's checkpoint to the uninterrupted run's bytes."""
+    path = small_scene(tmp_path, hold=0.15)
+    whole = run_cli("run", str(path), "--out", str(tmp_path / "whole"), "--json", cwd=tmp_path)
+    assert whole.returncode == 0, whole.stderr
+    sent = []
+
+    def interrupt_in_hold(stage: str, done: int, total: int) -> None:
+        if stage == "hold" and not sent:
+            sent.append(done)
+            os.kill(os.getpid(), signal.SIGINT)
+
+    out = tmp_path / "run"
+    sim = grains.Simulation(grains.Scene.load(path), out=out, progress=interrupt_in_hold)
+    with pytest.raises(KeyboardInterrupt):
+        sim.run()
+    assert sent and not (out / "summary.json").exists()
+    rows = (out / "stats.csv").read_text().count("\n")
+    assert rows > 1
+    with pytest.raises(grains.SimulationError, match="resume"):
+        sim.run()
+    resumed = grains.Simulation.resume(out, progress=False)
+    assert resumed.stages == (["pour", "hold"], 1)
+    resumed.run()
+    same_files(tmp_path / "whole", out, names=("stats.csv", "stages.csv"))
