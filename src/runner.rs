@@ -288,7 +288,7 @@ pub fn resume(dir: &Path, scene_file: Option<&Path>, precision: Option<&str>, ad
 pub struct Resumed<E> {
     /// The scene, as the run recorded it (VTK files kept on where the run wrote them).
     pub scene: Scene,
-    /// The scene's file and its text.
+    /// The scene's file.
     pub scene_file: PathBuf,
     /// The scene file's text.
     pub scene_text: String,

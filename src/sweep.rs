@@ -95,7 +95,7 @@ impl Sweep {
     pub fn scene_for(&self, p: &Point) -> anyhow::Result<String> {
         let mut doc: toml::Table = toml::from_str(&self.scene_text).with_context(|| format!("{}: not valid TOML", self.scene.display()))?;
         for (path, v) in &p.values {
-            crate::scene::dotted::set(&mut doc, path, v.clone()).map_err(|e| anyhow::anyhow!("{}: parameters.\"{path}\": {e}; fix: name a key of the scene (tables by key, [[arrays]] by name or index)", self.file.display()))?;
+            crate::scene::dotted::set(&mut doc, path, v.clone()).map_err(|e| anyhow::anyhow!("{}: parameters.\"{path}\": {e}; {}", self.file.display(), crate::scene::dotted::FIX))?;
         }
         let text = toml::to_string(&doc)?;
         crate::scene::parse(&self.scene, &text).map_err(|e| anyhow::anyhow!("{} point {}: {e}", self.file.display(), p.index))?;

@@ -67,7 +67,7 @@ impl Scene {
     /// Reads and validates a scene file.
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Scene> {
-        let text = std::fs::read_to_string(&path).map_err(|e| scene_err(format!("{}: cannot read the scene: {e}; fix: check the path", path.display())))?;
+        let text = std::fs::read_to_string(&path).map_err(|reason| scene_err(grains::scene::SceneError::Read { file: path.clone(), reason }))?;
         Scene::of_text(path, text, true)
     }
 
@@ -82,7 +82,7 @@ impl Scene {
     /// The value at a dotted path (`material.sand.mu_s`, `stage.0.duration`); `None` where
     /// the scene leaves it to its default.
     fn __getitem__(&self, py: Python<'_>, key: &str) -> PyResult<Py<PyAny>> {
-        match dotted::get(&self.doc, key).map_err(|e| PyKeyError_new(key, &e))? {
+        match dotted::get(&self.doc, key).map_err(|e| key_error(key, &e))? {
             Some(v) => toml_to_py(py, &v),
             None => Ok(py.None()),
         }
@@ -144,7 +144,7 @@ impl Scene {
     fn update_with(&mut self, values: &[(String, toml::Value)]) -> PyResult<()> {
         let mut doc = self.doc.clone();
         for (key, value) in values {
-            dotted::set(&mut doc, key, value.clone()).map_err(|e| PyKeyError_new(key, &e))?;
+            dotted::set(&mut doc, key, value.clone()).map_err(|e| key_error(key, &e))?;
         }
         let text = toml::to_string(&doc).expect("a TOML table serialises");
         grains::scene::parse(&self.path, &text).map_err(scene_err)?;
@@ -154,9 +154,9 @@ impl Scene {
     }
 }
 
-#[allow(non_snake_case)]
-fn PyKeyError_new(key: &str, e: &str) -> PyErr {
-    pyo3::exceptions::PyKeyError::new_err(format!("{key}: {e}; fix: name a key of the scene (tables by key, [[arrays]] by name or index)"))
+/// The `KeyError` for a dotted path `key` that names nothing (`e` says which part).
+fn key_error(key: &str, e: &str) -> PyErr {
+    pyo3::exceptions::PyKeyError::new_err(format!("{key}: {e}; {}", dotted::FIX))
 }
 
 fn toml_to_py(py: Python<'_>, v: &toml::Value) -> PyResult<Py<PyAny>> {

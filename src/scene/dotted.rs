@@ -3,6 +3,9 @@
 //! `grain`) by the `name` of an entry or by index, e.g. `material.sand.mu_s` or
 //! `stage.0.duration`.
 
+/// What to do about a path that names nothing, for the error that reports it.
+pub const FIX: &str = "fix: name a key of the scene (tables by key, [[arrays]] by name or index)";
+
 /// The table that holds the last key of `path` (split at dots), and that key.
 fn parent<'d>(doc: &'d mut toml::Table, path: &str) -> Result<(&'d mut toml::Table, String), String> {
     let parts: Vec<&str> = path.split('.').collect();
