@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
-use grains::model::{contact_force, Bodies, ContactForce, Geometry, History, KickWindow, Kinematics, PairCoeffs};
+use grains::model::{contact_force, Bodies, ContactForce, Geometry, History, KickWindow, Kinematics};
 use grains::real::{Real, Vec3};
 use grains::scene::{self, Scene};
 use std::hint::black_box;
@@ -19,7 +19,7 @@ fn scene(name: &str) -> Scene {
 fn pair_maths<T: Real>(c: &mut Criterion, label: &str) {
     let s = scene("pour");
     let model = s.model.cast::<T>();
-    let coeffs = PairCoeffs::<T>::mix(&s.materials[0].constants, &s.materials[0].constants, &s.model);
+    let coeffs = s.pair_coeffs::<T>()[0];
     let (r, m) = (T::of(5e-4), T::of(1.4e-6));
     let geo = Geometry::grain_grain(Vec3::new(T::of(9.99e-4), T::ZERO, T::ZERO), T::of(9.99e-4), r, r, m, m);
     let kin = Kinematics { v_i: Vec3::new(T::of(-1e-3), T::of(2e-3), T::ZERO), v_j: Vec3::ZERO, w_i: Vec3::new(T::ZERO, T::ZERO, T::of(3.0)), w_j: Vec3::ZERO };

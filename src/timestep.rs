@@ -13,7 +13,7 @@
 //! `t_c /` [`WARN_COLLISION_STEPS`] gets a warning; above [`MAX_RAYLEIGH_FRACTION`] `t_R` or
 //! `t_c /` [`MAX_COLLISION_STEPS`] the scene is refused.
 
-use crate::model::{ContactModel, NormalSetup, PairCoeffs};
+use crate::model::{ContactModel, MaterialConstants, NormalSetup};
 pub use crate::scene::types::{CharacteristicTimes, TimeStep};
 use crate::scene::types::{Grains, Material, Wall};
 
@@ -119,12 +119,12 @@ pub fn characteristic_times(materials: &[Material], grains: &Grains, walls: &[Wa
         }
     }
     let collision = |a: usize, b: Option<usize>, (ra, ma): (f64, f64), other: Option<(f64, f64)>| -> f64 {
-        let c: PairCoeffs<f64> = PairCoeffs::mix(&materials[a].constants, &materials[b.unwrap_or(a)].constants, model);
+        let v_eff = MaterialConstants::effective_stiffness(&materials[a].constants, &materials[b.unwrap_or(a)].constants);
         let (r_eff, m_eff) = match other {
             Some((rb, mb)) => (ra * rb / (ra + rb), ma * mb / (ma + mb)),
             None => (ra, ma),
         };
-        model.normal.collision_time(m_eff, r_eff, c.v_eff, v)
+        model.normal.collision_time(m_eff, r_eff, v_eff, v)
     };
     let mut t_c = f64::INFINITY;
     let mut t_r = f64::INFINITY;

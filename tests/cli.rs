@@ -141,6 +141,11 @@ fn oedometer() -> String {
     std::fs::read_to_string(common::scene_path("oedometer.toml")).unwrap()
 }
 
+/// A `[[pair]]` table of `materials` (TOML array items) with `keys`, followed by `[model]`.
+fn pair(materials: &str, keys: &str) -> String {
+    format!("[[pair]]\nmaterials = [{materials}]\n{keys}\n\n[model]")
+}
+
 fn two_spheres() -> String {
     std::fs::read_to_string(common::scene_path("two_spheres.toml")).unwrap()
 }
@@ -170,6 +175,16 @@ fn malformed_scenes_get_one_line_naming_the_key_and_the_fix() {
             "material[0].restitution = 0.0005: is below 0.001",
         ),
         ("clamp_without_damping.toml", base.replace("damping = \"none\"", "damping = \"none\"\nlimit_damping = false"), "model.limit_damping"),
+        ("pair_unknown_material.toml", base.replace("[model]", &pair("\"glass\", \"steel\"", "mu_s = 0.1")), "pair[0].materials = \"steel\": names no [[material]]"),
+        ("pair_twice.toml", base.replace("[model]", &pair("\"glass\", \"glass\"", "mu_s = 0.1")).replacen("[model]", &pair("\"glass\", \"glass\"", "mu_s = 0.2"), 1), "names the same pair as pair[0]"),
+        ("pair_empty.toml", base.replace("[model]", &pair("\"glass\", \"glass\"", "")), "pair[0] = [\"glass\", \"glass\"]: gives no coefficient"),
+        ("pair_restitution.toml", base.replace("[model]", &pair("\"glass\", \"glass\"", "restitution = 1.5")), "pair[0].restitution = 1.5"),
+        ("pair_friction.toml", base.replace("[model]", &pair("\"glass\", \"glass\"", "mu_s = -0.1")), "pair[0].mu_s = -0.1"),
+        (
+            "pair_mu_k_under_mindlin.toml",
+            base.replace("[model]", &pair("\"glass\", \"glass\"", "mu_s = 0.3\nmu_k = 0.2")).replace("damping = \"none\"", "damping = \"none\"\ntangential = \"mindlin\""),
+            "pair[0].mu_k = 0.2: the Hertz-Mindlin law has one friction coefficient",
+        ),
     ];
     for (name, text, key) in cases {
         let err = refused(name, &text);

@@ -111,7 +111,7 @@ duration = 1.0e-8
 
 /// The Hertz force of the pair at overlap `h` (N).
 fn hertz(scene: &grains::scene::Scene, r: f64, h: f64) -> f64 {
-    let c = grains::model::PairCoeffs::<f64>::mix(&scene.materials[0].constants, &scene.materials[0].constants, &scene.model);
+    let c = scene.pair_coeffs::<f64>()[0];
     4.0 / 3.0 * c.v_eff * (r / 2.0).sqrt() * h.powf(1.5)
 }
 

@@ -150,6 +150,7 @@ fn every_scene_key_the_parser_accepts_is_in_the_scene_reference() {
     let probes: &[(&str, &str)] = &[
         ("Top level", "zzz_probe = 1"),
         ("`[[material]]`", "[[material]]\nzzz_probe = 1"),
+        ("`[[pair]]`", "[[pair]]\nzzz_probe = 1"),
         ("`[[grain]]`", "[[grain]]\nzzz_probe = 1"),
         ("`[[read]]`", "[[read]]\nzzz_probe = 1"),
         ("`[[generate]]`", "[[generate]]\nzzz_probe = 1"),
@@ -168,7 +169,7 @@ fn every_scene_key_the_parser_accepts_is_in_the_scene_reference() {
         ("`[[stage]]`", "[[stage]]\nzzz_probe = 1"),
         ("`[output]`", "[output]\nzzz_probe = 1"),
     ];
-    let tables = ["material", "grain", "read", "generate", "wall", "periodic", "model", "simulation", "stage", "output", "contact_dynamics"];
+    let tables = ["material", "pair", "grain", "read", "generate", "wall", "periodic", "model", "simulation", "stage", "output", "contact_dynamics"];
     let mut missing = Vec::new();
     let mut count = 0;
     for (heading, probe) in probes {

@@ -78,7 +78,7 @@ struct Rolled {
 fn roll(g: f64, v0: f64, duration: f64) -> Rolled {
     let mut scene = common::parse(&sphere_on_steel(g, v0).replace("duration = 1.0e-3", &format!("duration = {duration:e}")));
     let (r, m) = (scene.grains.radius[0], scene.grains.mass[0]);
-    let c = grains::model::PairCoeffs::<f64>::mix(&scene.materials[0].constants, &scene.materials[1].constants, &scene.model);
+    let c = scene.pair_coeffs::<f64>()[1];
     let h = (m * g / (4.0 / 3.0 * r.sqrt() * c.v_eff)).powf(2.0 / 3.0);
     scene.grains.position[0][2] = r - h;
     let mut e: CpuEngine<f64> = common::engine(&scene);

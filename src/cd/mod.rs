@@ -275,12 +275,6 @@ pub enum CdError {
     },
 }
 
-/// Friction and restitution of a contact between two materials, mixed as
-/// [`crate::model::PairCoeffs::mix`] mixes them: the smaller `mu_s`, the mean restitution.
-fn mix(a: &crate::model::MaterialConstants, b: &crate::model::MaterialConstants) -> (f64, f64) {
-    (a.mu_s.min(b.mu_s), 0.5 * (a.restitution + b.restitution))
-}
-
 impl<T: Real> ContactDynamics<T> {
     /// The system of a scene's grains and walls at step `h` = the scene's time step.
     pub fn new(scene: &Scene, params: CdParams) -> Result<Self, CdError> {
@@ -299,13 +293,9 @@ impl<T: Real> ContactDynamics<T> {
             return unsupported("an adhesive normal law (DMT)", "use normal = \"hertz\" or the DEM method");
         }
         let n_materials = scene.materials.len();
-        let mut coeffs = Vec::with_capacity(n_materials * n_materials);
-        for a in &scene.materials {
-            for b in &scene.materials {
-                let (mu, e) = mix(&a.constants, &b.constants);
-                coeffs.push((T::of(mu), T::of(e)));
-            }
-        }
+        // Friction and restitution of each pair of materials: the mixing rule's, or the pair
+        // table's.
+        let coeffs = crate::scene::mixed_table(&scene.materials, &scene.pairs).iter().map(|m| (T::of(m.mu_s), T::of(m.restitution))).collect();
         let g = &scene.grains;
         let n = g.len();
         let (pos, residual): (Vec<Vec3<T>>, Vec<Vec3<T>>) = g.position.iter().map(|&x| position::split(x)).unzip();

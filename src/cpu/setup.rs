@@ -7,12 +7,7 @@ impl<T: Real> CpuEngine<T> {
     /// Sets up the engine for a scene and builds the first neighbour list.
     pub fn new(scene: &Scene) -> Result<Self, SimError> {
         let n_materials = scene.materials.len();
-        let mut coeffs = Vec::with_capacity(n_materials * n_materials);
-        for a in &scene.materials {
-            for b in &scene.materials {
-                coeffs.push(PairCoeffs::mix(&a.constants, &b.constants, &scene.model));
-            }
-        }
+        let coeffs = scene.pair_coeffs();
         let g = &scene.grains;
         let n = g.len();
         let (positions, residual): (Vec<Vec3<T>>, Vec<Vec3<T>>) = g.position.iter().map(|&x| position::split(x)).unzip();

@@ -252,7 +252,7 @@ impl GpuEngine {
             servo: scene.servo.map(|s| s.walls),
             periodic: crate::periodic::Periodic::of(&scene.periodic),
             model: scene.model.cast::<f32>(),
-            coeffs: scene.materials.iter().flat_map(|a| scene.materials.iter().map(move |b| PairCoeffs::mix(&a.constants, &b.constants, &scene.model))).collect(),
+            coeffs: scene.pair_coeffs(),
             n_materials: scene.materials.len(),
             step: 0,
             time: 0.0,

@@ -45,7 +45,7 @@ pub struct History<T> {
     pub bridge: T,
 }
 
-/// Coefficients of one pair of materials (see [`PairCoeffs::mix`]).
+/// Coefficients of one pair of materials (see [`PairCoeffs::of`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PairCoeffs<T> {
     /// `V_eff = V_i V_j / (V_i + V_j)` (Pa), `V = E / (1 - nu^2)`.
@@ -97,30 +97,98 @@ impl MaterialConstants {
     pub fn shear_modulus(&self) -> f64 {
         self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
     }
+    /// `V_eff = V_a V_b / (V_a + V_b)` (Pa) of a contact between materials `a` and `b`.
+    pub fn effective_stiffness(a: &Self, b: &Self) -> f64 {
+        let (va, vb) = (a.stiffness(), b.stiffness());
+        va * vb / (va + vb)
+    }
+}
+
+/// The coefficients a contact between two materials takes from a mixing rule, or from the
+/// scene's `[[pair]]` table where it gives them: friction, rolling, damping and restitution
+/// (the elastic moduli are the materials' own and always combine by docs/physics.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MixedConstants {
+    /// Static friction coefficient (-).
+    pub mu_s: f64,
+    /// Kinetic friction coefficient (-).
+    pub mu_k: f64,
+    /// Rolling angle `theta_r` (rad).
+    pub rolling_angle: f64,
+    /// `gamma_n` (s^-1 m^-1/2).
+    pub gamma_n: f64,
+    /// `gamma_nt` (s^-1).
+    pub gamma_nt: f64,
+    /// Restitution coefficient (-), of [`DampingLaw::Restitution`].
+    pub restitution: f64,
+}
+
+impl MixedConstants {
+    /// The mixing rule: friction coefficients and the rolling angle take the smaller of the
+    /// two (as YADE does: a frictionless wall makes frictionless contacts); damping and
+    /// restitution take the arithmetic mean. Equal materials give their own values.
+    pub fn rule(a: &MaterialConstants, b: &MaterialConstants) -> Self {
+        let mean = |x: f64, y: f64| 0.5 * (x + y);
+        MixedConstants {
+            mu_s: a.mu_s.min(b.mu_s),
+            mu_k: a.mu_k.min(b.mu_k),
+            rolling_angle: a.rolling_angle.min(b.rolling_angle),
+            gamma_n: mean(a.gamma_n, b.gamma_n),
+            gamma_nt: mean(a.gamma_nt, b.gamma_nt),
+            restitution: mean(a.restitution, b.restitution),
+        }
+    }
+}
+
+/// What a `[[pair]]` table gives for its pair of materials; what it leaves out (`None`) comes
+/// from the mixing rule, except `mu_k`, which follows a given `mu_s` as a material's does.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MixedOverride {
+    /// Static friction coefficient (-).
+    pub mu_s: Option<f64>,
+    /// Kinetic friction coefficient (-).
+    pub mu_k: Option<f64>,
+    /// Rolling angle `theta_r` (rad).
+    pub rolling_angle: Option<f64>,
+    /// `gamma_n` (s^-1 m^-1/2).
+    pub gamma_n: Option<f64>,
+    /// `gamma_nt` (s^-1).
+    pub gamma_nt: Option<f64>,
+    /// Restitution coefficient (-).
+    pub restitution: Option<f64>,
+}
+
+impl MixedOverride {
+    /// `rule` with what this table gives in place of the rule's values.
+    pub fn over(&self, rule: MixedConstants) -> MixedConstants {
+        MixedConstants {
+            mu_s: self.mu_s.unwrap_or(rule.mu_s),
+            mu_k: self.mu_k.or(self.mu_s).unwrap_or(rule.mu_k),
+            rolling_angle: self.rolling_angle.unwrap_or(rule.rolling_angle),
+            gamma_n: self.gamma_n.unwrap_or(rule.gamma_n),
+            gamma_nt: self.gamma_nt.unwrap_or(rule.gamma_nt),
+            restitution: self.restitution.unwrap_or(rule.restitution),
+        }
+    }
 }
 
 impl<T: Real> PairCoeffs<T> {
-    /// Coefficients for a contact between materials `a` and `b`. Elastic constants combine
-    /// as docs/physics.md rules; friction coefficients and the rolling angle take the smaller of
-    /// the two (as YADE does: a frictionless wall makes frictionless contacts); damping and
-    /// restitution take the arithmetic mean. Equal materials give their own values. The
-    /// dashpot ratio is sized for `model`'s normal law and clamp.
-    pub fn mix(a: &MaterialConstants, b: &MaterialConstants, model: &ContactModel<f64>) -> Self {
-        let (va, vb) = (a.stiffness(), b.stiffness());
+    /// Coefficients for a contact between materials `a` and `b` whose mixed constants are
+    /// `mixed` ([`MixedConstants::rule`], or the scene's pair table): elastic constants
+    /// combine as docs/physics.md rules. The dashpot ratio is sized for `model`'s normal law
+    /// and clamp.
+    pub fn of(a: &MaterialConstants, b: &MaterialConstants, mixed: &MixedConstants, model: &ContactModel<f64>) -> Self {
         let g_inv = (2.0 - a.poisson_ratio) / a.shear_modulus() + (2.0 - b.poisson_ratio) / b.shear_modulus();
-        let mean = |x: f64, y: f64| 0.5 * (x + y);
         PairCoeffs {
-            v_eff: T::of(va * vb / (va + vb)),
+            v_eff: T::of(MaterialConstants::effective_stiffness(a, b)),
             g_eff: T::of(1.0 / g_inv),
-            mu_s: T::of(a.mu_s.min(b.mu_s)),
-            mu_k: T::of(a.mu_k.min(b.mu_k)),
-            tan_roll: T::of(a.rolling_angle.min(b.rolling_angle).tan()),
-            gamma_n: T::of(mean(a.gamma_n, b.gamma_n)),
-            gamma_nt: T::of(mean(a.gamma_nt, b.gamma_nt)),
+            mu_s: T::of(mixed.mu_s),
+            mu_k: T::of(mixed.mu_k),
+            tan_roll: T::of(mixed.rolling_angle.tan()),
+            gamma_n: T::of(mixed.gamma_n),
+            gamma_nt: T::of(mixed.gamma_nt),
             beta: T::of(match model.damping {
-                DampingLaw::Restitution => {
-                    restitution::dashpot_ratio(mean(a.restitution, b.restitution), model.normal.spring(), model.limit_damping)
-                }
+                DampingLaw::Restitution => restitution::dashpot_ratio(mixed.restitution, model.normal.spring(), model.limit_damping),
                 _ => 0.0,
             }),
         }

@@ -3,7 +3,7 @@
 //! and turns a [`KeyProblem`] into its error, which names the file, the key, the value and the
 //! fix.
 
-use super::{MaterialConstants, NormalLaw};
+use super::{MaterialConstants, MixedConstants, NormalLaw};
 
 /// The keys of a scene's `[model]` table, by name.
 pub trait LawKeys {
@@ -37,6 +37,9 @@ pub struct LawInput<'a> {
     pub keys: &'a dyn LawKeys,
     /// The scene's materials, in order.
     pub materials: &'a [MaterialUse],
+    /// Each `[[pair]]` table's constants, in the scene's order (`pair[k]`): the mixing rule's
+    /// with the table's values in place.
+    pub pairs: &'a [MixedConstants],
     /// The normal law, for the slots chosen after it (`None` while the normal law is chosen).
     pub normal: Option<&'a NormalLaw<f64>>,
 }

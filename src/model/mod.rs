@@ -23,7 +23,7 @@ pub mod tangential;
 pub mod twisting;
 pub mod window;
 
-pub use coeffs::{History, HistoryLayout, MaterialConstants, PairCoeffs};
+pub use coeffs::{History, HistoryLayout, MaterialConstants, MixedConstants, MixedOverride, PairCoeffs};
 pub use cohesion::{capillary_force, capillary_potential, decay_length, rupture_distance, share_liquid, within_rupture, CohesionLaw};
 pub use contact::{contact_force, ContactForce, Regime};
 pub use damping::{normal_damping, normal_force, restitution, DampingLaw};
@@ -151,7 +151,7 @@ mod tests {
 
     /// Two 0.5 mm grains of 1.3875e-6 kg along x, overlapping by 1 um.
     fn pair() -> (PairCoeffs<f64>, Geometry<f64>) {
-        let c = PairCoeffs::mix(&sand(), &sand(), &restitution_model(NormalLaw::Hertz(Hertz), true));
+        let c = PairCoeffs::of(&sand(), &sand(), &MixedConstants::rule(&sand(), &sand()), &restitution_model(NormalLaw::Hertz(Hertz), true));
         let g = Geometry::grain_grain(Vec3::new(0.999e-3, 0.0, 0.0), 0.999e-3, 5.0e-4, 5.0e-4, 1.3875e-6, 1.3875e-6);
         (c, g)
     }
@@ -167,10 +167,10 @@ mod tests {
         // that may pull has the oscillator's ln 2 / sqrt(ln^2 2 + pi^2).
         assert!(close(c.beta, restitution::dashpot_ratio(0.5, restitution::Spring::Hertz, true)));
         let (ln2, pi) = (std::f64::consts::LN_2, std::f64::consts::PI);
-        let linear: PairCoeffs<f64> = PairCoeffs::mix(&sand(), &sand(), &restitution_model(NormalLaw::Linear(Linear { k_n: 1.0e3 }), false));
+        let linear: PairCoeffs<f64> = PairCoeffs::of(&sand(), &sand(), &MixedConstants::rule(&sand(), &sand()), &restitution_model(NormalLaw::Linear(Linear { k_n: 1.0e3 }), false));
         assert!(close(linear.beta, ln2 / (ln2 * ln2 + pi * pi).sqrt()));
         let papers = ContactModel { damping: DampingLaw::Papers, ..restitution_model(NormalLaw::Hertz(Hertz), true) };
-        assert_eq!(PairCoeffs::<f64>::mix(&sand(), &sand(), &papers).beta, 0.0, "no dashpot ratio without restitution damping");
+        assert_eq!(PairCoeffs::<f64>::of(&sand(), &sand(), &MixedConstants::rule(&sand(), &sand()), &papers).beta, 0.0, "no dashpot ratio without restitution damping");
     }
 
     #[test]

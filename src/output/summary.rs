@@ -287,10 +287,12 @@ pub fn check_report(scene: &Scene) -> String {
                 // The pairs of materials that meet: a grain's with a grain's or a wall's.
                 let of_grains = |m: usize| g.material.iter().any(|&x| x as usize == m);
                 let of_walls = |m: usize| scene.walls.iter().any(|w| w.material as usize == m);
+                let coeffs = scene.pair_coeffs::<f64>();
+                let n = scene.materials.len();
                 for (i, a) in scene.materials.iter().enumerate().filter(|(i, _)| of_grains(*i)) {
-                    for (_, b) in scene.materials.iter().enumerate().filter(|(j, _)| (*j >= i && of_grains(*j)) || (of_walls(*j) && !of_grains(*j))) {
-                        let beta = crate::model::PairCoeffs::<f64>::mix(&a.constants, &b.constants, &scene.model).beta;
-                        let e = 0.5 * (a.constants.restitution + b.constants.restitution);
+                    for (j, b) in scene.materials.iter().enumerate().filter(|(j, _)| (*j >= i && of_grains(*j)) || (of_walls(*j) && !of_grains(*j))) {
+                        let beta = coeffs[i * n + j].beta;
+                        let e = scene.mixed(i, j).restitution;
                         let _ = writeln!(s, "  restitution {} on {}: e = {e}, dashpot ratio beta = {beta:.4} (sized for this normal law and clamp)", a.name, b.name);
                     }
                 }

@@ -24,7 +24,7 @@ use stage_specs::validate_stages;
 use wall_specs::{check_overlaps, finish_walls, servo_box, validate_walls};
 
 use crate::model::cohesion::DEFAULT_LIQUID_DENSITY;
-use crate::model::{CohesionLaw, ContactModel, DampingLaw, MaterialConstants};
+use crate::model::{CohesionLaw, ContactModel, DampingLaw, MaterialConstants, MixedOverride};
 use crate::timestep;
 use error::Complainer;
 use schema::{ContactDynamicsSpec, DtSpec, ModelSpec, SceneFile, SimulationSpec, StageSpec, WallSpec};
@@ -76,6 +76,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         })
     };
 
+    let pairs = validate_pairs(&c, &f, &material_of)?;
     let seed = f.seed.unwrap_or(1);
     let periodic = validate_periodic(&c, &f)?;
     let mut grains = Grains::default();
@@ -111,7 +112,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
     check_overlaps(&c, &origins, &grains, &walls)?;
     check_periodic(&c, &origins, &grains, &periodic, f.simulation.skin)?;
 
-    let model = validate_model(&c, &f.model, &materials, &grains, &walls)?;
+    let model = validate_model(&c, &f.model, &materials, &pairs, &grains, &walls)?;
     let sim = &f.simulation;
     let gravity = finite3(&c, "simulation.gravity", sim.gravity)?;
     let integrator = match sim.integrator.as_deref().unwrap_or("velocity_verlet") {
@@ -160,6 +161,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         name,
         description: f.description.clone().unwrap_or_default(),
         materials,
+        pairs,
         grains,
         walls,
         servo,
@@ -231,6 +233,41 @@ fn validate_materials(c: &Complainer, f: &SceneFile) -> Result<Vec<Material>, Sc
     }
     if out.is_empty() {
         return Err(c.invalid("material", "[]", "the scene has no [[material]]", "add a [[material]] table with name, density, youngs_modulus and poisson_ratio"));
+    }
+    Ok(out)
+}
+
+/// The `[[pair]]` tables: known materials, each pair once, values in the ranges a material's
+/// take, and at least one value given.
+fn validate_pairs(c: &Complainer, f: &SceneFile, material_of: &dyn Fn(String, &str) -> Result<u16, SceneError>) -> Result<Vec<MaterialPair>, SceneError> {
+    let mut out: Vec<MaterialPair> = Vec::new();
+    for (k, p) in f.pairs.iter().enumerate() {
+        let key = |s: &str| format!("pair[{k}].{s}");
+        let materials = [material_of(key("materials"), &p.materials[0])?, material_of(key("materials"), &p.materials[1])?];
+        let same = |m: &[u16; 2]| m == &materials || m == &[materials[1], materials[0]];
+        if let Some(j) = out.iter().position(|o| same(&o.materials)) {
+            return Err(c.invalid(key("materials"), format!("{:?}", p.materials), format!("names the same pair as pair[{j}]"), "give each pair of materials one [[pair]] table"));
+        }
+        let friction = |k: &str, v: Option<f64>| v.map(|v| non_negative(c, &key(k), v, "give a friction coefficient such as 0.3")).transpose();
+        let rolling_angle = match p.rolling_angle {
+            Some(a) if !(0.0..90.0).contains(&a) => return Err(c.invalid(key("rolling_angle"), a, "must lie in [0, 90) degrees", "give the rolling angle in degrees, e.g. 5")),
+            a => a.map(f64::to_radians),
+        };
+        if let Some(e) = p.restitution.filter(|e| !(*e > 0.0 && *e <= 1.0)) {
+            return Err(c.invalid(key("restitution"), e, "must lie in (0, 1]", "give a restitution coefficient such as 0.5"));
+        }
+        let given = MixedOverride {
+            mu_s: friction("mu_s", p.mu_s)?,
+            mu_k: friction("mu_k", p.mu_k)?,
+            rolling_angle,
+            gamma_n: p.gamma_n.map(|v| non_negative(c, &key("gamma_n"), v, "give gamma_n in s^-1 m^-1/2, or 0")).transpose()?,
+            gamma_nt: p.gamma_nt.map(|v| non_negative(c, &key("gamma_nt"), v, "give gamma_nt in s^-1, or 0")).transpose()?,
+            restitution: p.restitution,
+        };
+        if given == MixedOverride::default() {
+            return Err(c.invalid(format!("pair[{k}]"), format!("{:?}", p.materials), "gives no coefficient", "add mu_s, mu_k, rolling_angle, gamma_n, gamma_nt or restitution, or remove the table"));
+        }
+        out.push(MaterialPair { materials, given });
     }
     Ok(out)
 }

@@ -3,10 +3,11 @@
 
 use super::*;
 use crate::model::keys::{LawInput, MaterialUse};
+use crate::model::MixedConstants;
 use crate::model::registry::Slot;
 use crate::model::{cohesion, damping, normal, rolling, tangential, twisting};
 
-pub(super) fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], grains: &Grains, walls: &[Wall]) -> Result<ContactModel<f64>, SceneError> {
+pub(super) fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Material], pairs: &[MaterialPair], grains: &Grains, walls: &[Wall]) -> Result<ContactModel<f64>, SceneError> {
     for (key, v, why) in [
         ("v_slip", m.v_slip, "Oquendo et al.'s contacts slide when their static spring fails its Coulomb test (mu_s), not above a speed"),
         ("v_roll", m.v_roll, "Oquendo et al.'s contacts roll when their rolling spring reaches the rolling friction, not above a speed"),
@@ -18,7 +19,9 @@ pub(super) fn validate_model(c: &Complainer, m: &ModelSpec, materials: &[Materia
     let used: Vec<u16> = grains.material.iter().copied().chain(walls.iter().map(|w| w.material)).collect();
     let uses: Vec<MaterialUse> =
         materials.iter().enumerate().map(|(i, mat)| MaterialUse { constants: mat.constants, restitution: mat.restitution, in_contact: used.contains(&(i as u16)) }).collect();
-    let mut input = LawInput { keys: m, materials: &uses, normal: None };
+    let table = mixed_table(materials, pairs);
+    let pair_uses: Vec<MixedConstants> = pairs.iter().map(|p| table[p.materials[0] as usize * materials.len() + p.materials[1] as usize]).collect();
+    let mut input = LawInput { keys: m, materials: &uses, pairs: &pair_uses, normal: None };
     let normal = choose(c, &normal::SLOT, &m.normal, "hertz", &input)?;
     input.normal = Some(&normal);
     let damping = choose(c, &damping::SLOT, &m.damping, "none", &input)?;

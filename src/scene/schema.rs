@@ -19,6 +19,9 @@ pub struct SceneFile {
     /// `[[material]]` tables.
     #[serde(default, rename = "material")]
     pub materials: Vec<MaterialSpec>,
+    /// `[[pair]]` tables: coefficients of a pair of materials in place of the mixing rule's.
+    #[serde(default, rename = "pair")]
+    pub pairs: Vec<PairSpec>,
     /// `[[grain]]` tables: grains given one by one.
     #[serde(default, rename = "grain")]
     pub grains: Vec<GrainSpec>,
@@ -97,6 +100,29 @@ pub struct MaterialSpec {
     /// Twisting damping gamma_nt (s^-1) of `twisting = "oquendo"`. Default 0.
     #[serde(default)]
     pub gamma_nt: f64,
+    /// Restitution coefficient (-), in (0, 1], of `damping = "restitution"`.
+    pub restitution: Option<f64>,
+}
+
+/// `[[pair]]`: what a contact between two materials takes in place of the mixing rule
+/// (LIGGGHTS' per-type-pair coefficients). A key left out comes from the rule; `mu_k` follows
+/// a given `mu_s` as a material's does.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PairSpec {
+    /// The two materials' names (in either order; the same name twice for a material with
+    /// itself).
+    pub materials: [String; 2],
+    /// Static friction coefficient mu_s (-).
+    pub mu_s: Option<f64>,
+    /// Kinetic friction coefficient mu_k (-).
+    pub mu_k: Option<f64>,
+    /// Rolling angle theta_r (degrees).
+    pub rolling_angle: Option<f64>,
+    /// Normal damping gamma_n (s^-1 m^-1/2) of `damping = "papers"`.
+    pub gamma_n: Option<f64>,
+    /// Twisting damping gamma_nt (s^-1) of `twisting = "oquendo"`.
+    pub gamma_nt: Option<f64>,
     /// Restitution coefficient (-), in (0, 1], of `damping = "restitution"`.
     pub restitution: Option<f64>,
 }

@@ -3,7 +3,8 @@
 //! [`crate::timestep`] (the time step) and [`crate::walls`] (wall geometry).
 
 use glam::DVec3;
-use crate::model::{ContactModel, MaterialConstants};
+use crate::model::{ContactModel, MaterialConstants, MixedConstants, MixedOverride, PairCoeffs};
+use crate::real::Real;
 use serde::Serialize;
 use std::path::PathBuf;
 
@@ -18,6 +19,29 @@ pub struct Material {
     pub restitution: Option<f64>,
     /// Elastic and frictional constants.
     pub constants: MaterialConstants,
+}
+
+/// A `[[pair]]` table, validated: what contacts between two materials take in place of the
+/// mixing rule.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialPair {
+    /// Indices into [`Scene::materials`], as the scene names them.
+    pub materials: [u16; 2],
+    /// The coefficients it gives.
+    pub given: MixedOverride,
+}
+
+/// The mixed constants of every pair of `materials`, row-major (`a * n + b`): the mixing rule,
+/// overridden where `pairs` gives a value (for both orders of the pair).
+pub fn mixed_table(materials: &[Material], pairs: &[MaterialPair]) -> Vec<MixedConstants> {
+    let n = materials.len();
+    let mut table: Vec<MixedConstants> = materials.iter().flat_map(|a| materials.iter().map(|b| MixedConstants::rule(&a.constants, &b.constants))).collect();
+    for p in pairs {
+        let [a, b] = p.materials.map(usize::from);
+        table[a * n + b] = p.given.over(table[a * n + b]);
+        table[b * n + a] = table[a * n + b];
+    }
+    table
 }
 
 /// The initial state of every grain, indexed by permanent id.
@@ -236,6 +260,19 @@ impl Stage {
 }
 
 impl Scene {
+    /// The mixed constants of materials `a` and `b` (indices into [`Self::materials`]).
+    pub fn mixed(&self, a: usize, b: usize) -> MixedConstants {
+        mixed_table(&self.materials, &self.pairs)[a * self.materials.len() + b]
+    }
+
+    /// Each pair of materials' contact coefficients, row-major (`a * n + b`), as the engines
+    /// read them ([`crate::state::coeffs_of`]).
+    pub fn pair_coeffs<T: Real>(&self) -> Vec<PairCoeffs<T>> {
+        let mixed = mixed_table(&self.materials, &self.pairs);
+        let n = self.materials.len();
+        (0..n * n).map(|k| PairCoeffs::of(&self.materials[k / n].constants, &self.materials[k % n].constants, &mixed[k], &self.model)).collect()
+    }
+
     /// Steps of the whole run at most (every stage to its longest).
     pub fn max_steps(&self) -> u64 {
         self.stages.iter().map(|s| s.max_steps(self.time_step.dt)).fold(0u64, u64::saturating_add)
@@ -266,6 +303,8 @@ pub struct Scene {
     pub description: String,
     /// Materials.
     pub materials: Vec<Material>,
+    /// `[[pair]]` tables, in the scene's order.
+    pub pairs: Vec<MaterialPair>,
     /// Initial grain state.
     pub grains: Grains,
     /// Walls.

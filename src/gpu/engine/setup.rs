@@ -101,13 +101,9 @@ pub(super) fn walls_of(scene: &Scene) -> (Vec<layout::Wall>, Option<usize>) {
 /// Each pair of materials' coefficients, row-major, as the kernels read them.
 pub(super) fn pair_coeffs_of(scene: &Scene) -> Vec<layout::PairCoeffs> {
     scene
-        .materials
-        .iter()
-        .flat_map(|a| scene.materials.iter().map(move |b| (a, b)))
-        .map(|(a, b)| {
-            let c: PairCoeffs<f32> = PairCoeffs::mix(&a.constants, &b.constants, &scene.model);
-            layout::PairCoeffs { v_eff: c.v_eff, g_eff: c.g_eff, mu_s: c.mu_s, mu_k: c.mu_k, tan_roll: c.tan_roll, gamma_n: c.gamma_n, gamma_nt: c.gamma_nt, beta: c.beta }
-        })
+        .pair_coeffs::<f32>()
+        .into_iter()
+        .map(|c| layout::PairCoeffs { v_eff: c.v_eff, g_eff: c.g_eff, mu_s: c.mu_s, mu_k: c.mu_k, tan_roll: c.tan_roll, gamma_n: c.gamma_n, gamma_nt: c.gamma_nt, beta: c.beta })
         .collect()
 }
 

@@ -5,13 +5,13 @@ use super::DampingLaw;
 use crate::model::keys::{KeyProblem, LawInput};
 use crate::model::registry::Entry;
 
-/// The registry's row: refuses a scene where no material sets `gamma_n`, which would not damp.
+/// The registry's row: refuses a scene where no material or pair sets `gamma_n`, which would not damp.
 pub(super) const ENTRY: Entry<DampingLaw<f64>> = Entry {
     name: "papers",
     keys: &[],
     parse: |input: &LawInput| {
-        if input.materials.iter().all(|m| m.constants.gamma_n == 0.0) {
-            return Err(KeyProblem::new("model.damping", "\"papers\"", "no material sets gamma_n, so it would not damp", "set `gamma_n` (s^-1 m^-1/2) in the [[material]] tables or use damping = \"none\""));
+        if input.materials.iter().all(|m| m.constants.gamma_n == 0.0) && input.pairs.iter().all(|p| p.gamma_n == 0.0) {
+            return Err(KeyProblem::new("model.damping", "\"papers\"", "no material or pair sets gamma_n, so it would not damp", "set `gamma_n` (s^-1 m^-1/2) in the [[material]] tables or use damping = \"none\""));
         }
         Ok(DampingLaw::Papers)
     },

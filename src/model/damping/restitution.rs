@@ -34,7 +34,8 @@ use crate::model::keys::{KeyProblem, LawInput};
 use crate::model::registry::Entry;
 
 /// The registry's row: every material in contact needs its restitution coefficient, and every
-/// material one of at least [`MIN_RESTITUTION`] (the dashpot is sized for each pair of them).
+/// material and `[[pair]]` one of at least [`MIN_RESTITUTION`] (the dashpot is sized for each
+/// pair of them).
 pub(super) const ENTRY: Entry<DampingLaw<f64>> = Entry {
     name: "restitution",
     keys: &[],
@@ -49,6 +50,9 @@ pub(super) const ENTRY: Entry<DampingLaw<f64>> = Entry {
                 format!("is below {MIN_RESTITUTION}, where the dashpot would set the contact's time scale and the time step, picked from the elastic contact time, would not resolve it"),
                 format!("give a restitution of at least {MIN_RESTITUTION}"),
             ));
+        }
+        if let Some((k, e)) = input.pairs.iter().enumerate().find(|(_, p)| p.restitution < MIN_RESTITUTION).map(|(k, p)| (k, p.restitution)) {
+            return Err(KeyProblem::new(format!("pair[{k}].restitution"), e, format!("is below {MIN_RESTITUTION} (see the materials' limit)"), format!("give a restitution of at least {MIN_RESTITUTION}")));
         }
         Ok(DampingLaw::Restitution)
     },

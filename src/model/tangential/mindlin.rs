@@ -1,6 +1,6 @@
 //! The standard Hertz-Mindlin tangential law with history and one Coulomb coefficient (LAMMPS
 //! `tangential mindlin`, LIGGGHTS `tangential history`). Scene: `tangential = "mindlin"`, with
-//! `tangential_damping_ratio` and `kt_ratio`; the materials' `mu_k` must equal their `mu_s`.
+//! `tangential_damping_ratio` and `kt_ratio`; the materials' and pairs' `mu_k` must equal their `mu_s`.
 
 use super::{contact_tangential_velocity, rotate_into_plane, stiffness_of, TangentialLaw};
 use crate::model::keys::{non_negative_or, KeyProblem, LawInput};
@@ -15,6 +15,9 @@ pub(super) const ENTRY: Entry<TangentialLaw<f64>> = Entry {
     parse: |input: &LawInput| {
         if let Some((i, m)) = input.materials.iter().enumerate().find(|(_, m)| m.constants.mu_k != m.constants.mu_s) {
             return Err(KeyProblem::new(format!("material[{i}].mu_k"), m.constants.mu_k, "the Hertz-Mindlin law has one friction coefficient (mu_s)", "remove mu_k or set it equal to mu_s"));
+        }
+        if let Some((k, p)) = input.pairs.iter().enumerate().find(|(_, p)| p.mu_k != p.mu_s) {
+            return Err(KeyProblem::new(format!("pair[{k}].mu_k"), p.mu_k, "the Hertz-Mindlin law has one friction coefficient (mu_s)", "remove mu_k from the pair (and the materials) or set it equal to mu_s"));
         }
         Ok(TangentialLaw::Mindlin {
             damping_ratio: non_negative_or(input.keys, "tangential_damping_ratio", 0.0, "give a fraction such as 0.9075")?,
