@@ -2,8 +2,10 @@
 // pairs where it is partner, then its contacts with every wall (the grain-grain laws with an
 // infinite partner; their springs advance here). No float atomics. Each workgroup sums the
 // forces its grains put on each wall (row entries 0..MAX_WALLS: xyz force, w contacts as u32
-// bits) and, for servo walls (WALL_RESPONSE), their contacts' normal tangent stiffness and
-// damping coefficient (entries MAX_WALLS..: x N/m, y N s/m), which wall_reduce totals. For the
+// bits) and, for servo walls and spinning ones (WALL_RESPONSE), their contacts' normal tangent
+// stiffness and damping coefficient and the power the walls' spin gives the grains (entries
+// MAX_WALLS..: x N/m, y N s/m, z W), which wall_reduce totals. A wall moves at its surface
+// velocity where the grain's centre projects onto it. For the
 // statistics, force.w packs the grain's pairs that push (f_n > 0) with its wall contacts
 // sliding and rolling (WALL_COUNTS_*), torque.w is the magnitude of its wall force. With
 // phase.kick > 0 it then kicks the grain under that load: the kick after an evaluation, in the
@@ -106,9 +108,9 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index
 // on each wall go to wall_partials[row..].
 fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
     var out = WallLoad(vec3<f32>(0.0), vec3<f32>(0.0), 0u, 0u);
-    var response: array<vec2<f32>, MAX_WALLS>;
+    var response: array<vec3<f32>, MAX_WALLS>;
     for (var w = 0u; w < MAX_WALLS; w++) {
-        response[w] = vec2<f32>(0.0);
+        response[w] = vec3<f32>(0.0);
         reaction[lid * MAX_WALLS + w] = vec4<f32>(0.0);
     }
     if (live) {
@@ -136,7 +138,8 @@ fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
                 continue;
             }
             let g = geometry_grain_wall(frame.xyz, frame.w, p.w, v.w);
-            let kin = Kinematics(v.xyz, wall.velocity.xyz, om.xyz, vec3<f32>(0.0));
+            let surface = wall_velocity_at(wall, p.xyz - frame.xyz * frame.w);
+            let kin = Kinematics(v.xyz, surface, om.xyz, wall_spin(wall));
             let bodies = Bodies(v.w, om.w, 0.0, 0.0, true);
             let c = coeffs[wall.material * params.n_materials + material[i]];
             // Walls are not wetted: their contacts keep springs only.
@@ -152,14 +155,18 @@ fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
             out.sliding += select(0u, 1u, f.regime == REGIME_SLIDING);
             out.rolling += select(0u, 1u, f.regime == REGIME_ROLLING);
             if (WALL_RESPONSE) {
-                response[w] = vec2<f32>(normal_stiffness(c, g), normal_damping(c, g));
+                var power = 0.0;
+                if (wall.driven == 1u && any(wall.drive.xyz != vec3<f32>(0.0))) {
+                    power = dot(f.f_i, surface - wall.velocity.xyz);
+                }
+                response[w] = vec3<f32>(normal_stiffness(c, g), normal_damping(c, g), power);
             }
         }
     }
     reduce_walls(lid, row);
     if (WALL_RESPONSE) {
         for (var w = 0u; w < MAX_WALLS; w++) {
-            reaction[lid * MAX_WALLS + w] = vec4<f32>(response[w], 0.0, 0.0);
+            reaction[lid * MAX_WALLS + w] = vec4<f32>(response[w], 0.0);
         }
         reduce_walls(lid, row + MAX_WALLS);
     }

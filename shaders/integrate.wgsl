@@ -2,7 +2,7 @@
 // phase.drift (x += v tau, compensated: the sum's rounding kept in residual; its orientation by Omelyan's norm-preserving update) and records
 // how far it has moved since the last build; a zero duration skips that half, so a kick and
 // the drift after it are one dispatch. Invocation 0 does the same to the piston and books
-// the work of its target pressure.
+// the work of its target pressure, and drifts the driven walls.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
 @group(0) @binding(2) var<storage, read_write> pos: array<vec4<f32>>;
@@ -20,8 +20,11 @@
 @compute @workgroup_size(64)
 fn integrate(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat_index(wid, lid, nwg);
-    if (i == 0u && params.piston != NONE) {
-        move_piston(phase.kick, phase.drift);
+    if (i == 0u) {
+        if (params.piston != NONE) {
+            move_piston(phase.kick, phase.drift);
+        }
+        move_walls(phase.drift);
     }
     if (i >= params.n_grains) {
         return;

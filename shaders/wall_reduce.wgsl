@@ -1,9 +1,10 @@
 // One workgroup sums the per-workgroup wall rows in a fixed order into each wall's totals:
 // entries 0..MAX_WALLS (xyz: force the grains exert, w: contacts, u32 bits), then MAX_WALLS.. (the
-// contacts' summed stiffness and damping, for servo walls; zero otherwise). With phase.kick > 0
+// contacts' summed stiffness and damping for servo walls and the spin's power for spinning
+// walls; zero otherwise). With phase.kick > 0
 // it then kicks the piston under those totals: the kick after an evaluation, whose grains the
 // gather kicked; and with phase.drift > 0 kicks it by phase.then_kick and drifts it, the next
-// step's first sweep, carried as the gather carried the grains'.
+// step's first sweep, carried as the gather carried the grains', and drifts the driven walls.
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<uniform> phase: Phase;
 @group(0) @binding(2) var<storage, read> wall_partials: array<vec4<f32>>;
@@ -18,11 +19,14 @@ fn wall_reduce(@builtin(local_invocation_index) lid: u32) {
         reduce_half(lid, half * MAX_WALLS);
     }
     // Invocation 0 wrote the totals it reads.
-    if (lid == 0u && params.piston != NONE) {
-        if (phase.kick > 0.0) {
-            kick_piston(phase.kick);
+    if (lid == 0u) {
+        if (params.piston != NONE) {
+            if (phase.kick > 0.0) {
+                kick_piston(phase.kick);
+            }
+            move_piston(phase.then_kick, phase.drift);
         }
-        move_piston(phase.then_kick, phase.drift);
+        move_walls(phase.drift);
     }
 }
 

@@ -53,6 +53,34 @@ impl<T: Real> WallGeom<T> {
         }
     }
 
+    /// The same surface moved by `d` (m): a cylinder, infinite along z, by `d`'s x and y.
+    pub fn translated(&self, d: Vec3<T>) -> Self {
+        match *self {
+            WallGeom::Plane { point, normal } => WallGeom::Plane { point: point + d, normal },
+            WallGeom::Cylinder { cx, cy, radius } => WallGeom::Cylinder { cx: cx + d.x, cy: cy + d.y, radius },
+            WallGeom::Piston { z } => WallGeom::Piston { z: z + d.z },
+        }
+    }
+
+    /// The point on the wall's axis of symmetry that a spin turns about (m): a plane's point,
+    /// a cylinder's axis at z = 0, the middle of the piston.
+    pub fn centre(&self) -> Vec3<T> {
+        match *self {
+            WallGeom::Plane { point, .. } => point,
+            WallGeom::Cylinder { cx, cy, .. } => Vec3::new(cx, cy, T::ZERO),
+            WallGeom::Piston { z } => Vec3::new(T::ZERO, T::ZERO, z),
+        }
+    }
+
+    /// The same surface with its [`Self::centre`] at `c` (m).
+    pub fn centred_at(&self, c: Vec3<T>) -> Self {
+        match *self {
+            WallGeom::Plane { normal, .. } => WallGeom::Plane { point: c, normal },
+            WallGeom::Cylinder { radius, .. } => WallGeom::Cylinder { cx: c.x, cy: c.y, radius },
+            WallGeom::Piston { .. } => WallGeom::Piston { z: c.z },
+        }
+    }
+
     /// True when the point `x` lies nearer than `reach` (m) to one of `walls` (signed distance,
     /// [`Self::frame`]): a grain of radius `r` there can touch one of them within `reach - r`.
     pub fn any_within<'a>(walls: impl IntoIterator<Item = &'a WallGeom<T>>, x: Vec3<T>, reach: T) -> bool

@@ -141,6 +141,11 @@ fn oedometer() -> String {
     std::fs::read_to_string(common::scene_path("oedometer.toml")).unwrap()
 }
 
+/// A glass `[[wall]]` table with `keys`, followed by `[model]`.
+fn wall(keys: &str) -> String {
+    format!("[[wall]]\nmaterial = \"glass\"\n{keys}\n\n[model]")
+}
+
 /// A `[[pair]]` table of `materials` (TOML array items) with `keys`, followed by `[model]`.
 fn pair(materials: &str, keys: &str) -> String {
     format!("[[pair]]\nmaterials = [{materials}]\n{keys}\n\n[model]")
@@ -175,6 +180,10 @@ fn malformed_scenes_get_one_line_naming_the_key_and_the_fix() {
             "material[0].restitution = 0.0005: is below 0.001",
         ),
         ("clamp_without_damping.toml", base.replace("damping = \"none\"", "damping = \"none\"\nlimit_damping = false"), "model.limit_damping"),
+        ("plane_turning.toml", base.replace("[model]", &wall("type = \"plane\"\npoint = [0.0, 0.0, -1.0e-3]\nnormal = [0.0, 0.0, 1.0]\nangular_velocity = [1.0, 0.0, 0.0]")), "wall[0].angular_velocity = [1.0, 0.0, 0.0]: is not along the plane's normal"),
+        ("cylinder_tumbling.toml", base.replace("[model]", &wall("type = \"cylinder\"\ncenter = [0.0, 0.0]\nradius = 0.01\nangular_velocity = [0.0, 2.0, 0.0]")), "wall[0].angular_velocity = [0.0, 2.0, 0.0]: is not along the cylinder's axis (z)"),
+        ("box_spinning.toml", base.replace("[model]", &wall("type = \"box\"\nmin = [-0.01, -0.01, -0.01]\nmax = [0.01, 0.01, 0.01]\nangular_velocity = [0.0, 0.0, 1.0]")), "angular_velocity"),
+        ("wall_velocity_nan.toml", base.replace("[model]", &wall("type = \"plane\"\npoint = [0.0, 0.0, -1.0e-3]\nnormal = [0.0, 0.0, 1.0]\nvelocity = [nan, 0.0, 0.0]")), "wall[0].velocity"),
         ("pair_unknown_material.toml", base.replace("[model]", &pair("\"glass\", \"steel\"", "mu_s = 0.1")), "pair[0].materials = \"steel\": names no [[material]]"),
         ("pair_twice.toml", base.replace("[model]", &pair("\"glass\", \"glass\"", "mu_s = 0.1")).replacen("[model]", &pair("\"glass\", \"glass\"", "mu_s = 0.2"), 1), "names the same pair as pair[0]"),
         ("pair_empty.toml", base.replace("[model]", &pair("\"glass\", \"glass\"", "")), "pair[0] = [\"glass\", \"glass\"]: gives no coefficient"),

@@ -437,4 +437,8 @@ fn bad_contact_dynamics_input_gets_one_line_naming_the_key_and_the_fix() {
     let s = grains::scene::parse(std::path::Path::new("cd.toml"), &periodic).unwrap();
     let err = grains::runner::cpu_engine(&s, "f64").err().unwrap().to_string();
     assert!(err.contains("a periodic boundary is not modelled by contact dynamics; fix:"), "{err}");
+    let driven = text.replacen("[[wall]]", "[[wall]]\nvelocity = [0.0, 0.0, 0.01]", 1);
+    let s = grains::scene::parse(std::path::Path::new("cd.toml"), &driven).unwrap();
+    let err = grains::runner::cpu_engine(&s, "f64").err().unwrap().to_string();
+    assert!(err.contains("a wall with a prescribed velocity or spin is not modelled by contact dynamics; fix: use the DEM method"), "{err}");
 }

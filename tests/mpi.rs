@@ -120,6 +120,20 @@ fn a_pour_in_f32_gives_the_same_bits_on_two_processes() {
     same_bits_on(&[2], &pour(dir.path()), "f32");
 }
 
+/// The pour in a box that moves along x at 0.05 m/s (a driven wall): its walls move alike on
+/// every process and its work sums over all of them.
+#[test]
+fn a_pour_in_a_moving_box_gives_the_same_bits_on_two_processes() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = pour(dir.path());
+    let text = common::edit(&std::fs::read_to_string(&path).unwrap(), &[("open_top = true", "open_top = true\nvelocity = [0.05, 0.0, 0.0]")]);
+    std::fs::write(&path, text).unwrap();
+    let stats = same_bits_on(&[2], &path, "f64");
+    let work: f64 = stats.lines().last().unwrap().split(',').nth(7).unwrap().parse().unwrap();
+    println!("the moving box's work on the grains: {work:e} J");
+    assert!(work != 0.0, "the box pushes the grains");
+}
+
 #[test]
 fn an_oedometer_stage_gives_the_same_bits_on_one_two_and_three_processes() {
     let dir = tempfile::tempdir().unwrap();

@@ -162,7 +162,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     ]);
     check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, then_kick]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);
-    check_struct!(&m, layout::Wall, "Wall", [kind, material, _pad0, _pad1, point, normal, velocity, piston]);
+    check_struct!(&m, layout::Wall, "Wall", [kind, material, driven, _pad1, point, normal, velocity, drive]);
     check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite, rebuild_checks]);
     check_struct!(&m, layout::DispatchArgs, "DispatchArgs", [x, y, z]);
     check_struct!(&m, layout::Servo, "Servo", [walls_lo, walls_hi, pressure, gain, max_speed, strain_rate, relaxation, work, work_lo, strain]);

@@ -1,8 +1,9 @@
-// The piston's kick (needs `params`, `walls`, `wall_reaction`).
+// The piston's kick and drift, and the driven walls' drift (needs `params`, `walls`,
+// `wall_reaction`).
 
 // The piston for tau (s), by the grains' push minus its target pressure times its area.
 fn kick_piston(tau: f32) {
-    let p = walls[params.piston].piston;
+    let p = walls[params.piston].drive;
     let push = wall_reaction[params.piston].z - p.z * p.y;
     walls[params.piston].velocity.z += push * tau / p.x;
 }
@@ -16,7 +17,28 @@ fn move_piston(kick: f32, drift: f32) {
     if (drift > 0.0) {
         let dz = walls[params.piston].velocity.z * drift;
         walls[params.piston].point.z += dz;
-        let p = walls[params.piston].piston;
-        walls[params.piston].piston.w -= p.z * p.y * dz;
+        let p = walls[params.piston].drive;
+        walls[params.piston].drive.w -= p.z * p.y * dz;
+    }
+}
+
+// The driven walls drifted by `drift` (s) at their velocity (a cylinder, infinite along z, in x
+// and y), booking the work they do on the grains in drive.w: their velocity against the
+// grains' push, plus their spin's power; a zero duration skips it.
+fn move_walls(drift: f32) {
+    if (drift <= 0.0) {
+        return;
+    }
+    for (var w = 0u; w < params.n_walls; w++) {
+        if (walls[w].driven != 1u) {
+            continue;
+        }
+        let v = walls[w].velocity.xyz;
+        if (walls[w].kind == WALL_CYLINDER) {
+            walls[w].point = vec4<f32>(walls[w].point.xy + v.xy * drift, walls[w].point.zw);
+        } else {
+            walls[w].point = vec4<f32>(walls[w].point.xyz + v * drift, walls[w].point.w);
+        }
+        walls[w].drive.w += (wall_reaction[MAX_WALLS + w].z - dot(wall_reaction[w].xyz, v)) * drift;
     }
 }

@@ -73,12 +73,14 @@ fn add_wall_row(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
 struct Wall {
     kind: u32,
     material: u32,
-    _pad0: u32,
+    driven: u32,         // 1: a prescribed motion moves it (velocity, drive.xyz)
     _pad1: u32,
     point: vec4<f32>,    // plane: a point; cylinder: axis (x, y); piston: (0, 0, z)
     normal: vec4<f32>,   // plane: unit normal into the domain; cylinder: w = radius
     velocity: vec4<f32>, // m/s
-    piston: vec4<f32>,   // mass (kg), area (m^2), target pressure (Pa), external work (J)
+    drive: vec4<f32>,    // piston: mass (kg), area (m^2), target pressure (Pa), external work (J);
+                         // other walls: angular velocity (rad/s) about the axis through the
+                         // centre, work on the grains (J)
 }
 
 // The servo box's control state.

@@ -14,6 +14,26 @@ fn wall_frame(w: Wall, p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
     return vec4<f32>(0.0, 0.0, -1.0, keep(vec3<f32>(w.point.z - p.z), r.w).z - r.z);
 }
 
+// A driven wall's angular velocity (rad/s; zero for any other wall).
+fn wall_spin(w: Wall) -> vec3<f32> {
+    if (w.driven == 1u) { return w.drive.xyz; }
+    return vec3<f32>(0.0);
+}
+
+// The point on a wall's axis of symmetry that its spin turns about.
+fn wall_centre(w: Wall) -> vec3<f32> {
+    if (w.kind == WALL_PLANE) { return w.point.xyz; }
+    if (w.kind == WALL_CYLINDER) { return vec3<f32>(w.point.xy, 0.0); }
+    return vec3<f32>(0.0, 0.0, w.point.z);
+}
+
+// The velocity of a wall's surface at x: its velocity, plus spin x (x - centre) where it spins.
+fn wall_velocity_at(w: Wall, x: vec3<f32>) -> vec3<f32> {
+    let spin = wall_spin(w);
+    if (all(spin == vec3<f32>(0.0))) { return w.velocity.xyz; }
+    return w.velocity.xyz + cross(spin, x - wall_centre(w));
+}
+
 // The statistics' count of a grain's wall contacts, packed into its force.w beside the pairs
 // that push it (at most WALL_COUNTS_SLIDING - 1): sliding ones times WALL_COUNTS_SLIDING,
 // rolling ones times WALL_COUNTS_ROLLING (each at most MAX_WALLS; the sum stays below 2^24, an

@@ -1,4 +1,4 @@
-//! The walls' controllers: the piston's state and the servo box's six planes.
+//! The walls' controllers: the piston's state, the servo box's six planes and the driven walls.
 
 use super::*;
 
@@ -83,6 +83,16 @@ impl<T: Real> CpuEngine<T> {
             self.walls[w].geom = WallGeom::Plane { point: point + velocity * tau, normal };
             self.walls[w].velocity = velocity;
             self.external_work -= (self.wall_reaction[w].dot(velocity) * tau).f64();
+        }
+    }
+
+    /// Moves each driven wall by its velocity for `tau` (s) and books the work it did on the
+    /// grains: its velocity against the grains' push, and its spin's power.
+    pub(super) fn drive_walls(&mut self, tau: T) {
+        for &w in &self.driven {
+            let wall = &mut self.walls[w];
+            wall.geom = wall.geom.translated(wall.velocity * tau);
+            self.external_work += ((self.wall_power[w] - self.wall_reaction[w].dot(wall.velocity)) * tau).f64();
         }
     }
 }

@@ -52,6 +52,7 @@ impl<T: Real> CpuEngine<T> {
         self.wall_reaction = sums.reaction;
         self.wall_count = sums.count;
         self.wall_response = sums.response;
+        self.wall_power = sums.power;
         self.wall_regimes = sums.regimes;
         self.forces_valid = true;
         self.clock.stop(Phase::Gather, t);

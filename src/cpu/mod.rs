@@ -132,6 +132,10 @@ pub struct CpuEngine<T: Real> {
     /// Sum over each wall's contacts of the normal tangent stiffness (N/m) and damping
     /// coefficient (N s/m).
     wall_response: Vec<(T, T)>,
+    /// Power (W) each wall's spin gives the grains at the last force evaluation.
+    wall_power: Vec<T>,
+    /// The walls with a prescribed motion (`crate::scene::WallDrive`), which each drift moves.
+    driven: Vec<usize>,
     // Pairs.
     pairs: PairList,
     hist: Vec<T>,

@@ -19,7 +19,7 @@ const PAIR_ARRAYS: [(&str, bool); 6] = [("hist", false), ("share", false), ("f_n
 pub(crate) const BRIDGE_ROW: usize = 6;
 
 /// The arrays that hold one value for the whole engine, not one per grain or pair.
-const GLOBAL_ARRAYS: [&str; 9] = ["wall_touch_ids", "wall_touches", "wall_reaction", "wall_count", "piston", "servo", "clock", "built_margin", "counters"];
+const GLOBAL_ARRAYS: [&str; 12] = ["wall_touch_ids", "wall_touches", "wall_touch_power", "wall_reaction", "wall_count", "wall_power", "piston", "servo", "driven_walls", "clock", "built_margin", "counters"];
 
 /// Values per grain and per pair of each array of [`GRAIN_ARRAYS`] and [`PAIR_ARRAYS`] (0
 /// where the scene keeps none).
@@ -201,23 +201,24 @@ pub(crate) fn touches_state<T: Real>(touches: &[WallTouch<T>]) -> EngineState {
     let v3 = |v: &Vec3<T>| [v.x.f64(), v.y.f64(), v.z.f64()];
     s.put_ints("wall_touch_ids", touches.iter().flat_map(|t| [t.grain as u64, t.wall as u64, t.code() as u64]));
     s.put_reals("wall_touches", touches.iter().flat_map(|t| [v3(&t.force).as_slice(), &[t.stiffness.f64(), t.damping.f64()]].concat()));
+    s.put_reals("wall_touch_power", touches.iter().map(|t| t.power.f64()));
     s
 }
 
 /// Values of a wall contact in [`touch_row`].
-pub(crate) const TOUCH_ROW: usize = 8;
+pub(crate) const TOUCH_ROW: usize = 9;
 
-/// A wall contact as `[grain, wall, code, force x, y, z, stiffness, damping]`, with the grain
-/// given by `id` ([`WallTouch::code`]).
+/// A wall contact as `[grain, wall, code, force x, y, z, stiffness, damping, power]`, with the
+/// grain given by `id` ([`WallTouch::code`]).
 pub(crate) fn touch_row<T: Real>(t: &WallTouch<T>, id: u32) -> [f64; TOUCH_ROW] {
     let f = t.force.f64();
-    [id as f64, t.wall as f64, t.code() as f64, f[0], f[1], f[2], t.stiffness.f64(), t.damping.f64()]
+    [id as f64, t.wall as f64, t.code() as f64, f[0], f[1], f[2], t.stiffness.f64(), t.damping.f64(), t.power.f64()]
 }
 
 /// [`touch_row`] undone.
 pub(crate) fn touch_of_row<T: Real>(r: &[f64]) -> WallTouch<T> {
     let (regime, touching) = WallTouch::<T>::of_code(r[2] as u8);
-    WallTouch { grain: r[0] as u32, wall: r[1] as u32, regime, touching, force: Vec3::new(T::of(r[3]), T::of(r[4]), T::of(r[5])), stiffness: T::of(r[6]), damping: T::of(r[7]) }
+    WallTouch { grain: r[0] as u32, wall: r[1] as u32, regime, touching, force: Vec3::new(T::of(r[3]), T::of(r[4]), T::of(r[5])), stiffness: T::of(r[6]), damping: T::of(r[7]), power: T::of(r[8]) }
 }
 
 impl<T: Real> CpuEngine<T> {
@@ -357,6 +358,7 @@ impl<T: Real> CpuEngine<T> {
         self.wall_reaction = sums.reaction;
         self.wall_count = sums.count;
         self.wall_response = sums.response;
+        self.wall_power = sums.power;
         self.wall_regimes = sums.regimes;
     }
 

@@ -28,7 +28,7 @@ impl<T: Real> CpuEngine<T> {
                 if let WallShape::Piston { pressure, mass, area, .. } = wall.shape {
                     piston = Some(Piston { wall: w, mass: T::of(mass), area: T::of(area), pressure: T::of(pressure) });
                 }
-                WallState { geom: WallGeom::of(&wall.shape), velocity: Vec3::ZERO, material: wall.material as u32 }
+                WallState { geom: WallGeom::of(&wall.shape), velocity: Vec3::of(wall.drive.velocity), spin: Vec3::of(wall.drive.angular_velocity), material: wall.material as u32 }
             })
             .collect();
         let n_walls = walls.len();
@@ -71,6 +71,8 @@ impl<T: Real> CpuEngine<T> {
             wall_count: vec![0; n_walls],
             wall_regimes: RegimeCounts::default(),
             wall_response: vec![(T::ZERO, T::ZERO); n_walls],
+            wall_power: vec![T::ZERO; n_walls],
+            driven: scene.walls.iter().enumerate().filter(|(_, w)| w.drive.moves()).map(|(k, _)| k).collect(),
             pairs: PairList::default(),
             hist: Vec::new(),
             share: Vec::new(),

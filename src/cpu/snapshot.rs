@@ -59,6 +59,7 @@ impl<T: Real> CpuEngine<T> {
         s.put_reals("load", self.load.iter().flat_map(|l| [v3(&l.force), v3(&l.torque)].concat()));
         s.put_ints("wall_touch_ids", self.wall_touches.iter().flat_map(|t| [t.grain as u64, t.wall as u64, t.code() as u64]));
         s.put_reals("wall_touches", self.wall_touches.iter().flat_map(|t| [v3(&t.force).as_slice(), &[t.stiffness.f64(), t.damping.f64()]].concat()));
+        s.put_reals("wall_touch_power", self.wall_touches.iter().map(|t| t.power.f64()));
         if T::COMPENSATED {
             s.put_reals("residual", self.residual.iter().flat_map(v3));
         }
@@ -88,6 +89,9 @@ impl<T: Real> CpuEngine<T> {
             v
         });
         s.put_reals("servo", servo);
+        // Where each driven wall has moved to (its centre), and its spin's power.
+        s.put_reals("driven_walls", self.driven.iter().flat_map(|&w| v3(&self.walls[w].geom.centre())));
+        s.put_reals("wall_power", self.wall_power.iter().map(|x| x.f64()));
         let l = &self.pairs;
         for (name, v) in [("owner_start", &l.owner_start), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
             s.put_ints(name, v.iter().map(|&x| x as u64));
@@ -130,12 +134,15 @@ impl<T: Real> CpuEngine<T> {
         }
         let ids = s.ints("wall_touch_ids", None)?;
         let values = s.reals("wall_touches", 5 * ids.len() / 3)?;
+        // Written before walls could spin: no power.
+        let power = s.reals("wall_touch_power", ids.len() / 3).map(<[f64]>::to_vec).unwrap_or_else(|_| vec![0.0; ids.len() / 3]);
         self.wall_touches = ids
             .chunks_exact(3)
             .zip(values.chunks_exact(5))
-            .map(|(i, v)| {
+            .zip(&power)
+            .map(|((i, v), &power)| {
                 let (regime, touching) = WallTouch::<T>::of_code(i[2] as u8);
-                WallTouch { grain: i[0] as u32, wall: i[1] as u32, regime, touching, force: v3(&v[0..3]), stiffness: T::of(v[3]), damping: T::of(v[4]) }
+                WallTouch { grain: i[0] as u32, wall: i[1] as u32, regime, touching, force: v3(&v[0..3]), stiffness: T::of(v[3]), damping: T::of(v[4]), power: T::of(power) }
             })
             .collect();
         // f64 keeps no residuals (and a checkpoint written before there were any still resumes).
@@ -181,6 +188,14 @@ impl<T: Real> CpuEngine<T> {
             sv.strain_rate = (!v[37].is_nan()).then(|| T::of(v[37]));
             self.servo = Some(sv);
         }
+        for (&w, c) in self.driven.iter().zip(s.reals("driven_walls", 3 * self.driven.len())?.chunks_exact(3)) {
+            self.walls[w].geom = self.walls[w].geom.centred_at(v3(c));
+        }
+        // Written before walls could spin: no power.
+        self.wall_power = match s.reals("wall_power", self.walls.len()) {
+            Ok(p) => p.iter().map(|&x| T::of(x)).collect(),
+            Err(_) => vec![T::ZERO; self.walls.len()],
+        };
         self.wall_springs = WallSprings::from_dense(&wall_hist, &self.built_at, &self.prop, &self.walls, self.skin, per_grain);
         let u32s = |name: &str, len: Option<usize>| -> anyhow::Result<Vec<u32>> { Ok(s.ints(name, len)?.iter().map(|&x| x as u32).collect()) };
         let partner = u32s("partner", None)?;

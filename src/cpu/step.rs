@@ -74,6 +74,7 @@ impl<T: Real> CpuEngine<T> {
             self.external_work -= (p.pressure * p.area * dz).f64();
         }
         self.servo_drift(tau);
+        self.drive_walls(tau);
         self.max_moved2 = built_at::with_margin(moved, self.built_margin);
     }
 

@@ -19,6 +19,9 @@ pub struct WallTouch<T> {
     pub stiffness: T,
     /// Normal damping coefficient (N s/m).
     pub damping: T,
+    /// Power (W) the wall's spin gives the grain: the force on the grain dotted with the spin's
+    /// part of the surface velocity at the contact (zero unless the wall spins).
+    pub power: T,
     /// Tangential regime.
     pub regime: Regime,
     /// False for a contact that parted within the window and still pulls
@@ -70,12 +73,13 @@ pub fn wall_contacts<T: Real>(
                 let f_n = parted_normal_force(ctx.model, ctx.wall_coeffs(wall.material, material), &geo, (b.vel - wall.velocity).dot(n), ctx.window);
                 if f_n != T::ZERO {
                     load.force += n * f_n;
-                    touches.push(WallTouch { grain: id, wall: w as u32, force: n * f_n, stiffness: T::ZERO, damping: T::ZERO, regime: Regime::Static, touching: false });
+                    touches.push(WallTouch { grain: id, wall: w as u32, force: n * f_n, stiffness: T::ZERO, damping: T::ZERO, power: T::ZERO, regime: Regime::Static, touching: false });
                 }
             }
             continue;
         }
         let (geo, c, f) = wall_contact(n, dist, b, p, material, wall, ctx, h_slot);
+        let power = if wall.spin == Vec3::ZERO { T::ZERO } else { f.f_i.dot(wall.velocity_at(b.pos - n * dist) - wall.velocity) };
         load.force += f.f_i;
         load.torque += f.t_i;
         touches.push(WallTouch {
@@ -84,6 +88,7 @@ pub fn wall_contacts<T: Real>(
             force: f.f_i,
             stiffness: ctx.model.normal.stiffness(c, &geo),
             damping: normal_damping(&ctx.model.damping, &ctx.model.normal, c, &geo),
+            power,
             regime: f.regime,
             touching: true,
         });

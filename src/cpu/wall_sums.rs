@@ -12,6 +12,8 @@ pub(super) struct WallSums<T> {
     pub(super) count: Vec<u64>,
     /// Sums of the contacts' normal tangent stiffness (N/m) and damping (N s/m).
     pub(super) response: Vec<(T, T)>,
+    /// Power (W) the wall's spin gives the grains.
+    pub(super) power: Vec<T>,
     /// Contacts sliding and rolling, over all walls.
     pub(super) regimes: RegimeCounts,
 }
@@ -26,17 +28,19 @@ pub(super) struct WallRow<T> {
     count: u64,
     /// Summed normal tangent stiffness (N/m) and damping (N s/m).
     response: (T, T),
+    /// Summed spin power (W).
+    power: T,
 }
 
 impl<T: Real> WallRow<T> {
-    const ZERO: Self = WallRow { reaction: Vec3::ZERO, count: 0, response: (T::ZERO, T::ZERO) };
+    const ZERO: Self = WallRow { reaction: Vec3::ZERO, count: 0, response: (T::ZERO, T::ZERO), power: T::ZERO };
 
     fn of(t: &WallTouch<T>) -> Self {
-        WallRow { reaction: -t.force, count: t.touching as u64, response: (t.stiffness, t.damping) }
+        WallRow { reaction: -t.force, count: t.touching as u64, response: (t.stiffness, t.damping), power: t.power }
     }
 
     fn add(self, o: Self) -> Self {
-        WallRow { reaction: self.reaction + o.reaction, count: self.count + o.count, response: (self.response.0 + o.response.0, self.response.1 + o.response.1) }
+        WallRow { reaction: self.reaction + o.reaction, count: self.count + o.count, response: (self.response.0 + o.response.0, self.response.1 + o.response.1), power: self.power + o.power }
     }
 }
 
@@ -50,7 +54,7 @@ impl<T: Real> WallSums<T> {
         for t in touches.iter().filter(|t| t.touching) {
             regimes.count(t.regime);
         }
-        WallSums { reaction: totals.iter().map(|r| r.reaction).collect(), count: totals.iter().map(|r| r.count).collect(), response: totals.iter().map(|r| r.response).collect(), regimes }
+        WallSums { reaction: totals.iter().map(|r| r.reaction).collect(), count: totals.iter().map(|r| r.count).collect(), response: totals.iter().map(|r| r.response).collect(), power: totals.iter().map(|r| r.power).collect(), regimes }
     }
 }
 
@@ -97,6 +101,7 @@ impl<T: Real> WallRow<T> {
             p.reaction -= t.force;
             p.count += t.touching as u64;
             p.response = (p.response.0 + t.stiffness, p.response.1 + t.damping);
+            p.power += t.power;
         }
         absorb(&mut total, &mut part);
         total

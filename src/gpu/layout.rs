@@ -163,8 +163,8 @@ pub struct Wall {
     pub kind: u32,
     /// Material index.
     pub material: u32,
-    /// Padding.
-    pub _pad0: u32,
+    /// 1 where a prescribed motion moves the wall (`velocity`, `drive`'s spin).
+    pub driven: u32,
     /// Padding.
     pub _pad1: u32,
     /// Plane point; cylinder axis (x, y); piston (0, 0, z).
@@ -173,8 +173,9 @@ pub struct Wall {
     pub normal: Vec4,
     /// Velocity (m/s).
     pub velocity: Vec4,
-    /// Piston: mass (kg), area (m^2), target pressure (Pa), external work (J).
-    pub piston: Vec4,
+    /// Piston: mass (kg), area (m^2), target pressure (Pa), external work (J); other walls:
+    /// angular velocity (rad/s) about the axis through the centre, work on the grains (J).
+    pub drive: Vec4,
 }
 
 /// The servo box's control state (WGSL `Servo`).

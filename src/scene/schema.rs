@@ -226,6 +226,11 @@ pub enum WallSpec {
         point: DVec3,
         /// Normal pointing into the domain (any length).
         normal: DVec3,
+        /// Prescribed velocity (m/s). Default 0.
+        velocity: Option<DVec3>,
+        /// Prescribed angular velocity (rad/s), along the normal: the plane spins about the
+        /// normal through `point` (a turntable). Default 0.
+        angular_velocity: Option<DVec3>,
     },
     /// Five or six planes bounding an axis-aligned box; grains live inside.
     Box {
@@ -238,6 +243,8 @@ pub enum WallSpec {
         /// Leave out the top (z = max) plane. Default false.
         #[serde(default)]
         open_top: bool,
+        /// Prescribed velocity of the whole box (m/s). Default 0.
+        velocity: Option<DVec3>,
     },
     /// Vertical cylindrical side wall (axis along z, infinite height); grains live inside.
     Cylinder {
@@ -247,6 +254,11 @@ pub enum WallSpec {
         center: [f64; 2],
         /// Radius (m).
         radius: f64,
+        /// Prescribed velocity (m/s). Default 0.
+        velocity: Option<DVec3>,
+        /// Prescribed angular velocity (rad/s), along z: the cylinder spins about its axis (a
+        /// drum). Default 0.
+        angular_velocity: Option<DVec3>,
     },
     /// Six planes bounding a box, each moved along its normal by a servo that holds a target
     /// pressure: wall speed = gain x (target - measured pressure), capped at `max_speed`

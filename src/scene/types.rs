@@ -150,6 +150,28 @@ pub struct Wall {
     pub shape: WallShape,
     /// Index into [`Scene::materials`].
     pub material: u16,
+    /// Its prescribed motion (zero for a fixed wall, and for the piston's and the servo box's,
+    /// which their controllers move).
+    pub drive: WallDrive,
+}
+
+/// A wall's prescribed motion: it translates at `velocity` and spins at `angular_velocity`
+/// about its own axis of symmetry (a plane about its normal through its point, a cylinder
+/// about its axis), so that its surface stays where the translation takes it while each point
+/// of it moves at `velocity + angular_velocity x (x - centre)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WallDrive {
+    /// Velocity (m/s).
+    pub velocity: DVec3,
+    /// Angular velocity (rad/s).
+    pub angular_velocity: DVec3,
+}
+
+impl WallDrive {
+    /// Whether the wall moves at all.
+    pub fn moves(&self) -> bool {
+        *self != WallDrive::default()
+    }
 }
 
 /// Time integration scheme (Oquendo et al. sec. 3).

@@ -19,11 +19,12 @@ pub(super) fn validate_walls(
     material_of: &dyn Fn(String, &str) -> Result<u16, SceneError>,
 ) -> Result<Vec<PendingWall>, SceneError> {
     let mut out = Vec::new();
-    let plain = |name: String, shape: WallShape, material: u16| PendingWall { wall: Wall { name, shape, material }, piston_mass: None, piston_area: None, servo: None };
+    let driven = |name: String, shape: WallShape, material: u16, drive: WallDrive| PendingWall { wall: Wall { name, shape, material, drive }, piston_mass: None, piston_area: None, servo: None };
+    let plain = |name: String, shape: WallShape, material: u16| driven(name, shape, material, WallDrive::default());
     for (i, w) in f.walls.iter().enumerate() {
         let key = |k: &str| format!("wall[{i}].{k}");
         match w {
-            WallSpec::Plane { material, point, normal } => {
+            WallSpec::Plane { material, point, normal, velocity, angular_velocity } => {
                 let m = material_of(key("material"), material)?;
                 let point = finite3(c, &key("point"), *point)?;
                 let normal = finite3(c, &key("normal"), *normal)?;
@@ -32,9 +33,10 @@ pub(super) fn validate_walls(
                     return Err(c.invalid(key("normal"), format!("{:?}", normal.to_array()), "is the zero vector", "give the direction into the domain, e.g. [0, 0, 1]"));
                 }
                 let normal = DVec3::new(normal[0] / len, normal[1] / len, normal[2] / len);
-                out.push(plain(format!("wall[{i}]"), WallShape::Plane { point, normal }, m));
+                let drive = drive_of(c, i, *velocity, *angular_velocity, normal, "the plane's normal")?;
+                out.push(driven(format!("wall[{i}]"), WallShape::Plane { point, normal }, m, drive));
             }
-            WallSpec::Box { material, min, max, open_top } => {
+            WallSpec::Box { material, min, max, open_top, velocity } => {
                 let m = material_of(key("material"), material)?;
                 let (lo, hi) = (finite3(c, &key("min"), *min)?, finite3(c, &key("max"), *max)?);
                 if (0..3).any(|k| hi[k] <= lo[k]) {
@@ -52,7 +54,8 @@ pub(super) fn validate_walls(
                     if *open_top && face == "top" {
                         continue;
                     }
-                    out.push(plain(format!("wall[{i}].{face}"), WallShape::Plane { point, normal }, m));
+                    let drive = drive_of(c, i, *velocity, None, normal, "")?;
+                    out.push(driven(format!("wall[{i}].{face}"), WallShape::Plane { point, normal }, m, drive));
                 }
             }
             WallSpec::ServoBox { material, min, max, pressure, gain, max_speed } => {
@@ -81,10 +84,11 @@ pub(super) fn validate_walls(
                     out.push(w);
                 }
             }
-            WallSpec::Cylinder { material, center, radius } => {
+            WallSpec::Cylinder { material, center, radius, velocity, angular_velocity } => {
                 let m = material_of(key("material"), material)?;
                 let radius = positive(c, &key("radius"), *radius, "give the radius in metres")?;
-                out.push(plain(format!("wall[{i}]"), WallShape::Cylinder { center: *center, radius }, m));
+                let drive = drive_of(c, i, *velocity, *angular_velocity, DVec3::Z, "the cylinder's axis (z)")?;
+                out.push(driven(format!("wall[{i}]"), WallShape::Cylinder { center: *center, radius }, m, drive));
             }
             WallSpec::Piston { material, z, pressure, mass, area } => {
                 let m = material_of(key("material"), material)?;
@@ -98,7 +102,7 @@ pub(super) fn validate_walls(
                     return Err(c.invalid(key("type"), "\"piston\"", "a scene has at most one piston", "remove the extra piston"));
                 }
                 out.push(PendingWall {
-                    wall: Wall { name: format!("wall[{i}]"), shape: WallShape::Piston { z: *z, pressure, mass: 0.0, area: 0.0 }, material: m },
+                    wall: Wall { name: format!("wall[{i}]"), shape: WallShape::Piston { z: *z, pressure, mass: 0.0, area: 0.0 }, material: m, drive: WallDrive::default() },
                     piston_mass,
                     piston_area,
                     servo: None,
@@ -107,6 +111,28 @@ pub(super) fn validate_walls(
         }
     }
     Ok(out)
+}
+
+/// Largest sine of the angle between a wall's angular velocity and its axis of symmetry: a
+/// spin off the axis would turn the surface, which a wall cannot do yet.
+const SPIN_OFF_AXIS: f64 = 1e-9;
+
+/// The prescribed motion of `wall[i]`: `velocity` and `angular_velocity` (finite; the spin
+/// along `axis`, the wall's axis of symmetry, named `axis_name` in the error; none allowed
+/// where `axis_name` is empty).
+fn drive_of(c: &Complainer, i: usize, velocity: Option<DVec3>, angular_velocity: Option<DVec3>, axis: DVec3, axis_name: &str) -> Result<WallDrive, SceneError> {
+    let key = |k: &str| format!("wall[{i}].{k}");
+    let velocity = velocity.map(|v| finite3(c, &key("velocity"), v)).transpose()?.unwrap_or_default();
+    let angular_velocity = angular_velocity.map(|w| finite3(c, &key("angular_velocity"), w)).transpose()?.unwrap_or_default();
+    if angular_velocity.cross(axis).length() > SPIN_OFF_AXIS * angular_velocity.length() {
+        return Err(c.invalid(
+            key("angular_velocity"),
+            format!("{:?}", angular_velocity.to_array()),
+            format!("is not along {axis_name} {:?}: the wall spins about its own axis only", axis.to_array()),
+            format!("give a multiple of {:?} (rad/s)", axis.to_array()),
+        ));
+    }
+    Ok(WallDrive { velocity, angular_velocity })
 }
 
 /// Fills in the piston's default mass (total grain mass) and area (cross-section of the

@@ -15,18 +15,32 @@ pub struct WallState<T> {
     pub geom: WallGeom<T>,
     /// Velocity (m/s).
     pub velocity: Vec3<T>,
+    /// Angular velocity (rad/s) about its axis of symmetry through [`WallGeom::centre`]; zero
+    /// but for a driven wall that spins (`crate::scene::WallDrive`).
+    pub spin: Vec3<T>,
     /// Material index.
     pub material: u32,
 }
 
+impl<T: Real> WallState<T> {
+    /// The velocity (m/s) of the wall's surface at `x` (m): its velocity, plus `spin x (x -
+    /// centre)` where it spins.
+    #[inline(always)]
+    pub fn velocity_at(&self, x: Vec3<T>) -> Vec3<T> {
+        if self.spin == Vec3::ZERO { self.velocity } else { self.velocity + self.spin.cross(x - self.geom.centre()) }
+    }
+}
+
 /// The contact of a grain of material `material` with a wall it touches, seen from the wall's
 /// frame (`n`, `dist`: [`WallGeom::frame`]): its geometry, coefficients and force; the history
-/// in `h_slot` advances by `ctx.elapsed`.
+/// in `h_slot` advances by `ctx.elapsed`. The wall moves at its surface velocity where the
+/// grain's centre projects onto it ([`WallState::velocity_at`]) and turns at its spin.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, material: usize, wall: &WallState<T>, ctx: &ForceContext<'c, T>, h_slot: &mut [T]) -> (Geometry<T>, &'c PairCoeffs<T>, ContactForce<T>) {
     let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
-    let kin = Kinematics { v_i: b.vel, v_j: wall.velocity, w_i: b.omega, w_j: Vec3::ZERO };
+    // The wall's surface velocity where the grain's centre projects onto it.
+    let kin = Kinematics { v_i: b.vel, v_j: wall.velocity_at(b.pos - n * dist), w_i: b.omega, w_j: wall.spin };
     let bodies = Bodies { m_i: p.mass, inertia_i: p.inertia, j_is_wall: true, ..Default::default() };
     let c = ctx.wall_coeffs(wall.material, material);
     let mut h = ctx.slots.load(h_slot);

@@ -108,7 +108,9 @@ impl GpuEngine {
             ("CENTRED_KICKS", crate::schedule::centred_kicks(scene.integrator) as u8 as f64),
         ];
         let orientation = ("TRACK_ORIENTATION", self.track_orientation as u8 as f64);
-        let wall_response = ("WALL_RESPONSE", self.servo.is_some() as u8 as f64);
+        // The servo reads its walls' stiffness and damping, a spinning wall's work its power.
+        let spins = scene.walls.iter().any(|w| w.drive.angular_velocity != glam::DVec3::ZERO);
+        let wall_response = ("WALL_RESPONSE", (self.servo.is_some() || spins) as u8 as f64);
         let partner_force = ("PARTNER_FORCE_STORED", m.keeps_both_forces() as u8 as f64);
         (self.layouts, self.pipelines) = StepKernel::ALL
             .iter()

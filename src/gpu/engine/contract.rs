@@ -108,7 +108,7 @@ impl Engine for GpuEngine {
 
     fn set_piston_pressure(&mut self, pressure: f64) {
         if let Some(w) = self.piston {
-            let offset = (w * std::mem::size_of::<layout::Wall>() + std::mem::offset_of!(layout::Wall, piston) + 8) as u64;
+            let offset = (w * std::mem::size_of::<layout::Wall>() + std::mem::offset_of!(layout::Wall, drive) + 8) as u64;
             self.gpu.queue.write_buffer(&self.buffers[Buf::Walls], offset, bytemuck::bytes_of(&(pressure as f32)));
         }
     }

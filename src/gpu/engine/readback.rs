@@ -251,8 +251,8 @@ impl GpuEngine {
             PistonStats {
                 z: wall.point[2] as f64,
                 velocity: wall.velocity[2] as f64,
-                target_pressure: wall.piston[2] as f64,
-                pressure: reaction[w][2] as f64 / wall.piston[1] as f64,
+                target_pressure: wall.drive[2] as f64,
+                pressure: reaction[w][2] as f64 / wall.drive[1] as f64,
             }
         });
         Ok(Stats {
@@ -263,8 +263,9 @@ impl GpuEngine {
             elastic_energy: p(pr::ELASTIC) + g(gr::WALL_ELASTIC),
             capillary_energy,
             gravity_energy: g(gr::PE_G),
-            piston_ke: self.piston.map_or(0.0, |w| 0.5 * walls[w].piston[0] as f64 * (walls[w].velocity[2] as f64).powi(2)),
-            external_work: self.piston.map_or(0.0, |w| walls[w].piston[3] as f64) + servo.work as f64 + servo.work_lo as f64,
+            piston_ke: self.piston.map_or(0.0, |w| 0.5 * walls[w].drive[0] as f64 * (walls[w].velocity[2] as f64).powi(2)),
+            // The piston's and the driven walls' work, booked in their `drive.w`.
+            external_work: walls.iter().map(|w| w.drive[3] as f64).sum::<f64>() + servo.work as f64 + servo.work_lo as f64,
             momentum: [0, 1, 2].map(|a| g(gr::MOMENTUM + a)),
             angular_momentum: [0, 1, 2].map(|a| g(gr::ANGULAR + a)),
             pairs: control.n_pairs as u64,

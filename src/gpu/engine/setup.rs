@@ -88,9 +88,15 @@ pub(super) fn walls_of(scene: &Scene) -> (Vec<layout::Wall>, Option<usize>) {
                 WallShape::Piston { z, pressure, mass, area } => {
                     g.kind = layout::wall_kind::PISTON;
                     g.point = Vec4::new(0.0, 0.0, z as f32, 0.0);
-                    g.piston = Vec4::new(mass as f32, area as f32, pressure as f32, 0.0);
+                    g.drive = Vec4::new(mass as f32, area as f32, pressure as f32, 0.0);
                     piston = Some(w);
                 }
+            }
+            if wall.drive.moves() {
+                let (v, w) = (wall.drive.velocity, wall.drive.angular_velocity);
+                g.driven = 1;
+                g.velocity = Vec4::new(v[0] as f32, v[1] as f32, v[2] as f32, 0.0);
+                g.drive = Vec4::new(w[0] as f32, w[1] as f32, w[2] as f32, 0.0);
             }
             g
         })

@@ -81,6 +81,7 @@ impl GpuEngine {
             .map(|w| WallState {
                 geom: wall_geom(w),
                 velocity: Vec3::new(w.velocity.x, w.velocity.y, w.velocity.z),
+                spin: if w.driven == 1 { Vec3::new(w.drive.x, w.drive.y, w.drive.z) } else { Vec3::ZERO },
                 material: w.material,
             })
             .collect();
