@@ -471,6 +471,9 @@ pub trait Engine {
     /// Sets the servo walls' target pressure (Pa, when given) and switches the z walls to a
     /// fixed strain rate (1/s, positive closing) or back to pressure control (`None`).
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>);
+    /// Sets wall `wall` (an index into the scene's walls: a plane or a cylinder, not the piston
+    /// or a servo plane) moving as `drive` says from now on.
+    fn set_wall_drive(&mut self, wall: usize, drive: &crate::scene::WallDrive);
     /// Wets the sample with `volume` (m^3) of liquid: shared among the pairs closer than their
     /// rupture distance in proportion to their reduced diameter (Richefeu et al. (2009), docs/physics.md).
     fn wet(&mut self, volume: f64) -> anyhow::Result<()>;

@@ -184,6 +184,18 @@ fn malformed_scenes_get_one_line_naming_the_key_and_the_fix() {
         ("cylinder_tumbling.toml", base.replace("[model]", &wall("type = \"cylinder\"\ncenter = [0.0, 0.0]\nradius = 0.01\nangular_velocity = [0.0, 2.0, 0.0]")), "wall[0].angular_velocity = [0.0, 2.0, 0.0]: is not along the cylinder's axis (z)"),
         ("box_spinning.toml", base.replace("[model]", &wall("type = \"box\"\nmin = [-0.01, -0.01, -0.01]\nmax = [0.01, 0.01, 0.01]\nangular_velocity = [0.0, 0.0, 1.0]")), "angular_velocity"),
         ("wall_velocity_nan.toml", base.replace("[model]", &wall("type = \"plane\"\npoint = [0.0, 0.0, -1.0e-3]\nnormal = [0.0, 0.0, 1.0]\nvelocity = [nan, 0.0, 0.0]")), "wall[0].velocity"),
+        ("wall_name_dotted.toml", base.replace("[model]", &wall("name = \"a.b\"\ntype = \"plane\"\npoint = [0.0, 0.0, -1.0e-3]\nnormal = [0.0, 0.0, 1.0]")), "wall[0].name = \"a.b\": must be a word"),
+        ("stage_unknown_wall.toml", base.replace("kind = \"run\"", "kind = \"run\"\nwalls = { gate = { velocity = [0.0, 0.0, 1.0] } }"), "stage[0].walls = \"gate\": names no wall"),
+        (
+            "stage_moves_piston.toml",
+            oedometer().replacen("[[stage]]\n", "[[stage]]\nwalls = { \"wall[2]\" = { velocity = [0.0, 0.0, 1.0] } }\n", 1),
+            "stage[0].walls = \"wall[2]\": wall[2] is moved by its controller",
+        ),
+        (
+            "stage_spins_box.toml",
+            base.replace("[model]", &wall("name = \"bin\"\ntype = \"box\"\nmin = [-0.01, -0.01, -0.01]\nmax = [0.01, 0.01, 0.01]")).replace("kind = \"run\"", "kind = \"run\"\nwalls = { bin = { angular_velocity = [0.0, 0.0, 1.0] } }"),
+            "stage[0].walls.bin.angular_velocity = [0.0, 0.0, 1.0]: is given to a box",
+        ),
         ("pair_unknown_material.toml", base.replace("[model]", &pair("\"glass\", \"steel\"", "mu_s = 0.1")), "pair[0].materials = \"steel\": names no [[material]]"),
         ("pair_twice.toml", base.replace("[model]", &pair("\"glass\", \"glass\"", "mu_s = 0.1")).replacen("[model]", &pair("\"glass\", \"glass\"", "mu_s = 0.2"), 1), "names the same pair as pair[0]"),
         ("pair_empty.toml", base.replace("[model]", &pair("\"glass\", \"glass\"", "")), "pair[0] = [\"glass\", \"glass\"]: gives no coefficient"),

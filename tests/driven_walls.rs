@@ -1,6 +1,7 @@
-//! Walls with a prescribed motion (`velocity`, `angular_velocity` on `[[wall]]`): a grain
-//! dropped at rest on a conveyor leaves it rolling at 2/7 of the belt's speed, the belt having
-//! done `(2/7) m v^2` of work; a plane driven along its normal into a grain at rest throws it at
+//! Walls with a prescribed motion (`velocity`, `angular_velocity` on `[[wall]]`, or set by a
+//! stage's `walls`): a grain dropped at rest on a conveyor leaves it rolling at 2/7 of the
+//! belt's speed, the belt having done `(2/7) m v^2` of work, and comes to rest when a later
+//! stage stops the belt; a plane driven along its normal into a grain at rest throws it at
 //! `(1 + e) v`; a grain pressed against a spinning drum slides at first at `mu g` along the
 //! drum's surface velocity, the drum's spin doing `mu m g (omega R) t` of work. The GPU runs
 //! them as its CPU f32 twin does, and a checkpoint taken while a wall moves resumes bitwise.
@@ -9,6 +10,8 @@ mod common;
 
 use grains::cpu::CpuEngine;
 use grains::engine::Engine;
+use grains::output::RunRecorder;
+use grains::protocol;
 use grains::scene::Scene;
 
 const R: f64 = 2.5e-3;
@@ -21,17 +24,21 @@ fn mass() -> f64 {
 }
 
 /// One glass grain at `x` (m) beside `wall` (a `[[wall]]` table's keys), gravity `gravity`
-/// (m/s^2), restitution `e`, Hertz-Mindlin friction [`MU`].
+/// (m/s^2), restitution `e`, Hertz-Mindlin friction [`MU`], one stage of `duration` (s).
 fn scene(wall: &str, x: [f64; 3], gravity: [f64; 3], e: f64, duration: f64) -> Scene {
-    common::parse(&format!(
+    common::parse(&scene_text(wall, x, gravity, e, &format!("[[stage]]\nkind = \"run\"\nduration = {duration:e}\n")))
+}
+
+/// [`scene`]'s text with `stages` (`[[stage]]` tables).
+fn scene_text(wall: &str, x: [f64; 3], gravity: [f64; 3], e: f64, stages: &str) -> String {
+    format!(
         "[[material]]\nname = \"glass\"\ndensity = {RHO}\nyoungs_modulus = 6.3e10\npoisson_ratio = 0.24\nmu_s = {MU}\nrestitution = {e}\n\n\
          [[wall]]\nmaterial = \"glass\"\n{wall}\n\n\
          [[grain]]\nmaterial = \"glass\"\nradius = {R:e}\nposition = [{:e}, {:e}, {:e}]\n\n\
          [model]\nnormal = \"hertz\"\ndamping = \"restitution\"\ntangential = \"mindlin\"\n\n\
-         [simulation]\ngravity = [{:e}, {:e}, {:e}]\ndt = \"auto\"\nexpected_speed = 1.0\n\n\
-         [[stage]]\nkind = \"run\"\nduration = {duration:e}\n",
+         [simulation]\ngravity = [{:e}, {:e}, {:e}]\ndt = \"auto\"\nexpected_speed = 1.0\n\n{stages}",
         x[0], x[1], x[2], gravity[0], gravity[1], gravity[2]
-    ))
+    )
 }
 
 /// The belt: a floor moving along x at [`BELT`] m/s.
@@ -115,18 +122,46 @@ fn a_grain_on_a_spinning_drum_is_dragged_along_the_drums_surface() {
     assert!((st.external_work / work - 1.0).abs() < 1e-2, "{}", st.external_work);
 }
 
+/// A belt that stages start and stop: still for 5 ms while the grain settles, at [`BELT`] for
+/// `moving` (s), then still again for `stopped` (s).
+fn staged_belt(moving: f64, stopped: f64) -> Scene {
+    let wall = "name = \"belt\"\ntype = \"plane\"\npoint = [0.0, 0.0, 0.0]\nnormal = [0.0, 0.0, 1.0]";
+    let mut stages = format!("[[stage]]\nkind = \"run\"\nduration = 5e-3\n\n[[stage]]\nkind = \"run\"\nduration = {moving:e}\nwalls = {{ belt = {{ velocity = [{BELT}, 0.0, 0.0] }} }}\n");
+    if stopped > 0.0 {
+        stages += &format!("\n[[stage]]\nkind = \"run\"\nduration = {stopped:e}\nwalls = {{ belt = {{}} }}\n");
+    }
+    common::parse(&scene_text(wall, [0.0, 0.0, R], [0.0, 0.0, -G], 0.5, &stages))
+}
+
+/// Stages start and stop the belt: the grain leaves rolling at 2/7 of its speed, and when the
+/// belt stops, its angular momentum about the contact, `I omega + m R v` = 0 at that moment,
+/// brings it to rest; the belt moved only while its stage ran.
+#[test]
+fn stages_start_and_stop_a_belt() {
+    for (stopped, want) in [(0.0, 2.0 / 7.0 * BELT), (0.06, 0.0)] {
+        let s = staged_belt(0.06, stopped);
+        let mut e: CpuEngine<f64> = common::engine(&s);
+        protocol::run(&s, &mut e, &mut RunRecorder::new(None, false).unwrap()).unwrap();
+        let f = e.frame(false).unwrap();
+        let grains::walls::WallGeom::Plane { point, .. } = f.walls[0] else { panic!("{:?}", f.walls[0]) };
+        let moved = s.stages[1].max_steps(s.time_step.dt) as f64 * s.time_step.dt * BELT;
+        println!("after {} stages: grain v = {:?} m/s, omega = {:?} rad/s; the belt moved {} m against {moved}", s.stages.len(), f.velocity[0], f.angular_velocity[0], point.x);
+        assert!((f.velocity[0].x - want).abs() < 1e-3 * BELT, "v_x = {} against {want}", f.velocity[0].x);
+        assert!((point.x - moved).abs() < 1e-12, "the belt stands at {}", point.x);
+    }
+}
+
 /// The GPU moves the walls and reads their surface velocities as its CPU f32 twin does
 /// (bitwise on a software adapter), and books the same work.
 #[test]
 fn driven_walls_run_on_the_gpu_as_on_the_cpu() {
     const F32_TOLERANCE: f64 = 1e-5;
-    for (name, s) in [("conveyor", conveyor(2e-3)), ("pushed", pushed(1e-3)), ("drum", drum(2e-3))] {
+    for (name, s) in [("conveyor", conveyor(2e-3)), ("pushed", pushed(1e-3)), ("drum", drum(2e-3)), ("staged belt", staged_belt(1e-3, 1e-3))] {
         let Some(mut g) = common::gpu_engine(&s) else { return };
         let exact = g.adapter().device_type == wgpu::DeviceType::Cpu;
         let mut c: CpuEngine<f32> = common::engine(&s);
-        let n = steps(&s, s.stages[0].duration);
-        g.advance(n).unwrap();
-        c.advance(n).unwrap();
+        protocol::run(&s, &mut g, &mut RunRecorder::new(None, false).unwrap()).unwrap();
+        protocol::run(&s, &mut c, &mut RunRecorder::new(None, false).unwrap()).unwrap();
         let (fg, fc) = (g.frame(false).unwrap(), c.frame(false).unwrap());
         let (wg, wc) = (g.stats().unwrap().external_work, c.stats().unwrap().external_work);
         println!("{name}: gpu v {:?}, cpu v {:?}; work {wg:e} / {wc:e} J; walls {:?} / {:?}", fg.velocity[0], fc.velocity[0], fg.walls[0], fc.walls[0]);
@@ -146,7 +181,8 @@ fn driven_walls_run_on_the_gpu_as_on_the_cpu() {
 }
 
 /// A checkpoint taken while the belt and the pushing plane move resumes to the uninterrupted
-/// run's bits: the walls where they were, the work booked, on the CPU and the GPU.
+/// run's bits: the walls where they were, the work booked, on the CPU and the GPU; and the
+/// motion a stage set (here set as a stage would) comes back with it.
 #[test]
 fn a_run_with_driven_walls_resumes_bitwise() {
     type Maker = Box<dyn Fn(&Scene) -> Option<Box<dyn Engine>>>;
@@ -154,12 +190,19 @@ fn a_run_with_driven_walls_resumes_bitwise() {
     if common::gpu().is_some() {
         makers.push(("gpu", Box::new(|s| common::gpu_engine(s).map(|g| Box::new(g) as Box<dyn Engine>))));
     }
-    for s in [conveyor(2e-3), pushed(1e-3)] {
+    let spinning = grains::scene::WallDrive { velocity: glam::DVec3::ZERO, angular_velocity: glam::DVec3::new(0.0, 0.0, OMEGA) };
+    for (s, set) in [(conveyor(2e-3), None), (pushed(1e-3), None), (drum(2e-3), Some(spinning))] {
         for (name, make) in &makers {
             let n = steps(&s, s.stages[0].duration);
             let mut whole = make(&s).unwrap();
-            whole.advance(n).unwrap();
             let mut first = make(&s).unwrap();
+            if let Some(d) = &set {
+                // The drum spun twice as fast by a "stage".
+                let faster = grains::scene::WallDrive { angular_velocity: 2.0 * d.angular_velocity, ..*d };
+                whole.set_wall_drive(0, &faster);
+                first.set_wall_drive(0, &faster);
+            }
+            whole.advance(n).unwrap();
             first.advance(n / 3).unwrap();
             let saved = first.save().unwrap();
             let mut resumed = make(&s).unwrap();

@@ -21,7 +21,7 @@ import math
 import os
 import sys
 from pathlib import Path
-from typing import Any, Callable, Dict, List, Optional, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -163,6 +163,12 @@ class Simulation:
     def set_piston_pressure(self, pressure: float) -> None:
         """Sets the piston's target pressure (Pa)."""
         self._sim.set_piston_pressure(float(pressure))
+
+    def set_wall_motion(self, name: str, velocity: Sequence[float] = (0.0, 0.0, 0.0), angular_velocity: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
+        """Sets wall ``name`` (a plane or a cylinder, or a box for every face) moving at
+        ``velocity`` (m/s) and spinning at ``angular_velocity`` (rad/s) about its own axis from
+        now on, as a stage's ``walls`` does; raises SceneError for a wall it cannot move."""
+        self._sim.set_wall_motion(name, [float(v) for v in velocity], [float(w) for w in angular_velocity])
 
     def set_servo(self, pressure: Optional[float] = None, axial_strain_rate: Optional[float] = None) -> None:
         """Sets the servo walls' target pressure (Pa) and the z walls' strain rate (1/s,

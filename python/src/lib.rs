@@ -402,6 +402,19 @@ impl Simulation {
         Ok(())
     }
 
+    /// Sets wall `name` (a plane or a cylinder by its name, a box by its name for every face)
+    /// moving at `velocity` (m/s) and spinning at `angular_velocity` (rad/s) about its axis from
+    /// now on, checked as a stage's `walls` are.
+    #[pyo3(signature = (name, velocity = [0.0; 3], angular_velocity = [0.0; 3]))]
+    fn set_wall_motion(&self, name: &str, velocity: [f64; 3], angular_velocity: [f64; 3]) -> PyResult<()> {
+        let mut sim = self.lock()?;
+        let drives = sim.scene.wall_drives("set_wall_motion", name, velocity.into(), angular_velocity.into()).map_err(scene_err)?;
+        for (wall, drive) in &drives {
+            sim.engine.set_wall_drive(*wall, drive);
+        }
+        Ok(())
+    }
+
     /// Sets the servo walls' target pressure (Pa, when given) and the z walls' strain rate
     /// (1/s, positive closing; None: back to pressure control).
     #[pyo3(signature = (pressure = None, axial_strain_rate = None))]

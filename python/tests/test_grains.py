@@ -128,6 +128,27 @@ def test_a_parameter_set_from_python_runs_as_the_same_toml_edit(tmp_path: Path) 
     assert (tmp_path / "plain" / "stats.csv").read_bytes() != (tmp_path / "py" / "stats.csv").read_bytes()
 
 
+def test_a_wall_set_moving_from_python_moves_as_a_stages_walls_do(tmp_path: Path) -> None:
+    """The small scene's box given a name: its second stage moving the box by its `walls` key
+    (run by the command line) and the same motion set from Python between the stages end in the
+    same files; a name that moves nothing raises SceneError naming it."""
+    path = small_scene(tmp_path)
+    text = path.read_text().replace('type = "box"', 'type = "box"\nname = "bin"')
+    named = tmp_path / "named.toml"
+    named.write_text(text)
+    staged = tmp_path / "staged.toml"
+    staged.write_text(text.replace('name = "hold"', 'name = "hold"\nwalls = { bin = { velocity = [0.02, 0.0, 0.0] } }'))
+    done = run_cli("run", str(staged), "--out", str(tmp_path / "cli"), "--json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    sim = grains.Simulation(grains.Scene.load(named), out=tmp_path / "py", progress=False)
+    sim.run_stage()
+    sim.set_wall_motion("bin", velocity=(0.02, 0.0, 0.0))
+    sim.run()
+    same_files(tmp_path / "cli", tmp_path / "py")
+    with pytest.raises(grains.SceneError, match=r'set_wall_motion = "gate": names no wall'):
+        sim.set_wall_motion("gate", velocity=(1.0, 0.0, 0.0))
+
+
 def test_bad_scenes_raise_the_named_errors_with_the_clis_message(tmp_path: Path) -> None:
     """A negative friction coefficient: SceneError with the message `grains check` prints; a
     path that names nothing: KeyError; an invalid value set is not kept."""

@@ -263,6 +263,10 @@ impl<T: Real> Engine for ContactDynamics<T> {
         Ok(())
     }
 
+    fn set_wall_drive(&mut self, _wall: usize, _drive: &crate::scene::WallDrive) {
+        // Contact-dynamics scenes have no moving walls (refused at `ContactDynamics::new`).
+    }
+
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
         if let Some(s) = &mut self.servo {
             if let Some(p) = pressure {

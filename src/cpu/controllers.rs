@@ -91,6 +91,9 @@ impl<T: Real> CpuEngine<T> {
     pub(super) fn drive_walls(&mut self, tau: T) {
         for &w in &self.driven {
             let wall = &mut self.walls[w];
+            if wall.velocity == Vec3::ZERO && wall.spin == Vec3::ZERO {
+                continue;
+            }
             wall.geom = wall.geom.translated(wall.velocity * tau);
             self.external_work += ((self.wall_power[w] - self.wall_reaction[w].dot(wall.velocity)) * tau).f64();
         }

@@ -134,7 +134,8 @@ pub struct CpuEngine<T: Real> {
     wall_response: Vec<(T, T)>,
     /// Power (W) each wall's spin gives the grains at the last force evaluation.
     wall_power: Vec<T>,
-    /// The walls with a prescribed motion (`crate::scene::WallDrive`), which each drift moves.
+    /// The walls a prescribed motion may move (`crate::scene::WallDrive`: every wall but the
+    /// piston and the servo box's planes); each drift moves those that move.
     driven: Vec<usize>,
     // Pairs.
     pairs: PairList,
@@ -306,6 +307,12 @@ impl<T: Real> Engine for CpuEngine<T> {
         if let Some(p) = &mut self.piston {
             p.pressure = T::of(pressure);
         }
+    }
+
+    fn set_wall_drive(&mut self, wall: usize, drive: &crate::scene::WallDrive) {
+        debug_assert!(self.driven.contains(&wall), "wall {wall} is moved by a controller");
+        self.walls[wall].velocity = Vec3::of(drive.velocity);
+        self.walls[wall].spin = Vec3::of(drive.angular_velocity);
     }
 
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {

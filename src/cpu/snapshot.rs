@@ -89,8 +89,9 @@ impl<T: Real> CpuEngine<T> {
             v
         });
         s.put_reals("servo", servo);
-        // Where each driven wall has moved to (its centre), and its spin's power.
-        s.put_reals("driven_walls", self.driven.iter().flat_map(|&w| v3(&self.walls[w].geom.centre())));
+        // Where each wall a prescribed motion may move stands (its centre), its velocity and
+        // spin; and the spins' power.
+        s.put_reals("driven_walls", self.driven.iter().flat_map(|&w| [v3(&self.walls[w].geom.centre()), v3(&self.walls[w].velocity), v3(&self.walls[w].spin)].concat()));
         s.put_reals("wall_power", self.wall_power.iter().map(|x| x.f64()));
         let l = &self.pairs;
         for (name, v) in [("owner_start", &l.owner_start), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
@@ -188,8 +189,9 @@ impl<T: Real> CpuEngine<T> {
             sv.strain_rate = (!v[37].is_nan()).then(|| T::of(v[37]));
             self.servo = Some(sv);
         }
-        for (&w, c) in self.driven.iter().zip(s.reals("driven_walls", 3 * self.driven.len())?.chunks_exact(3)) {
-            self.walls[w].geom = self.walls[w].geom.centred_at(v3(c));
+        for (&w, c) in self.driven.iter().zip(s.reals("driven_walls", 9 * self.driven.len())?.chunks_exact(9)) {
+            let wall = &mut self.walls[w];
+            (wall.geom, wall.velocity, wall.spin) = (wall.geom.centred_at(v3(&c[0..3])), v3(&c[3..6]), v3(&c[6..9]));
         }
         // Written before walls could spin: no power.
         self.wall_power = match s.reals("wall_power", self.walls.len()) {

@@ -193,7 +193,8 @@ pub fn run_next_stage<'p>(scene: &Scene, engine: &mut dyn Engine, rec: &mut dyn 
     Ok(progress.results.last())
 }
 
-/// Sets stage `stage` up on the engine (pressures, liquid, the piston lowered), returning
+/// Sets stage `stage` up on the engine (pressures, liquid, the walls it moves, the piston
+/// lowered), returning
 /// where it starts.
 fn start_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine) -> anyhow::Result<StageProgress> {
     if let Some(p) = stage.piston_pressure {
@@ -204,6 +205,9 @@ fn start_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine) -> anyhow:
     }
     if scene.servo.is_some() {
         engine.set_servo(stage.servo_pressure, stage.axial_strain_rate);
+    }
+    for (wall, drive) in &stage.walls {
+        engine.set_wall_drive(*wall, drive);
     }
     let mut initial_void_ratio = None;
     if stage.lower_piston {

@@ -146,7 +146,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         Some(v) => positive(&c, "model.liquid_density", v, "give the liquid's density in kg/m^3, e.g. 1000")?,
         None => DEFAULT_LIQUID_DENSITY,
     };
-    let stages = validate_stages(&c, &f.stages, &grains, gravity, d_mean, &walls, servo.is_some(), liquid_density)?;
+    let stages = validate_stages(&c, &f.stages, &grains, gravity, d_mean, &walls, servo, liquid_density)?;
     let bridges = bridge_limits(&c, &model, &stages, &grains)?;
     let output = Output {
         frame_interval: non_negative(&c, "output.frame_interval", f.output.frame_interval, "give seconds, or 0 for a frame per stage")?,

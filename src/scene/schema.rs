@@ -220,6 +220,8 @@ pub enum RegionSpec {
 pub enum WallSpec {
     /// Infinite plane; grains live on the side its normal points to.
     Plane {
+        /// Name that stages use (default `wall[i]`).
+        name: Option<String>,
         /// Material name.
         material: String,
         /// A point on the plane (m).
@@ -234,6 +236,9 @@ pub enum WallSpec {
     },
     /// Five or six planes bounding an axis-aligned box; grains live inside.
     Box {
+        /// Name that stages use for the whole box (default `wall[i]`; its faces are
+        /// `NAME.bottom`, `NAME.x_min`, ...).
+        name: Option<String>,
         /// Material name.
         material: String,
         /// Lower corner (m).
@@ -248,6 +253,8 @@ pub enum WallSpec {
     },
     /// Vertical cylindrical side wall (axis along z, infinite height); grains live inside.
     Cylinder {
+        /// Name that stages use (default `wall[i]`).
+        name: Option<String>,
         /// Material name.
         material: String,
         /// Axis position (x, y) (m).
@@ -509,6 +516,21 @@ pub struct StageSpec {
     /// Settle stages with a piston pressure, and oedometer steps: the piston's measured
     /// pressure must also be within this fraction of its target. Default 0.01.
     pub pressure_tolerance: Option<f64>,
+    /// Walls (planes, boxes, cylinders) this stage sets moving, by name: each one's velocity
+    /// and angular velocity from the stage's start on (a key left out is zero); walls not named
+    /// keep their motion.
+    #[serde(default)]
+    pub walls: std::collections::BTreeMap<String, WallDriveSpec>,
+}
+
+/// A stage's motion for one wall (`[[stage]] walls = { gate = { velocity = [...] } }`).
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallDriveSpec {
+    /// Velocity (m/s). Default 0.
+    pub velocity: Option<DVec3>,
+    /// Angular velocity (rad/s) about the wall's axis of symmetry. Default 0.
+    pub angular_velocity: Option<DVec3>,
 }
 
 /// `[output]`.

@@ -2,6 +2,7 @@
 //! targets checked against the scene's walls and gravity.
 
 use super::*;
+use super::wall_specs::stage_drives;
 
 pub(super) fn validate_stages(
     c: &Complainer,
@@ -10,9 +11,10 @@ pub(super) fn validate_stages(
     gravity: glam::DVec3,
     d_mean: f64,
     walls: &[Wall],
-    has_servo: bool,
+    servo: Option<ServoBox>,
     liquid_density: f64,
 ) -> Result<Vec<Stage>, SceneError> {
+    let has_servo = servo.is_some();
     let g = (gravity[0] * gravity[0] + gravity[1] * gravity[1] + gravity[2] * gravity[2]).sqrt();
     let m_mean = grains.mass.iter().sum::<f64>() / grains.len() as f64;
     let has_piston = walls.iter().any(|w| matches!(w.shape, WallShape::Piston { .. }));
@@ -88,6 +90,7 @@ pub(super) fn validate_stages(
                 Some(r) if !r.is_finite() => return Err(c.invalid(key("axial_strain_rate"), r, "must be finite", "give a strain rate in 1/s, positive to compress")),
                 other => other,
             },
+            walls: stage_drives(c, i, &s.walls, walls, servo)?,
             wet_volume: match s.water_content {
                 Some(w) => Some(positive(c, &key("water_content"), w, "give the gravimetric water content, e.g. 0.007")? * grains.mass.iter().sum::<f64>() / liquid_density),
                 None => None,

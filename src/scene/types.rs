@@ -240,6 +240,8 @@ pub struct Stage {
     pub servo_pressure: Option<f64>,
     /// Triaxial: strain rate (1/s) of the servo box's z walls, or `None` for all-servo.
     pub axial_strain_rate: Option<f64>,
+    /// Walls (indices into [`Scene::walls`]) set moving at the start, with their motion.
+    pub walls: Vec<(usize, WallDrive)>,
 }
 
 /// What `--out` records.

@@ -23,8 +23,22 @@ pub(super) fn validate_walls(
     let plain = |name: String, shape: WallShape, material: u16| driven(name, shape, material, WallDrive::default());
     for (i, w) in f.walls.iter().enumerate() {
         let key = |k: &str| format!("wall[{i}].{k}");
+        let name = match w {
+            WallSpec::Plane { name, .. } | WallSpec::Box { name, .. } | WallSpec::Cylinder { name, .. } => name.as_deref(),
+            _ => None,
+        };
+        let name = match name {
+            Some(n) if n.is_empty() || n.contains('.') || n.contains('[') => {
+                return Err(c.invalid(key("name"), format!("\"{n}\""), "must be a word without dots or brackets", "give a name such as \"gate\""));
+            }
+            Some(n) if f.walls[..i].iter().any(|o| matches!(o, WallSpec::Plane { name: Some(m), .. } | WallSpec::Box { name: Some(m), .. } | WallSpec::Cylinder { name: Some(m), .. } if m == n)) => {
+                return Err(c.invalid(key("name"), format!("\"{n}\""), "is used by an earlier wall", "give each wall its own name"));
+            }
+            Some(n) => n.to_string(),
+            None => format!("wall[{i}]"),
+        };
         match w {
-            WallSpec::Plane { material, point, normal, velocity, angular_velocity } => {
+            WallSpec::Plane { material, point, normal, velocity, angular_velocity, .. } => {
                 let m = material_of(key("material"), material)?;
                 let point = finite3(c, &key("point"), *point)?;
                 let normal = finite3(c, &key("normal"), *normal)?;
@@ -33,10 +47,10 @@ pub(super) fn validate_walls(
                     return Err(c.invalid(key("normal"), format!("{:?}", normal.to_array()), "is the zero vector", "give the direction into the domain, e.g. [0, 0, 1]"));
                 }
                 let normal = DVec3::new(normal[0] / len, normal[1] / len, normal[2] / len);
-                let drive = drive_of(c, i, *velocity, *angular_velocity, normal, "the plane's normal")?;
-                out.push(driven(format!("wall[{i}]"), WallShape::Plane { point, normal }, m, drive));
+                let drive = drive_of(c, &format!("wall[{i}]"), *velocity, *angular_velocity, normal, "the plane's normal")?;
+                out.push(driven(name, WallShape::Plane { point, normal }, m, drive));
             }
-            WallSpec::Box { material, min, max, open_top, velocity } => {
+            WallSpec::Box { material, min, max, open_top, velocity, .. } => {
                 let m = material_of(key("material"), material)?;
                 let (lo, hi) = (finite3(c, &key("min"), *min)?, finite3(c, &key("max"), *max)?);
                 if (0..3).any(|k| hi[k] <= lo[k]) {
@@ -54,8 +68,8 @@ pub(super) fn validate_walls(
                     if *open_top && face == "top" {
                         continue;
                     }
-                    let drive = drive_of(c, i, *velocity, None, normal, "")?;
-                    out.push(driven(format!("wall[{i}].{face}"), WallShape::Plane { point, normal }, m, drive));
+                    let drive = drive_of(c, &format!("wall[{i}]"), *velocity, None, normal, "")?;
+                    out.push(driven(format!("{name}.{face}"), WallShape::Plane { point, normal }, m, drive));
                 }
             }
             WallSpec::ServoBox { material, min, max, pressure, gain, max_speed } => {
@@ -84,11 +98,11 @@ pub(super) fn validate_walls(
                     out.push(w);
                 }
             }
-            WallSpec::Cylinder { material, center, radius, velocity, angular_velocity } => {
+            WallSpec::Cylinder { material, center, radius, velocity, angular_velocity, .. } => {
                 let m = material_of(key("material"), material)?;
                 let radius = positive(c, &key("radius"), *radius, "give the radius in metres")?;
-                let drive = drive_of(c, i, *velocity, *angular_velocity, DVec3::Z, "the cylinder's axis (z)")?;
-                out.push(driven(format!("wall[{i}]"), WallShape::Cylinder { center: *center, radius }, m, drive));
+                let drive = drive_of(c, &format!("wall[{i}]"), *velocity, *angular_velocity, DVec3::Z, "the cylinder's axis (z)")?;
+                out.push(driven(name, WallShape::Cylinder { center: *center, radius }, m, drive));
             }
             WallSpec::Piston { material, z, pressure, mass, area } => {
                 let m = material_of(key("material"), material)?;
@@ -117,13 +131,16 @@ pub(super) fn validate_walls(
 /// spin off the axis would turn the surface, which a wall cannot do yet.
 const SPIN_OFF_AXIS: f64 = 1e-9;
 
-/// The prescribed motion of `wall[i]`: `velocity` and `angular_velocity` (finite; the spin
-/// along `axis`, the wall's axis of symmetry, named `axis_name` in the error; none allowed
-/// where `axis_name` is empty).
-fn drive_of(c: &Complainer, i: usize, velocity: Option<DVec3>, angular_velocity: Option<DVec3>, axis: DVec3, axis_name: &str) -> Result<WallDrive, SceneError> {
-    let key = |k: &str| format!("wall[{i}].{k}");
+/// The prescribed motion given at `at` (`wall[0]`, `stage[2].walls.gate`): `velocity` and
+/// `angular_velocity` (finite; the spin along `axis`, the wall's axis of symmetry, named
+/// `axis_name` in the error; none allowed where `axis_name` is empty).
+pub(super) fn drive_of(c: &Complainer, at: &str, velocity: Option<DVec3>, angular_velocity: Option<DVec3>, axis: DVec3, axis_name: &str) -> Result<WallDrive, SceneError> {
+    let key = |k: &str| format!("{at}.{k}");
     let velocity = velocity.map(|v| finite3(c, &key("velocity"), v)).transpose()?.unwrap_or_default();
     let angular_velocity = angular_velocity.map(|w| finite3(c, &key("angular_velocity"), w)).transpose()?.unwrap_or_default();
+    if axis_name.is_empty() && angular_velocity != DVec3::ZERO {
+        return Err(c.invalid(key("angular_velocity"), format!("{:?}", angular_velocity.to_array()), "is given to a box, whose faces only translate", "give the box a velocity only"));
+    }
     if angular_velocity.cross(axis).length() > SPIN_OFF_AXIS * angular_velocity.length() {
         return Err(c.invalid(
             key("angular_velocity"),
@@ -225,4 +242,47 @@ pub(super) fn check_overlaps(c: &Complainer, origins: &Origins, grains: &Grains,
         }
     }
     Ok(())
+}
+
+/// A stage's `walls`: the walls each name moves, with their motion ([`drives_of`]).
+pub(super) fn stage_drives(c: &Complainer, stage: usize, specs: &std::collections::BTreeMap<String, schema::WallDriveSpec>, walls: &[Wall], servo: Option<ServoBox>) -> Result<Vec<(usize, WallDrive)>, SceneError> {
+    let mut out = Vec::new();
+    for (name, d) in specs {
+        out.extend(drives_of(c, &format!("stage[{stage}].walls"), name, d.velocity, d.angular_velocity, walls, servo)?);
+    }
+    Ok(out)
+}
+
+/// The walls `name` moves (a plane's or a cylinder's name, or a box's for its faces), each
+/// with `velocity` and `angular_velocity` checked as a `[[wall]]`'s; the piston and the servo
+/// box's planes, which their controllers move, are refused. `at` is where the name is given
+/// (`stage[2].walls`), for errors.
+pub(super) fn drives_of(c: &Complainer, at: &str, name: &str, velocity: Option<DVec3>, angular_velocity: Option<DVec3>, walls: &[Wall], servo: Option<ServoBox>) -> Result<Vec<(usize, WallDrive)>, SceneError> {
+    let found: Vec<usize> = match walls.iter().position(|w| w.name == name) {
+        Some(k) => vec![k],
+        None => (0..walls.len()).filter(|&k| walls[k].name.strip_prefix(name).is_some_and(|rest| rest.starts_with('.'))).collect(),
+    };
+    if found.is_empty() {
+        let known: Vec<&str> = walls.iter().map(|w| w.name.as_str()).collect();
+        let fix = if known.is_empty() { "add a [[wall]] with this name".to_string() } else { format!("use one of {known:?} (a box by its name moves every face)") };
+        return Err(c.invalid(at, format!("\"{name}\""), "names no wall", fix));
+    }
+    if let Some(&k) = found.iter().find(|&&k| matches!(walls[k].shape, WallShape::Piston { .. }) || servo.is_some_and(|s| s.walls.contains(&k))) {
+        return Err(c.invalid(at, format!("\"{name}\""), format!("{} is moved by its controller (the piston or the servo box)", walls[k].name), "set the stage's piston_pressure or servo_pressure instead"));
+    }
+    let (axis, axis_name) = match walls[found[0]].shape {
+        WallShape::Plane { normal, .. } if found.len() == 1 => (normal, "the plane's normal"),
+        WallShape::Cylinder { .. } => (DVec3::Z, "the cylinder's axis (z)"),
+        _ => (DVec3::Z, ""),
+    };
+    let drive = drive_of(c, &format!("{at}.{name}"), velocity, angular_velocity, axis, axis_name)?;
+    Ok(found.into_iter().map(|k| (k, drive)).collect())
+}
+
+impl Scene {
+    /// The walls `name` moves and their motion, checked as a stage's `walls` are ([`drives_of`];
+    /// `at` says where the name comes from, for the error).
+    pub fn wall_drives(&self, at: &str, name: &str, velocity: DVec3, angular_velocity: DVec3) -> Result<Vec<(usize, WallDrive)>, SceneError> {
+        drives_of(&Complainer { file: &self.path }, at, name, Some(velocity), Some(angular_velocity), &self.walls, self.servo)
+    }
 }

@@ -519,6 +519,12 @@ impl<T: Real> Engine for Distributed<T> {
         whole.restore(state)?;
         self.scatter_from(whole)
     }
+    fn set_wall_drive(&mut self, wall: usize, drive: &crate::scene::WallDrive) {
+        self.local.set_wall_drive(wall, drive);
+        if let Some(w) = &mut self.whole {
+            w.set_wall_drive(wall, drive);
+        }
+    }
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
         self.local.set_servo(pressure, axial_strain_rate);
         if let Some(w) = &mut self.whole {

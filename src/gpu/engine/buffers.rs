@@ -109,7 +109,7 @@ impl GpuEngine {
         ];
         let orientation = ("TRACK_ORIENTATION", self.track_orientation as u8 as f64);
         // The servo reads its walls' stiffness and damping, a spinning wall's work its power.
-        let spins = scene.walls.iter().any(|w| w.drive.angular_velocity != glam::DVec3::ZERO);
+        let spins = scene.walls.iter().map(|w| w.drive).chain(scene.stages.iter().flat_map(|s| s.walls.iter().map(|w| w.1))).any(|d| d.angular_velocity != glam::DVec3::ZERO);
         let wall_response = ("WALL_RESPONSE", (self.servo.is_some() || spins) as u8 as f64);
         let partner_force = ("PARTNER_FORCE_STORED", m.keeps_both_forces() as u8 as f64);
         (self.layouts, self.pipelines) = StepKernel::ALL

@@ -71,6 +71,15 @@ impl Engine for GpuEngine {
         self.restore_state(s)
     }
 
+    fn set_wall_drive(&mut self, wall: usize, drive: &crate::scene::WallDrive) {
+        let base = (wall * std::mem::size_of::<layout::Wall>()) as u64;
+        let (v, w) = (drive.velocity.as_vec3(), drive.angular_velocity.as_vec3());
+        let queue = &self.gpu.queue;
+        queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, driven) as u64, bytemuck::bytes_of(&(drive.moves() as u32)));
+        queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, velocity) as u64, bytemuck::bytes_of(&v));
+        queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, drive) as u64, bytemuck::bytes_of(&w));
+    }
+
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
         if self.servo.is_none() {
             return;
