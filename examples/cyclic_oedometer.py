@@ -18,6 +18,7 @@ import csv
 from pathlib import Path
 
 import grains
+from plotting import pyplot, save
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -89,15 +90,10 @@ def main() -> None:
             w.writerow([branch, c["target_pressure"], c["pressure"], c["void_ratio"], c["coordination"], c["settled"]])
     print(f"wrote {table}")
 
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        print("matplotlib is not installed: no plot (pip install matplotlib)")
+    plt = pyplot()
+    if plt is None:
         return
-    fig, ax = plt.subplots(figsize=(6, 4))
+    _, ax = plt.subplots(figsize=(6, 4))
     for branch, style in (("load", "o-"), ("unload", "s--"), ("reload", "^-")):
         pts = [c for b, c in points if b == branch]
         if branch != "load":
@@ -108,11 +104,7 @@ def main() -> None:
     ax.set_xlabel("vertical pressure on the piston (kPa)")
     ax.set_ylabel("void ratio e")
     ax.set_title("280-grain oedometer: loaded, unloaded, reloaded")
-    ax.legend()
-    fig.tight_layout()
-    png = args.out / "cyclic_oedometer.png"
-    fig.savefig(png, dpi=120)
-    print(f"wrote {png}")
+    save(ax, args.out / "cyclic_oedometer.png")
 
 
 if __name__ == "__main__":
