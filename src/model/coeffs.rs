@@ -106,22 +106,30 @@ impl MaterialConstants {
 
 /// The coefficients a contact between two materials takes from a mixing rule, or from the
 /// scene's `[[pair]]` table where it gives them: friction, rolling, damping and restitution
-/// (the elastic moduli are the materials' own and always combine by docs/physics.md).
+/// (the elastic moduli are the materials' own and always combine by docs/physics.md). Each is a
+/// value ([`MixedConstants`]) or one a table may leave out ([`MixedOverride`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct MixedConstants {
+pub struct Mixed<V> {
     /// Static friction coefficient (-).
-    pub mu_s: f64,
+    pub mu_s: V,
     /// Kinetic friction coefficient (-).
-    pub mu_k: f64,
+    pub mu_k: V,
     /// Rolling angle `theta_r` (rad).
-    pub rolling_angle: f64,
+    pub rolling_angle: V,
     /// `gamma_n` (s^-1 m^-1/2).
-    pub gamma_n: f64,
+    pub gamma_n: V,
     /// `gamma_nt` (s^-1).
-    pub gamma_nt: f64,
+    pub gamma_nt: V,
     /// Restitution coefficient (-), of [`DampingLaw::Restitution`].
-    pub restitution: f64,
+    pub restitution: V,
 }
+
+/// A pair of materials' mixed coefficients.
+pub type MixedConstants = Mixed<f64>;
+
+/// What a `[[pair]]` table gives for its pair of materials; what it leaves out (`None`) comes
+/// from the mixing rule, except `mu_k`, which follows a given `mu_s` as a material's does.
+pub type MixedOverride = Mixed<Option<f64>>;
 
 impl MixedConstants {
     /// The mixing rule: friction coefficients and the rolling angle take the smaller of the
@@ -138,24 +146,6 @@ impl MixedConstants {
             restitution: mean(a.restitution, b.restitution),
         }
     }
-}
-
-/// What a `[[pair]]` table gives for its pair of materials; what it leaves out (`None`) comes
-/// from the mixing rule, except `mu_k`, which follows a given `mu_s` as a material's does.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct MixedOverride {
-    /// Static friction coefficient (-).
-    pub mu_s: Option<f64>,
-    /// Kinetic friction coefficient (-).
-    pub mu_k: Option<f64>,
-    /// Rolling angle `theta_r` (rad).
-    pub rolling_angle: Option<f64>,
-    /// `gamma_n` (s^-1 m^-1/2).
-    pub gamma_n: Option<f64>,
-    /// `gamma_nt` (s^-1).
-    pub gamma_nt: Option<f64>,
-    /// Restitution coefficient (-).
-    pub restitution: Option<f64>,
 }
 
 impl MixedOverride {

@@ -23,7 +23,7 @@ pub mod tangential;
 pub mod twisting;
 pub mod window;
 
-pub use coeffs::{History, HistoryLayout, MaterialConstants, MixedConstants, MixedOverride, PairCoeffs};
+pub use coeffs::{History, HistoryLayout, MaterialConstants, Mixed, MixedConstants, MixedOverride, PairCoeffs};
 pub use cohesion::{capillary_force, capillary_potential, decay_length, rupture_distance, share_liquid, within_rupture, CohesionLaw};
 pub use contact::{contact_force, ContactForce, Regime};
 pub use damping::{normal_damping, normal_force, restitution, DampingLaw};
