@@ -89,7 +89,7 @@ impl<T: Real> CpuEngine<T> {
     /// Moves each driven wall by its velocity for `tau` (s) and books the work it did on the
     /// grains: its velocity against the grains' push, and its spin's power.
     pub(super) fn drive_walls(&mut self, tau: T) {
-        for &w in &self.driven {
+        for &w in &self.drivable {
             let wall = &mut self.walls[w];
             if wall.velocity == Vec3::ZERO && wall.spin == Vec3::ZERO {
                 continue;

@@ -136,7 +136,7 @@ pub struct CpuEngine<T: Real> {
     wall_power: Vec<T>,
     /// The walls a prescribed motion may move (`crate::scene::WallDrive`: every wall but the
     /// piston and the servo box's planes); each drift moves those that move.
-    driven: Vec<usize>,
+    drivable: Vec<usize>,
     // Pairs.
     pairs: PairList,
     hist: Vec<T>,
@@ -310,7 +310,7 @@ impl<T: Real> Engine for CpuEngine<T> {
     }
 
     fn set_wall_drive(&mut self, wall: usize, drive: &crate::scene::WallDrive) {
-        debug_assert!(self.driven.contains(&wall), "wall {wall} is moved by a controller");
+        debug_assert!(self.drivable.contains(&wall), "wall {wall} is moved by a controller");
         self.walls[wall].velocity = Vec3::of(drive.velocity);
         self.walls[wall].spin = Vec3::of(drive.angular_velocity);
     }

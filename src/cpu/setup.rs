@@ -72,7 +72,7 @@ impl<T: Real> CpuEngine<T> {
             wall_regimes: RegimeCounts::default(),
             wall_response: vec![(T::ZERO, T::ZERO); n_walls],
             wall_power: vec![T::ZERO; n_walls],
-            driven: (0..n_walls).filter(|&k| !matches!(scene.walls[k].shape, WallShape::Piston { .. }) && !scene.servo.is_some_and(|s| s.walls.contains(&k))).collect(),
+            drivable: (0..n_walls).filter(|&k| !matches!(scene.walls[k].shape, WallShape::Piston { .. }) && !scene.servo.is_some_and(|s| s.walls.contains(&k))).collect(),
             pairs: PairList::default(),
             hist: Vec::new(),
             share: Vec::new(),

@@ -91,7 +91,7 @@ impl<T: Real> CpuEngine<T> {
         s.put_reals("servo", servo);
         // Where each wall a prescribed motion may move stands (its centre), its velocity and
         // spin; and the spins' power.
-        s.put_reals("driven_walls", self.driven.iter().flat_map(|&w| [v3(&self.walls[w].geom.centre()), v3(&self.walls[w].velocity), v3(&self.walls[w].spin)].concat()));
+        s.put_reals("driven_walls", self.drivable.iter().flat_map(|&w| [v3(&self.walls[w].geom.centre()), v3(&self.walls[w].velocity), v3(&self.walls[w].spin)].concat()));
         s.put_reals("wall_power", self.wall_power.iter().map(|x| x.f64()));
         let l = &self.pairs;
         for (name, v) in [("owner_start", &l.owner_start), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
@@ -189,7 +189,7 @@ impl<T: Real> CpuEngine<T> {
             sv.strain_rate = (!v[37].is_nan()).then(|| T::of(v[37]));
             self.servo = Some(sv);
         }
-        for (&w, c) in self.driven.iter().zip(s.reals("driven_walls", 9 * self.driven.len())?.chunks_exact(9)) {
+        for (&w, c) in self.drivable.iter().zip(s.reals("driven_walls", 9 * self.drivable.len())?.chunks_exact(9)) {
             let wall = &mut self.walls[w];
             (wall.geom, wall.velocity, wall.spin) = (wall.geom.centred_at(v3(&c[0..3])), v3(&c[3..6]), v3(&c[6..9]));
         }
