@@ -189,9 +189,12 @@ impl<T: Real> CpuEngine<T> {
             sv.strain_rate = (!v[37].is_nan()).then(|| T::of(v[37]));
             self.servo = Some(sv);
         }
-        for (&w, c) in self.drivable.iter().zip(s.reals("driven_walls", 9 * self.drivable.len())?.chunks_exact(9)) {
-            let wall = &mut self.walls[w];
-            (wall.geom, wall.velocity, wall.spin) = (wall.geom.centred_at(v3(&c[0..3])), v3(&c[3..6]), v3(&c[6..9]));
+        // Written before walls could move: they stand where the scene put them.
+        if s.reals.contains_key("driven_walls") {
+            for (&w, c) in self.drivable.iter().zip(s.reals("driven_walls", 9 * self.drivable.len())?.chunks_exact(9)) {
+                let wall = &mut self.walls[w];
+                (wall.geom, wall.velocity, wall.spin) = (wall.geom.centred_at(v3(&c[0..3])), v3(&c[3..6]), v3(&c[6..9]));
+            }
         }
         // Written before walls could spin: no power.
         self.wall_power = match s.reals("wall_power", self.walls.len()) {
