@@ -70,6 +70,20 @@ pub enum SimError {
         /// A second fix, when the step may not be the cause ("" otherwise), starting with ", ".
         also: &'static str,
     },
+    /// A grain touched a mesh wall at more places than a grain keeps ([`crate::mesh`]).
+    #[error("step {step}: grain {grain} touches mesh wall {wall} at more than {max} places, or more than {raw} of its triangles lie within the grain; fix: use a mesh whose triangles are at least as large as the grains and without pits narrower than a grain")]
+    MeshContacts {
+        /// Step at which it was seen.
+        step: u64,
+        /// Permanent id of the grain.
+        grain: u32,
+        /// The wall's name.
+        wall: String,
+        /// Distinct contacts a grain keeps with one mesh.
+        max: usize,
+        /// Triangles within a grain a mesh may have.
+        raw: usize,
+    },
     /// The processes of a run over MPI disagree on the state or its messages: a bug of grains,
     /// not of the scene or its step.
     #[error("processes disagree at step {step}: {what}; fix: report this as a bug, with the scene and the process count (the run on one process does not meet it)")]

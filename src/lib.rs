@@ -13,6 +13,7 @@ pub mod cpu;
 pub mod engine;
 pub mod gpu;
 pub mod lammps;
+pub mod mesh;
 pub mod model;
 pub mod output;
 pub mod periodic;

@@ -286,6 +286,9 @@ impl<T: Real> ContactDynamics<T> {
         if scene.walls.iter().any(|w| matches!(w.shape, WallShape::Piston { .. })) {
             return unsupported("a piston", "use static walls or a servo box");
         }
+        if scene.walls.iter().any(|w| matches!(w.shape, WallShape::Mesh { .. })) {
+            return unsupported("a mesh wall", "use the DEM method (simulation.method = \"dem\")");
+        }
         if scene.walls.iter().any(|w| w.drive.moves()) || scene.stages.iter().any(|s| !s.walls.is_empty()) {
             return unsupported("a wall with a prescribed velocity or spin", "use the DEM method (simulation.method = \"dem\")");
         }

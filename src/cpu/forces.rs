@@ -29,6 +29,7 @@ impl<T: Real> CpuEngine<T> {
             periodic: self.periodic,
             residual: &[],
             material: &self.material,
+            meshes: &self.meshes,
         };
         let ctx = ForceContext { residual: &self.residual, ..sweep_ctx };
         let (pairs, body, prop, gravity) = (&self.pairs, &self.body, &self.prop, self.gravity);
@@ -47,8 +48,9 @@ impl<T: Real> CpuEngine<T> {
         self.clock.stop(Phase::Force, t);
         let t = self.clock.start();
         let grains = Grains { body: &mut self.body, residual: &mut self.residual, built_at: &self.built_at, prop, id: &self.id };
-        let (sums, touches, moved) = complete_loads(&sweep_ctx, pairs, &self.share, grains, &bounds, &self.walls, &mut self.load, &mut self.wall_springs, kick, carry);
+        let (sums, touches, moved, overflow) = complete_loads(&sweep_ctx, pairs, &self.share, grains, &bounds, &self.walls, &mut self.load, &mut self.wall_springs, kick, carry);
         self.wall_touches = touches;
+        self.mesh_overflow = overflow;
         self.wall_reaction = sums.reaction;
         self.wall_count = sums.count;
         self.wall_response = sums.response;
@@ -108,8 +110,8 @@ pub(super) fn complete_loads<T: Real>(
     wall_springs: &mut WallSprings<T>,
     kick: Option<T>,
     carry: Option<Carry<T>>,
-) -> (WallSums<T>, Vec<WallTouch<T>>, T) {
-    let per_grain = walls.len() * ctx.slots.stride;
+) -> (WallSums<T>, Vec<WallTouch<T>>, T, Option<u32>) {
+    let per_grain = crate::state::walls_reals(walls, ctx.slots.stride);
     // Each part's first wall-spring entry (walls keep entries even where they keep no history).
     let first_entries: Vec<u32> = bounds.iter().map(|&b| wall_springs.first_entry(b)).collect();
     let (candidate, run_start, mut springs) = (&wall_springs.candidate, &wall_springs.run_start, &mut wall_springs.springs[..]);
@@ -125,11 +127,11 @@ pub(super) fn complete_loads<T: Real>(
         })
         .collect();
     let together = warm::Together::new(parts.len());
-    let done: Vec<(Vec<WallTouch<T>>, T)> = parts
+    let done: Vec<(Vec<WallTouch<T>>, T, Option<u32>)> = parts
         .into_par_iter()
         .with_max_len(1)
         .map(|(first, mut loads, mut bodies, mut residuals, mut springs)| {
-            let (mut touches, mut moved) = (Vec::new(), T::ZERO);
+            let (mut touches, mut moved, mut overflow) = (Vec::new(), T::ZERO, None);
             // A block of grains at a time, gathered, wall-contacted, kicked and (carried)
             // kicked and drifted while its arrays are in cache (a part of 10^6 grains is half
             // a million).
@@ -143,7 +145,7 @@ pub(super) fn complete_loads<T: Real>(
                 gather_block(at, loads, pairs, share);
                 if !walls.is_empty() {
                     let springs = take_front(&mut springs, (wall_springs::first_entry(run_start, stop) - wall_springs::first_entry(run_start, at)) as usize * per_grain);
-                    wall_block(at, loads, &candidate[at / split::ALIGN..], springs, &id[grains.clone()], bodies, residuals, &prop[grains.clone()], walls, ctx, &mut touches);
+                    wall_block(at, loads, &candidate[at / split::ALIGN..], springs, &id[grains.clone()], bodies, residuals, &prop[grains.clone()], walls, ctx, &mut touches, &mut overflow);
                 }
                 if let Some(tau) = kick {
                     for ((b, l), p) in bodies.iter_mut().zip(loads.iter()).zip(&prop[grains.clone()]) {
@@ -156,13 +158,14 @@ pub(super) fn complete_loads<T: Real>(
                 at = stop;
             }
             together.finish();
-            (touches, moved)
+            (touches, moved, overflow)
         })
         .collect();
     let moved = done.iter().fold(T::ZERO, |m, d| m.max(d.1));
+    let overflow = done.iter().filter_map(|d| d.2).min();
     let mut touches: Vec<WallTouch<T>> = done.into_iter().flat_map(|d| d.0).collect();
     touches.sort_unstable_by_key(|t| (t.grain, t.wall));
-    (WallSums::of(walls.len(), id.len(), &touches), touches, moved)
+    (WallSums::of(walls.len(), id.len(), &touches), touches, moved, overflow)
 }
 
 /// Splits the pair pass's outputs into the tasks of [`owner_block`]: [`pair_force::OWNERS`]

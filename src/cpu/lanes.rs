@@ -429,7 +429,7 @@ mod tests {
         }
         e.advance(400).unwrap();
         let model = hertz_mindlin(&e.model).expect("the scene's model is Hertz-Mindlin");
-        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), window: T::of(1.0e-7), periodic: e.periodic, residual: &e.residual, material: &e.material };
+        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed: T::of(1.0e-7), window: T::of(1.0e-7), periodic: e.periodic, residual: &e.residual, material: &e.material, meshes: &e.meshes };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let (mut hist_one, mut hist_lanes) = (e.hist.clone(), e.hist.clone());
         let one: Vec<ContactForce<T>> = e.pairs.owners_of(0..n).enumerate().map(|(k, i)| pair_force(i, k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist_one[stride * k..stride * (k + 1)])).collect();
@@ -472,16 +472,16 @@ mod tests {
         let mut e = CpuEngine::<T>::new(&scene).unwrap();
         e.advance(400).unwrap();
         let elapsed = T::of(1.0e-7);
-        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed, window: elapsed, periodic: e.periodic, residual: &e.residual, material: &e.material };
+        let ctx = ForceContext { model: &e.model, coeffs: &e.coeffs, n_materials: e.n_materials, slots: e.slots, elapsed, window: elapsed, periodic: e.periodic, residual: &e.residual, material: &e.material, meshes: &e.meshes };
         let (n, stride) = (e.pairs.len(), e.slots.stride);
         let mut hist = e.hist.clone();
         let one: Vec<ContactForce<T>> = e.pairs.owners_of(0..n).enumerate().map(|(k, i)| pair_force(i, k, &e.pairs, &e.body, &e.prop, &ctx, &mut hist[stride * k..stride * (k + 1)])).collect();
         let asymmetric = one.iter().filter(|f| f.f_i != -f.f_j).count();
         // The floor's loads, from the same history.
-        let per_grain = e.walls.len() * stride;
+        let per_grain = crate::state::walls_reals(&e.walls, stride);
         let mut wall_hist = e.wall_springs.dense(e.body.len(), per_grain);
         let mut touches = Vec::new();
-        let wall: Vec<Load<T>> = (0..e.body.len()).map(|i| wall_contacts(e.id[i], &e.body[i], crate::position::residual_at(&e.residual, i), &e.prop[i], ctx.material(i), &e.walls, &ctx, &mut wall_hist[i * per_grain..(i + 1) * per_grain], &mut touches)).collect();
+        let wall: Vec<Load<T>> = (0..e.body.len()).map(|i| wall_contacts(e.id[i], &e.body[i], crate::position::residual_at(&e.residual, i), &e.prop[i], ctx.material(i), &e.walls, &ctx, &mut wall_hist[i * per_grain..(i + 1) * per_grain], &mut touches, &mut None)).collect();
         assert!(!touches.is_empty(), "grains must touch the floor");
         e.evaluate_forces(elapsed, None, None);
         let p = &e.pairs;

@@ -40,7 +40,7 @@ pub use integrate::rotate;
 pub(crate) use parts::{state_of_rows, touch_of_row, touches_state, RowWidths, Rows, BRIDGE_ROW, TOUCH_ROW};
 #[cfg(feature = "mpi")]
 pub(crate) use wall_contacts::WallTouch as WallContact;
-use crate::state::{allocated, renew, Body, Counts, ForceContext, HistorySlots, ImageCount, Images, Load, PairFlags, PairList, PairReports, Props, WallState};
+use crate::state::{allocated, renew, walls_reals, Body, Counts, ForceContext, HistorySlots, ImageCount, Images, Load, PairFlags, PairList, PairReports, Props, WallState};
 
 use rebuild::kept_or_found;
 use crate::engine::EngineState;
@@ -117,6 +117,11 @@ pub struct CpuEngine<T: Real> {
     orientation: Option<Vec<[T; 4]>>,
     // Walls.
     walls: Vec<WallState<T>>,
+    /// The mesh walls' surfaces, by [`WallGeom::Mesh`]'s index.
+    meshes: Vec<crate::mesh::MeshSurface<T>>,
+    /// A grain that touched a mesh at more places than it has slots, at the last force
+    /// evaluation: the run stops.
+    mesh_overflow: Option<u32>,
     wall_names: Vec<String>,
     piston: Option<Piston<T>>,
     servo: Option<Servo<T>>,

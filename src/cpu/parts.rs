@@ -226,7 +226,7 @@ impl<T: Real> CpuEngine<T> {
     pub(crate) fn row_widths(&self) -> RowWidths {
         let stride = self.slots.stride;
         RowWidths {
-            grain: [9, 6, 3 * T::COMPENSATED as usize, 3, 3 * (self.image.width() > 0) as usize, 4 * self.orientation.is_some() as usize, self.walls.len() * stride, self.slots.layout.bridge as usize],
+            grain: [9, 6, 3 * T::COMPENSATED as usize, 3, 3 * (self.image.width() > 0) as usize, 4 * self.orientation.is_some() as usize, walls_reals(&self.walls, stride), self.slots.layout.bridge as usize],
             pair: [stride, 6, 1, self.slots.layout.bridge as usize, 1, 3 * self.model.keeps_both_forces() as usize],
         }
     }

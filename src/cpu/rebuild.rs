@@ -86,7 +86,7 @@ impl<T: Real> CpuEngine<T> {
             Counts::Wide(c) => r.apply_blocks(c, width),
         }
         r.apply(&mut self.liquid);
-        self.wall_springs = self.wall_springs.renumbered(&r.from, self.walls.len() * self.slots.stride);
+        self.wall_springs = self.wall_springs.renumbered(&r.from, walls_reals(&self.walls, self.slots.stride));
         if let Some(q) = &mut self.orientation {
             r.apply(q);
         }

@@ -63,6 +63,8 @@ impl<T: Real> CpuEngine<T> {
             orientation: scene.track_orientation.then(|| vec![[T::ONE, T::ZERO, T::ZERO, T::ZERO]; n]),
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
             walls,
+            meshes: scene.mesh_surfaces(),
+            mesh_overflow: None,
             piston,
             servo: scene.servo.map(|s| Servo { walls: s.walls, pressure: T::of(s.pressure), gain: T::of(s.gain), max_speed: T::of(s.max_speed), strain_rate: None }),
             wall_springs: WallSprings::default(),
@@ -97,7 +99,20 @@ impl<T: Real> CpuEngine<T> {
     /// Chooses the grains whose wall springs are kept ([`WallSprings::choose`]), from the
     /// positions of the last rebuild and the walls now.
     pub(super) fn choose_wall_springs(&mut self) {
-        let per_grain = self.walls.len() * self.slots.stride;
-        self.wall_springs = WallSprings::choose(&self.built_at, &self.prop, &self.walls, self.skin, per_grain, &self.wall_springs);
+        let per_grain = walls_reals(&self.walls, self.slots.stride);
+        self.wall_springs = WallSprings::choose(&self.built_at, &self.prop, &self.walls, &self.meshes, self.skin, per_grain, &self.wall_springs);
+    }
+
+    /// The error for a grain that touched a mesh at more places than it keeps.
+    pub(super) fn mesh_overflow_error(&self, grain: u32) -> SimError {
+        let i = self.id.iter().position(|&g| g == grain).unwrap_or(0);
+        let (b, p) = (&self.body[i], &self.prop[i]);
+        let wall = self
+            .walls
+            .iter()
+            .zip(&self.wall_names)
+            .find(|(w, _)| crate::state::wall_overlaps(w, &self.meshes, b.pos, position::residual_at(&self.residual, i), p.radius * T::of(1.0 + 1e-6)).1 > 0 && matches!(w.geom, WallGeom::Mesh { .. }))
+            .map_or_else(|| "(a mesh)".to_string(), |(_, n)| n.clone());
+        SimError::MeshContacts { step: self.step, grain, wall, max: crate::mesh::MESH_CONTACTS, raw: crate::mesh::RAW_CONTACTS }
     }
 }

@@ -42,8 +42,8 @@ impl<T: Real> CpuEngine<T> {
                     .collect()
             }),
             wall_contacts: contacts.then(|| {
-                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, window: T::ZERO, periodic: self.periodic, residual: &self.residual, material: &self.material };
-                wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_springs.dense(self.body.len(), self.walls.len() * self.slots.stride))
+                let ctx = ForceContext { model: &self.model, coeffs: &self.coeffs, n_materials: self.n_materials, slots: self.slots, elapsed: T::ZERO, window: T::ZERO, periodic: self.periodic, residual: &self.residual, material: &self.material, meshes: &self.meshes };
+                wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_springs.dense(self.body.len(), walls_reals(&self.walls, self.slots.stride)))
             }),
             walls: self.walls.iter().map(|w| w.geom.f64()).collect(),
         }
@@ -72,7 +72,7 @@ impl<T: Real> CpuEngine<T> {
             s.put_reals("orientation", q.iter().flat_map(|q| q.map(T::f64)));
         }
         // Dense, one block per grain and wall, as before the springs were kept for candidates only.
-        s.put_reals("wall_hist", self.wall_springs.dense(self.body.len(), self.walls.len() * self.slots.stride).iter().map(|x| x.f64()));
+        s.put_reals("wall_hist", self.wall_springs.dense(self.body.len(), walls_reals(&self.walls, self.slots.stride)).iter().map(|x| x.f64()));
         s.put_reals("wall_reaction", self.wall_reaction.iter().flat_map(v3));
         s.put_ints("wall_count", self.wall_count.iter().copied());
         let piston = self.piston.map_or(Vec::new(), |p| {
@@ -168,7 +168,7 @@ impl<T: Real> CpuEngine<T> {
                 *q = [T::of(c[0]), T::of(c[1]), T::of(c[2]), T::of(c[3])];
             }
         }
-        let per_grain = self.walls.len() * self.slots.stride;
+        let per_grain = walls_reals(&self.walls, self.slots.stride);
         let wall_hist: Vec<T> = s.reals("wall_hist", if self.walls.is_empty() { 0 } else { n * per_grain })?.iter().map(|&x| T::of(x)).collect();
         self.wall_reaction = s.reals("wall_reaction", 3 * self.walls.len())?.chunks_exact(3).map(v3).collect();
         self.wall_count = s.ints("wall_count", Some(self.walls.len()))?.to_vec();
@@ -201,7 +201,7 @@ impl<T: Real> CpuEngine<T> {
             Ok(p) => p.iter().map(|&x| T::of(x)).collect(),
             Err(_) => vec![T::ZERO; self.walls.len()],
         };
-        self.wall_springs = WallSprings::from_dense(&wall_hist, &self.built_at, &self.prop, &self.walls, self.skin, per_grain);
+        self.wall_springs = WallSprings::from_dense(&wall_hist, &self.built_at, &self.prop, &self.walls, &self.meshes, self.skin, per_grain);
         let u32s = |name: &str, len: Option<usize>| -> anyhow::Result<Vec<u32>> { Ok(s.ints(name, len)?.iter().map(|&x| x as u32).collect()) };
         let partner = u32s("partner", None)?;
         let n_pairs = partner.len();

@@ -84,9 +84,8 @@ impl<T: Real> CpuEngine<T> {
                 let pl = &self.pairs;
                 let mut contacts: u64 = (pl.owner_start[i]..pl.owner_start[i + 1]).map(pushes).sum::<u64>() + pl.rev_pair[pl.rev_start[i] as usize..pl.rev_start[i + 1] as usize].iter().map(|&k| pushes(k)).sum::<u64>();
                 for wall in &self.walls {
-                    let (_, dist) = wall.geom.frame(b.pos, crate::position::residual_at(&self.residual, i));
-                    let h = p.radius - dist;
-                    if h > T::ZERO {
+                    let (overlaps, touching) = crate::state::wall_overlaps(wall, &self.meshes, b.pos, crate::position::residual_at(&self.residual, i), p.radius);
+                    for &h in &overlaps[..touching] {
                         contacts += 1;
                         let c = coeffs_of(&self.coeffs, self.n_materials, wall.material as usize, crate::state::material_at(&self.material, i));
                         s.wall_contacts += 1;

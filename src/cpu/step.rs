@@ -105,6 +105,9 @@ impl<T: Real> CpuEngine<T> {
             self.clock.stop(Phase::Force, t);
         }
         let moved = self.evaluate_forces(T::of(elapsed), kick, carry);
+        if let Some(grain) = self.mesh_overflow {
+            return Err(self.mesh_overflow_error(grain));
+        }
         hooks.forces_evaluated(self)?;
         Ok(moved)
     }

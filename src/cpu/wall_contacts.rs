@@ -2,7 +2,8 @@
 //! the same laws as grain-grain contacts (the wall is a partner of infinite radius and mass).
 
 use super::wall_springs::is_candidate;
-use crate::state::{wall_contact, Body, ForceContext, Load, Props, WallState};
+use crate::state::{mesh_contacts, wall_contact, wall_reals, Body, ForceContext, Load, Props, WallState};
+use crate::walls::WallGeom;
 use crate::model::{normal_damping, parted_normal_force, Geometry, NormalModel, Regime};
 use crate::real::{Real, Vec3};
 
@@ -47,8 +48,9 @@ impl<T> WallTouch<T> {
 }
 
 /// `wall_contacts` for the grain of permanent id `id` and material `material`. `hist` holds
-/// the grain's history blocks, one per wall; each touching wall's contact is appended to
-/// `touches`. Returns the load on the grain.
+/// the grain's history blocks, one after another ([`wall_reals`] each); each touching wall's
+/// contacts are appended to `touches`. Returns the load on the grain. A grain that touches a
+/// mesh at more places than it has slots sets `overflow` to its id.
 #[inline(always)]
 pub fn wall_contacts<T: Real>(
     id: u32,
@@ -60,11 +62,34 @@ pub fn wall_contacts<T: Real>(
     ctx: &ForceContext<T>,
     hist: &mut [T],
     touches: &mut Vec<WallTouch<T>>,
+    overflow: &mut Option<u32>,
 ) -> Load<T> {
     let mut load = Load::default();
     let stride = ctx.slots.stride;
+    let mut at = 0;
     for (w, wall) in walls.iter().enumerate() {
-        let h_slot = &mut hist[w * stride..(w + 1) * stride];
+        let h_slot = &mut hist[at..at + wall_reals(wall, stride)];
+        at += h_slot.len();
+        if let WallGeom::Mesh { mesh, shift } = wall.geom {
+            let touched = mesh_contacts(b, residual, p, material, wall, &ctx.meshes[mesh as usize], shift, ctx, h_slot, |_, geo, c, f| {
+                load.force += f.f_i;
+                load.torque += f.t_i;
+                touches.push(WallTouch {
+                    grain: id,
+                    wall: w as u32,
+                    force: f.f_i,
+                    stiffness: ctx.model.normal.stiffness(c, geo),
+                    damping: normal_damping(&ctx.model.damping, &ctx.model.normal, c, geo),
+                    power: T::ZERO,
+                    regime: f.regime,
+                    touching: true,
+                });
+            });
+            if !touched {
+                *overflow = Some(id);
+            }
+            continue;
+        }
         let (n, dist) = wall.geom.frame(b.pos, residual);
         if dist >= p.radius {
             ctx.slots.clear_springs(h_slot);
@@ -103,22 +128,22 @@ super::simd::dispatch! {
     /// candidate bits from `first`, a multiple of [`ALIGN`](super::split::ALIGN), on): each
     /// one's wall load (zero without a contact) is added to its load; `springs` holds their
     /// entries' history blocks in slot order (empty when the model keeps none); the contacts
-    /// are appended to `touches`. A grain that is not a candidate can touch no wall
-    /// ([`super::wall_springs`]).
-    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], candidate: &[u64], springs: &mut [T], id: &[u32], body: &[Body<T>], residual: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) => wall_block_portable
+    /// are appended to `touches`; `overflow` as [`wall_contacts`]'. A grain that is not a
+    /// candidate can touch no wall ([`super::wall_springs`]).
+    pub fn wall_block<T: Real>(first: usize, loads: &mut [Load<T>], candidate: &[u64], springs: &mut [T], id: &[u32], body: &[Body<T>], residual: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>, overflow: &mut Option<u32>) => wall_block_portable
 }
 
 /// [`wall_block`] for whatever instruction set the caller is compiled for.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], candidate: &[u64], springs: &mut [T], id: &[u32], body: &[Body<T>], residual: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>) {
-    let per_grain = walls.len() * ctx.slots.stride;
+fn wall_block_portable<T: Real>(first: usize, loads: &mut [Load<T>], candidate: &[u64], springs: &mut [T], id: &[u32], body: &[Body<T>], residual: &[Vec3<T>], prop: &[Props<T>], walls: &[WallState<T>], ctx: &ForceContext<T>, touches: &mut Vec<WallTouch<T>>, overflow: &mut Option<u32>) {
+    let per_grain = crate::state::walls_reals(walls, ctx.slots.stride);
     let mut e = 0;
     for (m, l) in loads.iter_mut().enumerate() {
         if !is_candidate(candidate, m) {
             continue;
         }
-        let w = wall_contacts(id[m], &body[m], crate::position::residual_at(residual, m), &prop[m], ctx.material(first + m), walls, ctx, &mut springs[e * per_grain..(e + 1) * per_grain], touches);
+        let w = wall_contacts(id[m], &body[m], crate::position::residual_at(residual, m), &prop[m], ctx.material(first + m), walls, ctx, &mut springs[e * per_grain..(e + 1) * per_grain], touches, overflow);
         l.force += w.force;
         l.torque += w.torque;
         e += 1;

@@ -14,6 +14,7 @@ use super::split::ALIGN;
 use crate::state::Props;
 use crate::state::WallState;
 use crate::real::{Real, Vec3};
+use crate::mesh::MeshSurface;
 use crate::walls::WallGeom;
 
 /// One word of candidate bits per run of slots.
@@ -83,7 +84,7 @@ impl<T: Real> WallSprings<T> {
     /// Chooses the candidates: the grains whose position at the last rebuild (`built_at`) is
     /// nearer than their radius plus `skin` to a wall, now. Each keeps its springs from `old`
     /// (whose entries are by the same slots), or starts from zero. `per_grain` reals an entry.
-    pub fn choose(built_at: &[Vec3<f32>], prop: &[Props<T>], walls: &[WallState<T>], skin: T, per_grain: usize, old: &WallSprings<T>) -> Self {
+    pub fn choose(built_at: &[Vec3<f32>], prop: &[Props<T>], walls: &[WallState<T>], meshes: &[MeshSurface<T>], skin: T, per_grain: usize, old: &WallSprings<T>) -> Self {
         if walls.is_empty() {
             return WallSprings::default();
         }
@@ -92,7 +93,7 @@ impl<T: Real> WallSprings<T> {
         for (s, (&at, p)) in built_at.iter().zip(prop).enumerate() {
             // The kept position's rounding ([`super::built_at`]) widens the reach.
             let (x, rounding) = (super::built_at::widen::<T>(at), super::built_at::bound::<T>(at));
-            let near = WallGeom::any_within(walls.iter().map(|w| &w.geom), x, p.radius + skin + rounding);
+            let near = WallGeom::any_within(walls.iter().map(|w| &w.geom), meshes, x, p.radius + skin + rounding);
             b.push(s, near.then(|| old.springs_of(s, per_grain).unwrap_or(&zeros)));
         }
         b.finish(walls.iter().map(|w| w.geom).collect())
@@ -145,12 +146,12 @@ impl<T: Real> WallSprings<T> {
     }
 
     /// [`Self::choose`] with the springs of a dense array ([`Self::dense`]).
-    pub fn from_dense(dense: &[T], built_at: &[Vec3<f32>], prop: &[Props<T>], walls: &[WallState<T>], skin: T, per_grain: usize) -> Self {
+    pub fn from_dense(dense: &[T], built_at: &[Vec3<f32>], prop: &[Props<T>], walls: &[WallState<T>], meshes: &[MeshSurface<T>], skin: T, per_grain: usize) -> Self {
         let mut every = Builder::new(built_at.len());
         for s in 0..built_at.len() {
             every.push(s, dense.get(s * per_grain..(s + 1) * per_grain));
         }
-        Self::choose(built_at, prop, walls, skin, per_grain, &every.finish(Vec::new()))
+        Self::choose(built_at, prop, walls, meshes, skin, per_grain, &every.finish(Vec::new()))
     }
 
     /// The first entry at or after `slot`, a multiple of [`ALIGN`] or the number of grains

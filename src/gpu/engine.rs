@@ -98,6 +98,14 @@ pub enum GpuSetupError {
         /// How to fix.
         fix: &'static str,
     },
+    /// The scene has a wall the kernels do not model yet.
+    #[error("{file}: {wall} is a mesh wall, which runs on the CPU backend so far; fix: run with --backend cpu")]
+    MeshWall {
+        /// The scene file.
+        file: String,
+        /// The wall's name.
+        wall: String,
+    },
     /// The device had not the memory for the scene's buffers.
     #[error("\"{adapter}\" could not allocate the {mib:.0} MiB of buffers the scene needs: {reason}; fix: run fewer grains on this device, or run with --backend cpu")]
     Memory {
@@ -193,6 +201,9 @@ impl GpuEngine {
     /// the tests take on purpose), not ahead of it at the checks: for a caller that knows the
     /// list a run will reach, or that would rather hold no margin at all.
     pub fn with_pair_capacity(gpu: Gpu, scene: &Scene, pairs: Option<u64>) -> Result<Self, anyhow::Error> {
+        if let Some(w) = scene.walls.iter().find(|w| matches!(w.shape, WallShape::Mesh { .. })) {
+            return Err(GpuSetupError::MeshWall { file: scene.path.display().to_string(), wall: w.name.clone() }.into());
+        }
         let n = scene.grains.len() as u64;
         let adapter = gpu.info.name.clone();
         let limit = |what, need: u64, have: u64, fix| -> Result<(), GpuSetupError> {

@@ -6,7 +6,7 @@ use crate::engine::Engine;
 use crate::model::{CohesionLaw, TangentialLaw};
 use crate::protocol::{CompressionPoint, StageResult};
 use crate::real::Vec3;
-use crate::scene::Scene;
+use crate::scene::{Scene, WallShape};
 use crate::walls::WallGeom;
 use serde::Serialize;
 use std::fmt::Write;
@@ -241,8 +241,10 @@ pub(crate) fn engine_bytes(scene: &Scene, real: usize, pairs_per_grain: f64) -> 
     // The partner and the reverse index (u32), the history, the partner's share 6 and the
     // normal force 1 reals, the capillary force, the owner's force (Oquendo et al.'s law), the flags.
     let per_pair = 8 + (stride + 7 + some(capillary, 1) + some(owner_force, 3)) * real + 1;
-    // One history block per wall for each grain a wall can reach (`cpu::wall_springs`), as placed.
-    let wall_springs = wall_candidates(scene) * scene.walls.len() * stride * real;
+    // One history block per wall (a mesh's slots) for each grain a wall can reach
+    // (`cpu::wall_springs`), as placed.
+    let per_candidate: usize = scene.walls.iter().map(|w| if matches!(w.shape, WallShape::Mesh { .. }) { crate::mesh::slots::mesh_reals(stride) } else { stride }).sum();
+    let wall_springs = wall_candidates(scene) * per_candidate * real;
     scene.grains.len() as f64 * (per_grain + pairs_per_grain * per_pair as f64) + wall_springs as f64
 }
 
@@ -250,8 +252,9 @@ pub(crate) fn engine_bytes(scene: &Scene, real: usize, pairs_per_grain: f64) -> 
 /// springs the CPU engine keeps.
 fn wall_candidates(scene: &Scene) -> usize {
     let walls: Vec<WallGeom<f64>> = scene.walls.iter().map(|w| WallGeom::of(&w.shape)).collect();
+    let meshes = scene.mesh_surfaces::<f64>();
     let g = &scene.grains;
-    g.position.iter().zip(&g.radius).filter(|&(x, &r)| WallGeom::any_within(&walls, Vec3::of(*x), r + scene.skin)).count()
+    g.position.iter().zip(&g.radius).filter(|&(x, &r)| WallGeom::any_within(&walls, &meshes, Vec3::of(*x), r + scene.skin)).count()
 }
 
 /// The `grains check` report.

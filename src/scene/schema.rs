@@ -267,6 +267,24 @@ pub enum WallSpec {
         /// drum). Default 0.
         angular_velocity: Option<DVec3>,
     },
+    /// A triangle mesh read from an STL file (binary or ASCII), placed by `scale`, then
+    /// `rotation`, then `offset`; grains touch either side of its triangles.
+    Mesh {
+        /// Name that stages use (default `wall[i]`).
+        name: Option<String>,
+        /// Material name.
+        material: String,
+        /// The STL file, relative to the scene file's folder.
+        file: String,
+        /// Factor from the file's units to metres (0.001 for millimetres). Default 1.
+        scale: Option<f64>,
+        /// Turns (degrees) about x, then y, then z (fixed axes). Default none.
+        rotation: Option<DVec3>,
+        /// Translation (m) after scaling and turning. Default none.
+        offset: Option<DVec3>,
+        /// Prescribed velocity (m/s). Default 0.
+        velocity: Option<DVec3>,
+    },
     /// Six planes bounding a box, each moved along its normal by a servo that holds a target
     /// pressure: wall speed = gain x (target - measured pressure), capped at `max_speed`
     /// (isotropic compaction); a stage's `axial_strain_rate` drives the two z planes at a

@@ -110,6 +110,13 @@ pub enum WallShape {
         /// Radius (m).
         radius: f64,
     },
+    /// Triangle mesh, grains on either side of its triangles.
+    Mesh {
+        /// The triangles, placed in the scene (m).
+        mesh: std::sync::Arc<crate::mesh::TriMesh>,
+        /// Its rank among the scene's mesh walls (the engines' mesh tables).
+        index: u32,
+    },
     /// Horizontal plate facing down, driven by a target pressure.
     Piston {
         /// Initial height (m).
@@ -295,6 +302,20 @@ impl Scene {
         let mixed = mixed_table(&self.materials, &self.pairs);
         let n = self.materials.len();
         (0..n * n).map(|k| PairCoeffs::of(&self.materials[k / n].constants, &self.materials[k % n].constants, &mixed[k], &self.model)).collect()
+    }
+
+    /// The mesh walls' surfaces in precision `T`, by their index, binned for the largest
+    /// grain's radius plus the skin (widened by a thousandth for the rounding of the positions
+    /// the wall springs are chosen from).
+    pub fn mesh_surfaces<T: Real>(&self) -> Vec<crate::mesh::MeshSurface<T>> {
+        let reach = (self.grains.radius.iter().copied().fold(0.0, f64::max) + self.skin) * 1.001;
+        self.walls
+            .iter()
+            .filter_map(|w| match &w.shape {
+                WallShape::Mesh { mesh, .. } => Some(crate::mesh::MeshSurface::new(mesh, reach)),
+                _ => None,
+            })
+            .collect()
     }
 
     /// Steps of the whole run at most (every stage to its longest).

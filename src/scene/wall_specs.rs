@@ -24,14 +24,14 @@ pub(super) fn validate_walls(
     for (i, w) in f.walls.iter().enumerate() {
         let key = |k: &str| format!("wall[{i}].{k}");
         let name = match w {
-            WallSpec::Plane { name, .. } | WallSpec::Box { name, .. } | WallSpec::Cylinder { name, .. } => name.as_deref(),
+            WallSpec::Plane { name, .. } | WallSpec::Box { name, .. } | WallSpec::Cylinder { name, .. } | WallSpec::Mesh { name, .. } => name.as_deref(),
             _ => None,
         };
         let name = match name {
             Some(n) if n.is_empty() || n.contains('.') || n.contains('[') => {
                 return Err(c.invalid(key("name"), format!("\"{n}\""), "must be a word without dots or brackets", "give a name such as \"gate\""));
             }
-            Some(n) if f.walls[..i].iter().any(|o| matches!(o, WallSpec::Plane { name: Some(m), .. } | WallSpec::Box { name: Some(m), .. } | WallSpec::Cylinder { name: Some(m), .. } if m == n)) => {
+            Some(n) if f.walls[..i].iter().any(|o| matches!(o, WallSpec::Plane { name: Some(m), .. } | WallSpec::Box { name: Some(m), .. } | WallSpec::Cylinder { name: Some(m), .. } | WallSpec::Mesh { name: Some(m), .. } if m == n)) => {
                 return Err(c.invalid(key("name"), format!("\"{n}\""), "is used by an earlier wall", "give each wall its own name"));
             }
             Some(n) => n.to_string(),
@@ -104,6 +104,18 @@ pub(super) fn validate_walls(
                 let drive = drive_of(c, &format!("wall[{i}]"), *velocity, *angular_velocity, DVec3::Z, "the cylinder's axis (z)")?;
                 out.push(driven(name, WallShape::Cylinder { center: *center, radius }, m, drive));
             }
+            WallSpec::Mesh { material, file, scale, rotation, offset, velocity, .. } => {
+                let m = material_of(key("material"), material)?;
+                let scale = positive(c, &key("scale"), scale.unwrap_or(1.0), "give the factor from the file's units to metres, e.g. 0.001 for millimetres")?;
+                let rotation_deg = finite3(c, &key("rotation"), rotation.unwrap_or_default())?;
+                let offset = finite3(c, &key("offset"), offset.unwrap_or_default())?;
+                let path = c.file.parent().unwrap_or(std::path::Path::new("")).join(file);
+                let mesh = crate::mesh::read::read_stl(&path, &crate::mesh::MeshPlacement { scale, rotation_deg, offset })
+                    .map_err(|e| c.invalid(key("file"), format!("\"{file}\""), format!("{}: {}", e.file.display(), e.problem), e.fix))?;
+                let drive = drive_of(c, &format!("wall[{i}]"), *velocity, None, DVec3::Z, "")?;
+                let index = out.iter().filter(|p: &&PendingWall| matches!(p.wall.shape, WallShape::Mesh { .. })).count() as u32;
+                out.push(driven(name, WallShape::Mesh { mesh: std::sync::Arc::new(mesh), index }, m, drive));
+            }
             WallSpec::Piston { material, z, pressure, mass, area } => {
                 let m = material_of(key("material"), material)?;
                 if !z.is_finite() {
@@ -139,7 +151,7 @@ pub(super) fn drive_of(c: &Complainer, at: &str, velocity: Option<DVec3>, angula
     let velocity = velocity.map(|v| finite3(c, &key("velocity"), v)).transpose()?.unwrap_or_default();
     let angular_velocity = angular_velocity.map(|w| finite3(c, &key("angular_velocity"), w)).transpose()?.unwrap_or_default();
     if axis_name.is_empty() && angular_velocity != DVec3::ZERO {
-        return Err(c.invalid(key("angular_velocity"), format!("{:?}", angular_velocity.to_array()), "is given to a box, whose faces only translate", "give the box a velocity only"));
+        return Err(c.invalid(key("angular_velocity"), format!("{:?}", angular_velocity.to_array()), "is given to a box or a mesh, which only translate", "give it a velocity only"));
     }
     if angular_velocity.cross(axis).length() > SPIN_OFF_AXIS * angular_velocity.length() {
         return Err(c.invalid(
@@ -208,9 +220,12 @@ pub fn cross_section<'a>(shapes: impl Iterator<Item = &'a WallShape> + Clone, pe
 }
 
 /// Signed distance (m) from a point to a wall's surface at its initial position, positive on
-/// the grains' side.
+/// the grains' side (either side of a mesh).
 pub fn wall_distance(shape: &WallShape, p: DVec3) -> f64 {
-    crate::walls::WallGeom::<f64>::of(shape).frame(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).1
+    match shape {
+        WallShape::Mesh { mesh, .. } => mesh.distance(p),
+        _ => crate::walls::WallGeom::<f64>::of(shape).frame(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).1,
+    }
 }
 
 /// Grains may not start overlapping a wall (grains read from a file: by more than

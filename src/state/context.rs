@@ -29,6 +29,8 @@ pub struct ForceContext<'a, T> {
     pub residual: &'a [Vec3<T>],
     /// Material index by slot; empty in a scene of one material, whose grains are all 0.
     pub material: &'a [u32],
+    /// The mesh walls' surfaces, by [`crate::walls::WallGeom::Mesh`]'s index.
+    pub meshes: &'a [crate::mesh::MeshSurface<T>],
 }
 
 impl<'a, T: Real> ForceContext<'a, T> {

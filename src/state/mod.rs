@@ -23,7 +23,7 @@ pub use grid::{detect_pairs, hash_cells, CellGrid};
 pub use levels::{class_index, class_tops, detect_pairs_in, Grids, CLASS_RATIO, MAX_CLASSES};
 pub use pairs::{owned_pairs, owner_capacity, remap_all, remap_history, PairList, OWNER_DOUBLINGS};
 pub use context::{coeffs_of, ForceContext};
-pub use wall::{wall_contact, wall_contact_records, WallState};
+pub use wall::{mesh_contacts, wall_contact, wall_contact_records, wall_overlaps, wall_reals, walls_reals, WallState};
 
 /// Bytes a vector holds allocated.
 #[allow(clippy::ptr_arg)] // the capacity lives on the Vec, not the slice

@@ -4,7 +4,10 @@
 
 use super::{Body, ForceContext, Props};
 use crate::engine::WallContactRecord;
+use crate::mesh::slots::{assign, mesh_reals, slot_reals, SlotUse};
+use crate::mesh::{MeshSurface, MESH_CONTACTS};
 use crate::model::{contact_force, Bodies, ContactForce, Geometry, KickWindow, Kinematics, PairCoeffs};
+use crate::position::complete;
 use crate::real::{Real, Vec3};
 use crate::walls::WallGeom;
 
@@ -31,6 +34,21 @@ impl<T: Real> WallState<T> {
     }
 }
 
+/// The overlaps (m) of a grain of `radius` at `x` (residual `r`) with `wall`: at most one with
+/// a wall of one contact, one per contact with a mesh (`meshes`); the count is the second.
+pub fn wall_overlaps<T: Real>(wall: &WallState<T>, meshes: &[MeshSurface<T>], x: Vec3<T>, r: Vec3<T>, radius: T) -> ([T; MESH_CONTACTS], usize) {
+    let mut out = [T::ZERO; MESH_CONTACTS];
+    if let WallGeom::Mesh { mesh, shift } = wall.geom {
+        let t = meshes[mesh as usize].touching(complete(x - shift, r), radius);
+        for (o, c) in out.iter_mut().zip(&t.contacts[..t.len]) {
+            *o = radius - c.dist;
+        }
+        return (out, t.len);
+    }
+    out[0] = radius - wall.geom.frame(x, r).1;
+    (out, (out[0] > T::ZERO) as usize)
+}
+
 /// The contact of a grain of material `material` with a wall it touches, seen from the wall's
 /// frame (`n`, `dist`: [`WallGeom::frame`]): its geometry, coefficients and force; the history
 /// in `h_slot` advances by `ctx.elapsed`. The wall moves at its surface velocity where the
@@ -49,21 +67,93 @@ pub fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>,
     (geo, c, f)
 }
 
+/// Reals of wall history a grain keeps for `wall`: `stride` for a wall of one contact,
+/// [`MESH_CONTACTS`] slots of history and normal for a mesh ([`crate::mesh::slots`]).
+#[inline(always)]
+pub fn wall_reals<T>(wall: &WallState<T>, stride: usize) -> usize {
+    if matches!(wall.geom, WallGeom::Mesh { .. }) { mesh_reals(stride) } else { stride }
+}
+
+/// Reals of wall history a grain keeps for all of `walls`, one block after another.
+pub fn walls_reals<T>(walls: &[WallState<T>], stride: usize) -> usize {
+    walls.iter().map(|w| wall_reals(w, stride)).sum()
+}
+
+/// The contacts of a grain (its body `b` with position residual `residual`) with mesh wall
+/// `wall` (`surface`, moved by `shift` (m)): each one's slot in `block` ([`wall_reals`]) is
+/// chosen ([`assign`]), its history advanced and its normal kept, and `each` is given its
+/// normal, geometry, coefficients and force; slots left without a contact are cleared. False
+/// when the grain touches the mesh at more places than it has slots
+/// ([`MeshSurface::touching`]); its contacts are then not evaluated.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub fn mesh_contacts<'c, T: Real>(
+    b: &Body<T>,
+    residual: Vec3<T>,
+    p: &Props<T>,
+    material: usize,
+    wall: &WallState<T>,
+    surface: &MeshSurface<T>,
+    shift: Vec3<T>,
+    ctx: &ForceContext<'c, T>,
+    block: &mut [T],
+    mut each: impl FnMut(Vec3<T>, &Geometry<T>, &'c PairCoeffs<T>, &ContactForce<T>),
+) -> bool {
+    let touches = surface.touching(complete(b.pos - shift, residual), p.radius);
+    if touches.overflow {
+        return false;
+    }
+    let (stride, size) = (ctx.slots.stride, slot_reals(ctx.slots.stride));
+    let last: [Vec3<T>; MESH_CONTACTS] = std::array::from_fn(|j| {
+        let n = &block[j * size + stride..(j + 1) * size];
+        Vec3::new(n[0], n[1], n[2])
+    });
+    let uses = assign(&touches.contacts[..touches.len], &last, surface.merge_cos);
+    for (j, u) in uses.into_iter().enumerate() {
+        let slot = &mut block[j * size..(j + 1) * size];
+        let k = match u {
+            SlotUse::Free => {
+                slot.fill(T::ZERO);
+                continue;
+            }
+            SlotUse::New(k) => {
+                slot.fill(T::ZERO);
+                k
+            }
+            SlotUse::Carried(k) => k,
+        };
+        let c = touches.contacts[k];
+        let (geo, coeffs, f) = wall_contact(c.normal, c.dist, b, p, material, wall, ctx, &mut slot[..stride]);
+        slot[stride..].copy_from_slice(&[c.normal.x, c.normal.y, c.normal.z]);
+        each(c.normal, &geo, coeffs, &f);
+    }
+    true
+}
+
 /// Every touching grain-wall contact, with its force evaluated from the current state
 /// (springs read, not advanced: `ctx.elapsed` should be 0), grains in permanent-id order,
 /// walls in order.
 pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[u32], walls: &[WallState<T>], ctx: &ForceContext<T>, hist: &[T]) -> Vec<WallContactRecord> {
     let stride = ctx.slots.stride;
+    let per_grain = walls_reals(walls, stride);
     let mut out = Vec::new();
     for (i, (b, p)) in body.iter().zip(prop).enumerate() {
+        let residual = crate::position::residual_at(ctx.residual, i);
+        let mut at = i * per_grain;
         for (w, wall) in walls.iter().enumerate() {
-            let (n, dist) = wall.geom.frame(b.pos, crate::position::residual_at(ctx.residual, i));
+            let block = &hist[at..at + wall_reals(wall, stride)];
+            at += block.len();
+            let record = |n: Vec3<T>, geo: &Geometry<T>, f: &ContactForce<T>| WallContactRecord { grain: id[i], wall: w as u32, overlap: geo.h.f64(), normal: n.f64(), lever: geo.rp_i.f64(), force: f.f_i.f64() };
+            if let WallGeom::Mesh { mesh, shift } = wall.geom {
+                mesh_contacts(b, residual, p, ctx.material(i), wall, &ctx.meshes[mesh as usize], shift, ctx, &mut block.to_vec(), |n, geo, _, f| out.push(record(n, geo, f)));
+                continue;
+            }
+            let (n, dist) = wall.geom.frame(b.pos, residual);
             if dist >= p.radius {
                 continue;
             }
-            let at = (i * walls.len() + w) * stride;
-            let (geo, _, f) = wall_contact(n, dist, b, p, ctx.material(i), wall, ctx, &mut hist[at..at + stride].to_vec());
-            out.push(WallContactRecord { grain: id[i], wall: w as u32, overlap: geo.h.f64(), normal: n.f64(), lever: geo.rp_i.f64(), force: f.f_i.f64() });
+            let (geo, _, f) = wall_contact(n, dist, b, p, ctx.material(i), wall, ctx, &mut block.to_vec());
+            out.push(record(n, &geo, &f));
         }
     }
     out.sort_by_key(|r| r.grain);

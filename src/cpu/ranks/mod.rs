@@ -121,6 +121,9 @@ impl<T: Real> Distributed<T> {
         if !matches!(scene.method, Method::Dem) {
             anyhow::bail!("{file}: simulation.method = \"contact_dynamics\" runs on one process; fix: run it without mpirun");
         }
+        if scene.walls.iter().any(|w| matches!(w.shape, crate::scene::WallShape::Mesh { .. })) {
+            anyhow::bail!("{file}: mesh walls run on one process so far; fix: run it without mpirun");
+        }
         let world = SimpleCommunicator::world();
         let grid = Grid::new(scene, world.size() as usize)?;
         let mut whole = CpuEngine::<T>::new(scene)?;

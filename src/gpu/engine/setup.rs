@@ -74,18 +74,20 @@ pub(super) fn walls_of(scene: &Scene) -> (Vec<layout::Wall>, Option<usize>) {
         .enumerate()
         .map(|(w, wall)| {
             let mut g = layout::Wall { material: wall.material as u32, ..Default::default() };
-            match wall.shape {
-                WallShape::Plane { point, normal } => {
+            match &wall.shape {
+                &WallShape::Plane { point, normal } => {
                     g.kind = layout::wall_kind::PLANE;
                     g.point = Vec4::new(point[0] as f32, point[1] as f32, point[2] as f32, 0.0);
                     g.normal = Vec4::new(normal[0] as f32, normal[1] as f32, normal[2] as f32, 0.0);
                 }
-                WallShape::Cylinder { center, radius } => {
+                &WallShape::Cylinder { center, radius } => {
                     g.kind = layout::wall_kind::CYLINDER;
                     g.point = Vec4::new(center[0] as f32, center[1] as f32, 0.0, 0.0);
                     g.normal = Vec4::new(0.0, 0.0, 0.0, radius as f32);
                 }
-                WallShape::Piston { z, pressure, mass, area } => {
+                // Refused by `GpuEngine::with_pair_capacity`.
+                WallShape::Mesh { .. } => {}
+                &WallShape::Piston { z, pressure, mass, area } => {
                     g.kind = layout::wall_kind::PISTON;
                     g.point = Vec4::new(0.0, 0.0, z as f32, 0.0);
                     g.drive = Vec4::new(mass as f32, area as f32, pressure as f32, 0.0);

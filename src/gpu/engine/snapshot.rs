@@ -97,6 +97,7 @@ impl GpuEngine {
             periodic: crate::periodic::Periodic::default(),
             residual: &residual,
             material,
+            meshes: &[],
         };
         Ok(wall_contact_records(&body, &prop, &(0..self.n).collect::<Vec<u32>>(), &states, &ctx, &hist))
     }

@@ -1,6 +1,6 @@
 //! The walls of a frame as polygons: planes and the piston as quads over the domain (the
 //! piston as a disc inside a cylinder), the cylinder as a ring of quads over the domain's
-//! height.
+//! height, a mesh as its triangles.
 
 use super::xml::{Array, PolyData};
 use crate::engine::Frame;
@@ -45,9 +45,28 @@ pub fn domain(scene: &Scene, f: &Frame) -> ([f64; 3], [f64; 3]) {
                 include(1, cy + radius);
             }
             WallGeom::Piston { z } => include(2, z),
+            WallGeom::Mesh { mesh, shift } => {
+                for v in &mesh_of(scene, mesh).vertices {
+                    for (a, x) in (*v + shift.f64()).to_array().into_iter().enumerate() {
+                        include(a, x);
+                    }
+                }
+            }
         }
     }
     (lo, hi)
+}
+
+/// The scene's mesh of index `index` ([`WallGeom::Mesh`]).
+fn mesh_of(scene: &Scene, index: u32) -> &crate::mesh::TriMesh {
+    scene
+        .walls
+        .iter()
+        .find_map(|w| match &w.shape {
+            crate::scene::WallShape::Mesh { mesh, index: i } if *i == index => Some(&**mesh),
+            _ => None,
+        })
+        .expect("a frame's mesh walls are its scene's")
 }
 
 /// The axis a unit normal lies along, if it does.
@@ -78,6 +97,12 @@ pub fn piece(scene: &Scene, f: &Frame) -> PolyData {
                 Some((cx, cy, radius)) => polygon(&mut piece, circle(cx, cy, radius).map(|(x, y)| [x, y, z]).collect(), w),
                 None => polygon(&mut piece, vec![[lo[0], lo[1], z], [hi[0], lo[1], z], [hi[0], hi[1], z], [lo[0], hi[1], z]], w),
             },
+            WallGeom::Mesh { mesh, shift } => {
+                let m = mesh_of(scene, mesh);
+                for t in 0..m.triangles.len() {
+                    polygon(&mut piece, m.corners(t).map(|v| (v + shift.f64()).to_array()).to_vec(), w);
+                }
+            }
             WallGeom::Cylinder { cx, cy, radius } => {
                 let ring: Vec<(f64, f64)> = circle(cx, cy, radius).collect();
                 for s in 0..CIRCLE_SIDES {
