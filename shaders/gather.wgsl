@@ -5,7 +5,8 @@
 // bits) and, for servo walls and spinning ones (WALL_RESPONSE), their contacts' normal tangent
 // stiffness and damping coefficient and the power the walls' spin gives the grains (entries
 // MAX_WALLS..: x N/m, y N s/m, z W), which wall_reduce totals. A wall moves at its surface
-// velocity where the grain's centre projects onto it. For the
+// velocity where the grain's centre projects onto it. A grain's contacts with a mesh wall add up
+// in its row in their slots' order. For the
 // statistics, force.w packs the grain's pairs that push (f_n > 0) with its wall contacts
 // sliding and rolling (WALL_COUNTS_*), torque.w is the magnitude of its wall force. With
 // phase.kick > 0 it then kicks the grain under that load: the kick after an evaluation, in the
@@ -40,6 +41,9 @@ override WALL_RESPONSE: bool = false;
 @group(0) @binding(20) var<storage, read> built_at: array<vec4<f32>>;
 @group(0) @binding(21) var<storage, read_write> quat: array<vec4<f32>>;
 @group(0) @binding(22) var<storage, read_write> control: Control;
+@group(0) @binding(23) var<storage, read> meshes: array<MeshInfo>;
+@group(0) @binding(24) var<storage, read> mesh_data: array<vec4<f32>>;
+@group(0) @binding(25) var<storage, read> mesh_index: array<u32>;
 
 var<workgroup> reaction: array<vec4<f32>, 512>; // WG x MAX_WALLS
 
@@ -108,7 +112,6 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index
 // on each wall go to wall_partials[row..].
 fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
     var out = WallLoad(vec3<f32>(0.0), vec3<f32>(0.0), 0u, 0u);
-    var response: array<vec3<f32>, MAX_WALLS>;
     for (var w = 0u; w < MAX_WALLS; w++) {
         response[w] = vec3<f32>(0.0);
         reaction[lid * MAX_WALLS + w] = vec4<f32>(0.0);
@@ -116,10 +119,13 @@ fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
     if (live) {
         let p = pos[i];
         let v = vel[i];
-        let om = omega[i];
         for (var w = 0u; w < params.n_walls; w++) {
             let wall = walls[w];
-            let base = (i * params.n_walls + w) * params.hist_blocks;
+            let base = i * params.wall_blocks + wall.hist_at;
+            if (wall.kind == WALL_MESH) {
+                mesh_loads(i, w, wall, base, lid, &out);
+                continue;
+            }
             let frame = wall_frame(wall, p.xyz, residual[i]);
             if (frame.w >= p.w) {
                 for (var b = 0u; b < params.hist_blocks; b++) { wall_hist[base + b] = vec4<f32>(0.0); }
@@ -137,30 +143,7 @@ fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
                 }
                 continue;
             }
-            let g = geometry_grain_wall(frame.xyz, frame.w, p.w, v.w);
-            let surface = wall_velocity_at(wall, p.xyz - frame.xyz * frame.w);
-            let kin = Kinematics(v.xyz, surface, om.xyz, wall_spin(wall));
-            let bodies = Bodies(v.w, om.w, 0.0, 0.0, true);
-            let c = coeffs[wall.material * params.n_materials + material[i]];
-            // Walls are not wetted: their contacts keep springs only.
-            var blocks: array<vec4<f32>, MAX_HISTORY_BLOCKS>;
-            for (var b = 0u; b < params.hist_blocks; b++) { blocks[b] = wall_hist[base + b]; }
-            var h = history_of_blocks(blocks);
-            let f = contact_force(c, g, kin, bodies, &h, phase.elapsed);
-            blocks = blocks_of_history(h);
-            for (var b = 0u; b < params.hist_blocks; b++) { wall_hist[base + b] = blocks[b]; }
-            out.force += f.f_i;
-            out.torque += f.t_i;
-            reaction[lid * MAX_WALLS + w] = vec4<f32>(-f.f_i, bitcast<f32>(1u));
-            out.sliding += select(0u, 1u, f.regime == REGIME_SLIDING);
-            out.rolling += select(0u, 1u, f.regime == REGIME_ROLLING);
-            if (WALL_RESPONSE) {
-                var power = 0.0;
-                if (wall.driven == 1u && any(wall.drive.xyz != vec3<f32>(0.0))) {
-                    power = dot(f.f_i, surface - wall.velocity.xyz);
-                }
-                response[w] = vec3<f32>(normal_stiffness(c, g), normal_damping(c, g), power);
-            }
+            wall_contact_at(i, w, wall, frame.xyz, frame.w, base, lid, true, &out);
         }
     }
     reduce_walls(lid, row);
@@ -171,6 +154,87 @@ fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
         reduce_walls(lid, row + MAX_WALLS);
     }
     return out;
+}
+
+// Each wall's response row of this invocation's grain (WALL_RESPONSE): its contacts' normal
+// stiffness, damping and the spin's power.
+var<private> response: array<vec3<f32>, MAX_WALLS>;
+
+// Grain i's contact with wall w, along unit normal n from the wall at distance dist (m), its
+// history at wall_hist[base..] advanced; its load added to `out`, its row to the wall's (set
+// where `first`, the grain's first contact with the wall, added to otherwise).
+fn wall_contact_at(i: u32, w: u32, wall: Wall, n: vec3<f32>, dist: f32, base: u32, lid: u32, first: bool, out: ptr<function, WallLoad>) {
+    let p = pos[i];
+    let v = vel[i];
+    let om = omega[i];
+    let g = geometry_grain_wall(n, dist, p.w, v.w);
+    let surface = wall_velocity_at(wall, p.xyz - n * dist);
+    let kin = Kinematics(v.xyz, surface, om.xyz, wall_spin(wall));
+    let bodies = Bodies(v.w, om.w, 0.0, 0.0, true);
+    let c = coeffs[wall.material * params.n_materials + material[i]];
+    // Walls are not wetted: their contacts keep springs only.
+    var blocks: array<vec4<f32>, MAX_HISTORY_BLOCKS>;
+    for (var b = 0u; b < params.hist_blocks; b++) { blocks[b] = wall_hist[base + b]; }
+    var h = history_of_blocks(blocks);
+    let f = contact_force(c, g, kin, bodies, &h, phase.elapsed);
+    blocks = blocks_of_history(h);
+    for (var b = 0u; b < params.hist_blocks; b++) { wall_hist[base + b] = blocks[b]; }
+    (*out).force += f.f_i;
+    (*out).torque += f.t_i;
+    let row = vec4<f32>(-f.f_i, bitcast<f32>(1u));
+    if (first) {
+        reaction[lid * MAX_WALLS + w] = row;
+    } else {
+        reaction[lid * MAX_WALLS + w] = add_wall_row(reaction[lid * MAX_WALLS + w], row);
+    }
+    (*out).sliding += select(0u, 1u, f.regime == REGIME_SLIDING);
+    (*out).rolling += select(0u, 1u, f.regime == REGIME_ROLLING);
+    if (WALL_RESPONSE) {
+        var power = 0.0;
+        if (wall.driven == 1u && any(wall.drive.xyz != vec3<f32>(0.0))) {
+            power = dot(f.f_i, surface - wall.velocity.xyz);
+        }
+        let r = vec3<f32>(normal_stiffness(c, g), normal_damping(c, g), power);
+        if (first) {
+            response[w] = r;
+        } else {
+            response[w] += r;
+        }
+    }
+}
+
+// Grain i's contacts with mesh wall w (mesh_touching), each in the slot of its history
+// (mesh_assign) at wall_hist[base..]: slots of hist_blocks blocks and the normal's block.
+// A grain touching the mesh at more places than it keeps stops the run (control.mesh_overflow).
+fn mesh_loads(i: u32, w: u32, wall: Wall, base: u32, lid: u32, out: ptr<function, WallLoad>) {
+    let p = pos[i];
+    let r = residual[i];
+    let m = meshes[bitcast<u32>(wall.normal.x)];
+    let t = mesh_touching(m, complete(p.xyz - wall.point.xyz, r.xyz, r.w), p.w);
+    if (t.overflow) {
+        atomicMin(&control.mesh_overflow, i);
+        return;
+    }
+    let size = params.hist_blocks + 1u;
+    var last: array<vec3<f32>, MESH_CONTACTS>;
+    for (var j = 0u; j < MESH_CONTACTS; j++) {
+        last[j] = wall_hist[base + j * size + params.hist_blocks].xyz;
+    }
+    let uses = mesh_assign(t, last, bitcast<f32>(m.bases.w));
+    var first = true;
+    for (var j = 0u; j < MESH_CONTACTS; j++) {
+        let at = base + j * size;
+        if (uses[j] == MESH_SLOT_FREE || uses[j] >= MESH_SLOT_NEW) {
+            for (var b = 0u; b < size; b++) { wall_hist[at + b] = vec4<f32>(0.0); }
+        }
+        if (uses[j] == MESH_SLOT_FREE) {
+            continue;
+        }
+        let k = uses[j] % MESH_SLOT_NEW;
+        wall_contact_at(i, w, wall, t.normal[k], t.dist[k], at, lid, first, out);
+        wall_hist[at + params.hist_blocks] = vec4<f32>(t.normal[k], 0.0);
+        first = false;
+    }
 }
 
 // Sums `reaction` over the workgroup's lanes by a fixed-order tree into wall_partials[at..].

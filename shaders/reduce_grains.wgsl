@@ -14,6 +14,9 @@
 @group(0) @binding(9) var<storage, read> coeffs: array<PairCoeffs>;
 @group(0) @binding(10) var<storage, read> walls: array<Wall>;
 @group(0) @binding(11) var<storage, read_write> grain_rows: array<f32>;
+@group(0) @binding(12) var<storage, read> meshes: array<MeshInfo>;
+@group(0) @binding(13) var<storage, read> mesh_data: array<vec4<f32>>;
+@group(0) @binding(14) var<storage, read> mesh_index: array<u32>;
 
 var<workgroup> row: array<f32, WG * STAT_ROW>;
 
@@ -48,9 +51,22 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         var contacts = f32(counts % WALL_COUNTS_SLIDING);
         var wall_contacts = 0u;
         for (var k = 0u; k < params.n_walls; k++) {
-            let frame = wall_frame(walls[k], p.xyz, residual[i]);
-            let h = p.w - frame.w;
-            if (h > 0.0) {
+            // The overlaps with the wall: one, or one per contact with a mesh.
+            var overlaps: array<f32, MESH_CONTACTS>;
+            var touching = 0u;
+            if (walls[k].kind == WALL_MESH) {
+                let q = residual[i];
+                let t = mesh_touching(meshes[bitcast<u32>(walls[k].normal.x)], complete(p.xyz - walls[k].point.xyz, q.xyz, q.w), p.w);
+                for (var j = 0u; j < t.len; j++) {
+                    overlaps[j] = p.w - t.dist[j];
+                }
+                touching = t.len;
+            } else {
+                overlaps[0] = p.w - wall_frame(walls[k], p.xyz, residual[i]).w;
+                touching = select(0u, 1u, overlaps[0] > 0.0);
+            }
+            for (var j = 0u; j < touching; j++) {
+                let h = overlaps[j];
                 let c = coeffs[walls[k].material * params.n_materials + material[i]];
                 contacts += 1.0;
                 wall_contacts += 1u;

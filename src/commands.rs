@@ -250,8 +250,6 @@ fn engine_for(scene: &Scene, backend: Backend, adapter: Option<&str>, precision:
         // Contact dynamics takes the GPU only when asked: its contacts are found on the host
         // and crossed over every step, and the wall contacts are swept on one invocation.
         Backend::Auto if rigid => cpu(precision),
-        // Mesh walls have no kernels yet.
-        Backend::Auto if scene.walls.iter().any(|w| matches!(w.shape, grains::scene::WallShape::Mesh { .. })) => cpu(precision),
         Backend::Gpu => {
             if precision == Some(Precision::F64) {
                 anyhow::bail!("--precision f64: the GPU backend computes in f32; fix: drop --precision or use --backend cpu");

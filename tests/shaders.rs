@@ -158,12 +158,13 @@ fn rust_mirrors_match_the_wgsl_structures() {
     check_struct!(&m, layout::Params, "Params", [
         n_grains, n_walls, n_materials, pair_capacity, hash_size, max_neighbours, piston, hist_blocks,
         gravity, periodic_lo, periodic_len, normal, damping, tangential, rolling, cohesion,
-        skin, reach, kt_law, rolling_as_written, r_min, classes, _pad1, _pad2, class_cell, class_dims
+        skin, reach, kt_law, rolling_as_written, r_min, classes, wall_blocks, _pad2, class_cell, class_dims
     ]);
     check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, then_kick]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);
-    check_struct!(&m, layout::Wall, "Wall", [kind, material, driven, _pad1, point, normal, velocity, drive]);
-    check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite, rebuild_checks]);
+    check_struct!(&m, layout::Wall, "Wall", [kind, material, driven, hist_at, point, normal, velocity, drive]);
+    check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite, rebuild_checks, mesh_overflow]);
+    check_struct!(&m, layout::MeshInfo, "MeshInfo", [origin, dims, bases]);
     check_struct!(&m, layout::DispatchArgs, "DispatchArgs", [x, y, z]);
     check_struct!(&m, layout::Servo, "Servo", [walls_lo, walls_hi, pressure, gain, max_speed, strain_rate, relaxation, work, work_lo, strain]);
     // Constants the host relies on.
@@ -184,7 +185,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     for (name, slot) in [("NORMAL_SLOT_NONE", normal_slot::NONE), ("NORMAL_SLOT_TANGENTIAL_W", normal_slot::TANGENTIAL_W), ("NORMAL_SLOT_ROLLING_W", normal_slot::ROLLING_W), ("NORMAL_SLOT_BRIDGE_Y", normal_slot::BRIDGE_Y), ("NORMAL_SLOT_OWN", normal_slot::OWN)] {
         assert_eq!(constant(name), slot, "{name}");
     }
-    for (name, kind) in [("WALL_PLANE", layout::wall_kind::PLANE), ("WALL_CYLINDER", layout::wall_kind::CYLINDER), ("WALL_PISTON", layout::wall_kind::PISTON)] {
+    for (name, kind) in [("WALL_PLANE", layout::wall_kind::PLANE), ("WALL_CYLINDER", layout::wall_kind::CYLINDER), ("WALL_PISTON", layout::wall_kind::PISTON), ("WALL_MESH", layout::wall_kind::MESH)] {
         assert_eq!(constant(name), kind, "{name}");
     }
     use layout::stat::{grain, pair};
@@ -235,4 +236,24 @@ fn every_registered_law_has_its_code_and_a_branch_in_the_shaders() {
         }
         assert!(own.contains(name.as_str()), "{name} has a registry row but no WGSL names it");
     }
+}
+
+/// The mesh kernels' region codes and slot counts are the CPU twin's (`src/mesh`).
+#[test]
+fn mesh_constants_match_the_cpu_twin() {
+    let k = KERNELS.iter().find(|k| k.name == "gather").expect("the gather kernel");
+    let src = k.wgsl();
+    let m = module(&src, k.name);
+    let constant = |name: &str| -> u32 {
+        let (_, c) = m.constants.iter().find(|(_, c)| c.name.as_deref() == Some(name)).unwrap_or_else(|| panic!("no const {name}"));
+        match m.global_expressions[c.init] {
+            naga::Expression::Literal(naga::Literal::U32(v)) => v,
+            ref e => panic!("{name}: {e:?}"),
+        }
+    };
+    use grains::mesh::closest::{EDGE, FACE, VERTEX};
+    assert_eq!([constant("MESH_FACE"), constant("MESH_EDGE"), constant("MESH_VERTEX")], [FACE, EDGE, VERTEX]);
+    assert_eq!(constant("MESH_CONTACTS") as usize, grains::mesh::MESH_CONTACTS);
+    assert_eq!(constant("RAW_CONTACTS") as usize, grains::mesh::RAW_CONTACTS);
+    assert!(constant("MESH_SLOT_NEW") as usize > grains::mesh::MESH_CONTACTS, "a new slot's mark must lie above every contact index");
 }

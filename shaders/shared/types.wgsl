@@ -26,7 +26,7 @@ struct Params {
     rolling_as_written: u32, // Oquendo et al.'s rolling friction: 0 torque pair, 1 eqs. 8-9 on each grain
     r_min: f32,           // the smallest grain's radius (m), for owner_capacity
     classes: u32,         // size classes of the neighbour search, 1 to MAX_CLASSES (src/state/levels.rs class_tops)
-    _pad1: u32,
+    wall_blocks: u32,     // vec4 blocks of wall history per grain: hist_blocks per wall, a mesh's slots (Wall.hist_at)
     _pad2: u32,
     class_cell: array<vec4<f32>, MAX_CLASSES>, // per size class: its grid's cell edge per axis (m) in xyz, its largest radius (m) in w
     class_dims: array<vec4<u32>, MAX_CLASSES>, // per size class: its grid's cells per wrapping axis; 0 where the axis does not wrap
@@ -56,6 +56,7 @@ struct PairCoeffs {
 const WALL_PLANE: u32 = 0u;
 const WALL_CYLINDER: u32 = 1u;
 const WALL_PISTON: u32 = 2u;
+const WALL_MESH: u32 = 3u;
 
 // Where a contact's normal velocity sits in its history blocks (src/gpu/layout.rs normal_slot).
 const NORMAL_SLOT_NONE: u32 = 0u;
@@ -74,9 +75,9 @@ struct Wall {
     kind: u32,
     material: u32,
     driven: u32,         // 1: a prescribed motion moves it (velocity, drive.xyz)
-    _pad1: u32,
-    point: vec4<f32>,    // plane: a point; cylinder: axis (x, y); piston: (0, 0, z)
-    normal: vec4<f32>,   // plane: unit normal into the domain; cylinder: w = radius
+    hist_at: u32,        // its first block in a grain's wall history (wall_hist[i * params.wall_blocks + hist_at])
+    point: vec4<f32>,    // plane: a point; cylinder: axis (x, y); piston: (0, 0, z); mesh: its shift from the scene's place
+    normal: vec4<f32>,   // plane: unit normal into the domain; cylinder: w = radius; mesh: x = bits of its index in `meshes`
     velocity: vec4<f32>, // m/s
     drive: vec4<f32>,    // piston: mass (kg), area (m^2), target pressure (Pa), external work (J);
                          // other walls: angular velocity (rad/s) about the axis through the
@@ -110,6 +111,16 @@ struct Control {
                                // no kernel until the host grows the buffers and goes on
     non_finite: atomic<u32>,   // lowest grain with a non-finite position, or 0xffffffff
     rebuild_checks: u32,       // decide_rebuild runs so far (the host finds the one that stopped)
+    mesh_overflow: atomic<u32>, // lowest grain touching a mesh at more places than it keeps, or 0xffffffff
+}
+
+// A mesh wall's triangles (src/mesh/grid.rs): the grid over its box in its own frame, and
+// where its corners (mesh_data), triangles (mesh_index: 3 corners, then 3 edges), cells' starts
+// and triangle ids (mesh_index) begin.
+struct MeshInfo {
+    origin: vec4<f32>,   // the grid's lower corner (m); w: the inverse of the cell side (1/m)
+    dims: vec4<u32>,     // cells along x, y, z; w: where its cells' starts begin in mesh_index
+    bases: vec4<u32>,    // its first corner in mesh_data, its first triangle's in mesh_index (6 u32 each), where its ids begin; w: bits of the merge cosine
 }
 
 // Workgroup-size indirect dispatch arguments.

@@ -1,5 +1,6 @@
 // Wall surfaces (needs `walls`): unit normal from the wall to a compensated position p + r
-// and the signed distance from the surface to it, positive on the grains' side.
+// and the signed distance from the surface to it, positive on the grains' side (not for a mesh,
+// whose contacts are mesh_touching's).
 fn wall_frame(w: Wall, p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
     if (w.kind == WALL_PLANE) {
         return vec4<f32>(w.normal.xyz, dot(complete(p - w.point.xyz, r.xyz, r.w), w.normal.xyz));
@@ -22,7 +23,7 @@ fn wall_spin(w: Wall) -> vec3<f32> {
 
 // The point on a wall's axis of symmetry that its spin turns about.
 fn wall_centre(w: Wall) -> vec3<f32> {
-    if (w.kind == WALL_PLANE) { return w.point.xyz; }
+    if (w.kind == WALL_PLANE || w.kind == WALL_MESH) { return w.point.xyz; }
     if (w.kind == WALL_CYLINDER) { return vec3<f32>(w.point.xy, 0.0); }
     return vec3<f32>(0.0, 0.0, w.point.z);
 }

@@ -164,7 +164,8 @@ pub(super) fn complete_loads<T: Real>(
     let moved = done.iter().fold(T::ZERO, |m, d| m.max(d.1));
     let overflow = done.iter().filter_map(|d| d.2).min();
     let mut touches: Vec<WallTouch<T>> = done.into_iter().flat_map(|d| d.0).collect();
-    touches.sort_unstable_by_key(|t| (t.grain, t.wall));
+    // Stable: a grain's contacts with a mesh keep their slots' order.
+    touches.sort_by_key(|t| (t.grain, t.wall));
     (WallSums::of(walls.len(), id.len(), &touches), touches, moved, overflow)
 }
 

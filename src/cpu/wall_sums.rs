@@ -45,7 +45,8 @@ impl<T: Real> WallRow<T> {
 }
 
 impl<T: Real> WallSums<T> {
-    /// The sums of `touches` (sorted by grain id, then wall) among `n_grains` grains: in the
+    /// The sums of `touches` (sorted by grain id, then wall, a grain's contacts with a mesh in
+    /// their slots' order) among `n_grains` grains: in the
     /// GPU's order for its twin ([`Real::GPU_TWIN`]), in chunks of ids otherwise. Either way
     /// the same bits however the slots are numbered.
     pub(super) fn of(n_walls: usize, n_grains: usize, touches: &[WallTouch<T>]) -> Self {
@@ -76,8 +77,12 @@ impl<T: Real> WallRow<T> {
                         return WallRow::ZERO;
                     }
                     lanes.fill(WallRow::ZERO);
+                    // A grain's contacts with a mesh add up in its lane in their order.
+                    let mut last = None;
                     for t in here.iter().filter(|t| t.wall as usize == w) {
-                        lanes[t.grain as usize % wg] = WallRow::of(t);
+                        let lane = &mut lanes[t.grain as usize % wg];
+                        *lane = if last == Some(t.grain) { lane.add(WallRow::of(t)) } else { WallRow::of(t) };
+                        last = Some(t.grain);
                     }
                     crate::workgroup::tree_sum(&mut lanes, WallRow::add)
                 });

@@ -50,8 +50,8 @@ pub const SUBMITS_PER_CHECK: u64 = 32;
 
 /// Buffers a checkpoint leaves out: the scene's constants (set up again from the scene) and
 /// scratch space every step or statistics read rewrites before reading it.
-const NOT_STATE: [Buf; 14] = [
-    Buf::Params, Buf::Phase, Buf::Material, Buf::Coeffs, // constants
+const NOT_STATE: [Buf; 17] = [
+    Buf::Params, Buf::Phase, Buf::Material, Buf::Coeffs, Buf::Meshes, Buf::MeshData, Buf::MeshIndex, // constants
     Buf::CellCount, Buf::CellFill, Buf::HashSums, Buf::GrainSums, Buf::SpareSum, // the hash grid
     Buf::BridgeEvent, // bridge scratch
     Buf::WallPartials, Buf::GrainRows, Buf::PairRows, Buf::Stats, // reductions
@@ -98,14 +98,6 @@ pub enum GpuSetupError {
         /// How to fix.
         fix: &'static str,
     },
-    /// The scene has a wall the kernels do not model yet.
-    #[error("{file}: {wall} is a mesh wall, which runs on the CPU backend so far; fix: run with --backend cpu")]
-    MeshWall {
-        /// The scene file.
-        file: String,
-        /// The wall's name.
-        wall: String,
-    },
     /// The device had not the memory for the scene's buffers.
     #[error("\"{adapter}\" could not allocate the {mib:.0} MiB of buffers the scene needs: {reason}; fix: run fewer grains on this device, or run with --backend cpu")]
     Memory {
@@ -141,6 +133,10 @@ pub struct GpuEngine {
     history: HistoryLayout,
     track_orientation: bool,
     wall_names: Vec<String>,
+    /// The mesh walls' surfaces in f32, for the host's re-evaluation of wall contacts.
+    meshes: Vec<crate::mesh::MeshSurface<f32>>,
+    /// The mesh walls' names, in their order.
+    mesh_names: Vec<String>,
     piston: Option<usize>,
     /// The servo box's planes (x_min, x_max, y_min, y_max, z_min, z_max), if any.
     servo: Option<[usize; 6]>,
@@ -201,9 +197,6 @@ impl GpuEngine {
     /// the tests take on purpose), not ahead of it at the checks: for a caller that knows the
     /// list a run will reach, or that would rather hold no margin at all.
     pub fn with_pair_capacity(gpu: Gpu, scene: &Scene, pairs: Option<u64>) -> Result<Self, anyhow::Error> {
-        if let Some(w) = scene.walls.iter().find(|w| matches!(w.shape, WallShape::Mesh { .. })) {
-            return Err(GpuSetupError::MeshWall { file: scene.path.display().to_string(), wall: w.name.clone() }.into());
-        }
         let n = scene.grains.len() as u64;
         let adapter = gpu.info.name.clone();
         let limit = |what, need: u64, have: u64, fix| -> Result<(), GpuSetupError> {
@@ -222,14 +215,14 @@ impl GpuEngine {
         let per_pair_bytes = 16 * hist_blocks.max(1);
         // Room for the first list comes once its pairs are counted (make_room_for_the_first_list).
         let pair_capacity = pairs.unwrap_or(n.max(1024)).max(1).min(binding / per_pair_bytes).min(binding / 16);
-        limit("bytes of wall history", 16 * n * scene.walls.len() as u64 * hist_blocks, binding, "use fewer walls or grains")?;
-
         let mut params = setup::params_of(scene, pair_capacity, hash_size, hist_blocks);
-        let (walls, piston) = setup::walls_of(scene);
+        let (walls, piston, wall_blocks) = setup::walls_of(scene, hist_blocks as u32);
+        params.wall_blocks = wall_blocks;
+        limit("bytes of wall history", 16 * n * wall_blocks as u64, binding, "use fewer walls or grains")?;
         if let Some(p) = piston {
             params.piston = p as u32;
         }
-        let control = Control { max_disp2: f32::INFINITY.to_bits(), overflow_grain: NONE, non_finite: NONE, ..Default::default() };
+        let control = Control { max_disp2: f32::INFINITY.to_bits(), overflow_grain: NONE, non_finite: NONE, mesh_overflow: NONE, ..Default::default() };
         let phase_stride = (gpu.limits.min_uniform_buffer_offset_alignment as u64).max(std::mem::size_of::<Phase>() as u64);
         let dt = scene.time_step.dt;
         let plans = Plans::of(&Schedule::new(scene.integrator, dt));
@@ -259,6 +252,8 @@ impl GpuEngine {
             history: layout_of_history,
             track_orientation: scene.track_orientation,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
+            meshes: scene.mesh_surfaces(),
+            mesh_names: scene.walls.iter().filter(|w| matches!(w.shape, WallShape::Mesh { .. })).map(|w| w.name.clone()).collect(),
             piston,
             servo: scene.servo.map(|s| s.walls),
             periodic: crate::periodic::Periodic::of(&scene.periodic),

@@ -84,6 +84,9 @@ buffers! {
     OutTi = "out_ti",
     OutTj = "out_tj",
     WallHist = "wall_hist",
+    Meshes = "meshes",
+    MeshData = "mesh_data",
+    MeshIndex = "mesh_index",
     WallPartials = "wall_partials",
     GrainRows = "grain_rows",
     PairRows = "pair_rows",
@@ -144,6 +147,7 @@ pub fn shared(name: &str) -> &'static str {
         "model/cohesion" => include_str!("../../shaders/shared/model/cohesion.wgsl"),
         "neighbours" => include_str!("../../shaders/shared/neighbours.wgsl"),
         "walls" => include_str!("../../shaders/shared/walls.wgsl"),
+        "mesh" => include_str!("../../shaders/shared/mesh.wgsl"),
         "reduce" => include_str!("../../shaders/shared/reduce.wgsl"),
         "kick" => include_str!("../../shaders/shared/kick.wgsl"),
         "piston" => include_str!("../../shaders/shared/piston.wgsl"),
@@ -162,7 +166,8 @@ impl Kernel {
     /// (`model`) is every slot's law codes, written from the registries
     /// ([`crate::model::wgsl_codes`]), each slot's file ([`MODEL_SLOTS`],
     /// `shaders/shared/model/<slot>.wgsl`), then `shaders/shared/model.wgsl`, which composes
-    /// them. The neighbour search gets [`crate::state::OWNER_DOUBLINGS`].
+    /// them. The neighbour search gets [`crate::state::OWNER_DOUBLINGS`], the mesh walls
+    /// [`crate::mesh::MESH_CONTACTS`] and [`crate::mesh::RAW_CONTACTS`].
     pub fn wgsl(&self) -> String {
         let mut s = String::new();
         for inc in self.includes {
@@ -172,6 +177,9 @@ impl Kernel {
                     s.push_str(shared(slot));
                     s.push('\n');
                 }
+            }
+            if *inc == "mesh" {
+                s.push_str(&format!("const MESH_CONTACTS: u32 = {}u;\nconst RAW_CONTACTS: u32 = {}u;\n", crate::mesh::MESH_CONTACTS, crate::mesh::RAW_CONTACTS));
             }
             if *inc == "neighbours" {
                 s.push_str(&format!("const OWNER_DOUBLINGS: u32 = {}u;\n", crate::state::OWNER_DOUBLINGS));
@@ -192,9 +200,10 @@ const INTEGRATE: &[&str] = &["types", "dispatch", "kick", "piston", "position", 
 const GRID: &[&str] = &["types", "dispatch", "position", "grid"];
 const DETECT: &[&str] = &["types", "dispatch", "position", "grid", "neighbours"];
 const FORCES: &[&str] = &["types", "dispatch", "position", "grid", "model"];
-const GATHER: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "kick", "drift"];
+const GATHER: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "mesh", "kick", "drift"];
 const CD: &[&str] = &["types", "dispatch", "cd"];
 const STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "reduce"];
+const GRAIN_STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "mesh", "reduce"];
 
 macro_rules! kernel {
     ($name:literal, $inc:expr, [$($b:ident: $a:expr),* $(,)?]) => {
@@ -260,9 +269,9 @@ kernel_table! {
     FindBridgeEvents = "find_bridge_events", FORCES, [Params: Uniform, Pos: Read, Residual: Read, PairI: Read, PairJ: Read, Hist: Read, BridgeEvent: Write, Control: Read];
     UpdateBridges = "update_bridges", FORCES, [Params: Uniform, PairI: Read, PairJ: Read, BridgeEvent: Read, Hist: ReadWrite, Liquid: ReadWrite, Control: Read];
     PairForce = "pair_force", FORCES, [Params: Uniform, Phase: Phase, Pos: Read, Residual: Read, Vel: Read, Omega: Read, Material: Read, Coeffs: Read, PairI: Read, PairJ: Read, Hist: ReadWrite, OutFi: Write, OutFj: Write, OutTi: Write, OutTj: Write, Control: Read];
-    Gather = "gather", GATHER, [Params: Uniform, Phase: Phase, Vel: ReadWrite, Omega: ReadWrite, PairStart: Read, RevStart: Read, RevPair: Read, OutFi: Read, OutFj: Read, OutTi: Read, OutTj: Read, Pos: ReadWrite, Residual: ReadWrite, Material: Read, Coeffs: Read, Walls: Read, WallHist: ReadWrite, WallPartials: Write, Force: Write, Torque: Write, BuiltAt: Read, Quat: ReadWrite, Control: ReadWrite];
+    Gather = "gather", GATHER, [Params: Uniform, Phase: Phase, Vel: ReadWrite, Omega: ReadWrite, PairStart: Read, RevStart: Read, RevPair: Read, OutFi: Read, OutFj: Read, OutTi: Read, OutTj: Read, Pos: ReadWrite, Residual: ReadWrite, Material: Read, Coeffs: Read, Walls: Read, WallHist: ReadWrite, WallPartials: Write, Force: Write, Torque: Write, BuiltAt: Read, Quat: ReadWrite, Control: ReadWrite, Meshes: Read, MeshData: Read, MeshIndex: Read];
     WallReduce = "wall_reduce", PISTON, [Params: Uniform, Phase: Phase, WallPartials: Read, WallReaction: ReadWrite, Walls: ReadWrite];
-    ReduceGrains = "reduce_grains", STATS, [Params: Uniform, Pos: Read, Residual: Read, Vel: Read, Omega: Read, Force: Read, Torque: Read, Image: Read, Material: Read, Coeffs: Read, Walls: Read, GrainRows: Write];
+    ReduceGrains = "reduce_grains", GRAIN_STATS, [Params: Uniform, Pos: Read, Residual: Read, Vel: Read, Omega: Read, Force: Read, Torque: Read, Image: Read, Material: Read, Coeffs: Read, Walls: Read, GrainRows: Write, Meshes: Read, MeshData: Read, MeshIndex: Read];
     ReducePairs = "reduce_pairs", STATS, [Params: Uniform, Pos: Read, Residual: Read, Material: Read, Coeffs: Read, PairI: Read, PairJ: Read, OutFi: Read, OutTi: Read, Control: Read, PairRows: Write];
     ReduceFinal = "reduce_final", STATS, [Params: Uniform, GrainRows: Read, PairRows: Read, Control: Read, Stats: Write];
 }

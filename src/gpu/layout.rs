@@ -58,8 +58,8 @@ pub struct Params {
     /// Size classes of the neighbour search, 1 to [`MAX_CLASSES`]
     /// ([`crate::state::class_tops`]).
     pub classes: u32,
-    /// Padding to the class tables' 16-byte alignment.
-    pub _pad1: u32,
+    /// vec4 blocks of wall history per grain ([`Wall::hist_at`]).
+    pub wall_blocks: u32,
     /// Padding.
     pub _pad2: u32,
     /// Per size class: its grid's cell edge per axis (m) in xyz, its largest radius (m) in w.
@@ -153,6 +153,8 @@ pub mod wall_kind {
     pub const CYLINDER: u32 = 1;
     /// The oedometer's piston.
     pub const PISTON: u32 = 2;
+    /// A triangle mesh ([`super::MeshInfo`]).
+    pub const MESH: u32 = 3;
 }
 
 /// A wall (WGSL `Wall`), of kind [`wall_kind`].
@@ -165,11 +167,12 @@ pub struct Wall {
     pub material: u32,
     /// 1 where a prescribed motion moves the wall (`velocity`, `drive`'s spin).
     pub driven: u32,
-    /// Padding.
-    pub _pad1: u32,
-    /// Plane point; cylinder axis (x, y); piston (0, 0, z).
+    /// Its first vec4 block in a grain's wall history: `hist_blocks` per wall before it, a
+    /// mesh's [`crate::mesh::MESH_CONTACTS`] slots of `hist_blocks + 1`.
+    pub hist_at: u32,
+    /// Plane point; cylinder axis (x, y); piston (0, 0, z); a mesh's shift (m).
     pub point: Vec4,
-    /// Plane unit normal; cylinder w = radius.
+    /// Plane unit normal; cylinder w = radius; a mesh's index in `meshes` in x's bits.
     pub normal: Vec4,
     /// Velocity (m/s).
     pub velocity: Vec4,
@@ -226,6 +229,24 @@ pub struct Control {
     pub non_finite: u32,
     /// `decide_rebuild` runs so far (wrapping).
     pub rebuild_checks: u32,
+    /// Lowest grain touching a mesh at more places than it keeps, or [`NONE`].
+    pub mesh_overflow: u32,
+}
+
+/// A mesh wall's triangles as the kernels read them (WGSL `MeshInfo`): its grid
+/// ([`crate::mesh::grid::TriangleGrid`]) and where its parts begin in `mesh_data` (corners,
+/// vec4) and `mesh_index` (per triangle 3 corners and 3 edges, then the cells' starts, then the
+/// triangle ids).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub struct MeshInfo {
+    /// The grid's lower corner (m); w: the inverse of its cell side (1/m).
+    pub origin: Vec4,
+    /// Cells along x, y, z; w: where the cells' starts begin in `mesh_index`.
+    pub dims: UVec4,
+    /// Its first corner in `mesh_data`, its first triangle in `mesh_index`, where its ids
+    /// begin in `mesh_index`; w: the merge cosine's bits.
+    pub bases: UVec4,
 }
 
 /// Indirect dispatch arguments (WGSL `DispatchArgs`).

@@ -9,6 +9,7 @@ mod periodic_specs;
 mod read;
 mod stage_specs;
 mod wall_specs;
+mod wall_schema;
 pub mod schema;
 pub mod types;
 

@@ -30,6 +30,13 @@ impl GpuEngine {
         super::super::pipeline::read_back(&self.gpu, &buffers).map_err(|reason| SimError::Device { what: parts.iter().map(|p| p.0.name()).collect::<Vec<_>>().join(", "), reason })
     }
 
+    /// The error for grain `grain`, which touched a mesh at more places than it keeps (the
+    /// mesh named where the scene has one).
+    fn mesh_overflow_error(&self, grain: u32) -> SimError {
+        let wall = if self.meshes.len() == 1 { self.mesh_names.first().cloned().unwrap_or_default() } else { format!("(one of {})", self.mesh_names.join(", ")) };
+        SimError::MeshContacts { step: self.step, grain, wall, max: crate::mesh::MESH_CONTACTS, raw: crate::mesh::RAW_CONTACTS }
+    }
+
     /// Reads the control flags and counters back (and keeps them).
     pub(super) fn read_control(&mut self) -> Result<Control, SimError> {
         let c = self.read(&[(Buf::Control, 0, std::mem::size_of::<Control>() as u64)])?;
@@ -50,6 +57,9 @@ impl GpuEngine {
             let c = self.read_control()?;
             if c.overflow_grain != NONE {
                 return Err(SimError::Capacity { step: self.step, grain: c.overflow_grain, count: c.overflow_count as usize, capacity: self.params.max_neighbours as usize });
+            }
+            if c.mesh_overflow != NONE {
+                return Err(self.mesh_overflow_error(c.mesh_overflow));
             }
             let marks = std::mem::take(&mut self.marks);
             let base = std::mem::replace(&mut self.marks_base, c.rebuild_checks);

@@ -65,15 +65,18 @@ pub(super) fn params_of(scene: &Scene, pair_capacity: u64, hash_size: u64, hist_
     params
 }
 
-/// The walls as the kernels read them, and the piston's index among them.
-pub(super) fn walls_of(scene: &Scene) -> (Vec<layout::Wall>, Option<usize>) {
+/// The walls as the kernels read them, their history placed for `hist_blocks` blocks per
+/// contact, the piston's index among them, and the wall history's blocks per grain.
+pub(super) fn walls_of(scene: &Scene, hist_blocks: u32) -> (Vec<layout::Wall>, Option<usize>, u32) {
     let mut piston = None;
+    let mut hist_at = 0;
     let walls: Vec<layout::Wall> = scene
         .walls
         .iter()
         .enumerate()
         .map(|(w, wall)| {
-            let mut g = layout::Wall { material: wall.material as u32, ..Default::default() };
+            let mut g = layout::Wall { material: wall.material as u32, hist_at, ..Default::default() };
+            hist_at += hist_blocks;
             match &wall.shape {
                 &WallShape::Plane { point, normal } => {
                     g.kind = layout::wall_kind::PLANE;
@@ -85,8 +88,11 @@ pub(super) fn walls_of(scene: &Scene) -> (Vec<layout::Wall>, Option<usize>) {
                     g.point = Vec4::new(center[0] as f32, center[1] as f32, 0.0, 0.0);
                     g.normal = Vec4::new(0.0, 0.0, 0.0, radius as f32);
                 }
-                // Refused by `GpuEngine::with_pair_capacity`.
-                WallShape::Mesh { .. } => {}
+                WallShape::Mesh { index, .. } => {
+                    g.kind = layout::wall_kind::MESH;
+                    g.normal = Vec4::new(f32::from_bits(*index), 0.0, 0.0, 0.0);
+                    hist_at += crate::mesh::MESH_CONTACTS as u32 * (hist_blocks + 1) - hist_blocks;
+                }
                 &WallShape::Piston { z, pressure, mass, area } => {
                     g.kind = layout::wall_kind::PISTON;
                     g.point = Vec4::new(0.0, 0.0, z as f32, 0.0);
@@ -103,7 +109,32 @@ pub(super) fn walls_of(scene: &Scene) -> (Vec<layout::Wall>, Option<usize>) {
             g
         })
         .collect();
-    (walls, piston)
+    (walls, piston, hist_at)
+}
+
+/// The mesh walls' triangles as the kernels read them: each mesh's [`layout::MeshInfo`], the
+/// corners (`mesh_data`) and the triangles, cells and ids (`mesh_index`), of the f32 surfaces
+/// the CPU's twin holds ([`Scene::mesh_surfaces`]).
+pub(super) fn meshes_of(scene: &Scene) -> (Vec<layout::MeshInfo>, Vec<[f32; 4]>, Vec<u32>) {
+    let (mut infos, mut data, mut index) = (Vec::new(), Vec::new(), Vec::new());
+    for m in scene.mesh_surfaces::<f32>() {
+        let g = &m.grid;
+        let (corners, triangles) = (data.len() as u32, index.len() as u32);
+        data.extend(m.vertices.iter().map(|v| [v.x, v.y, v.z, 0.0]));
+        for (t, e) in m.triangles.iter().zip(&m.edges) {
+            index.extend(t.iter().chain(e));
+        }
+        let starts = index.len() as u32;
+        index.extend(&g.start);
+        let ids = index.len() as u32;
+        index.extend(&g.ids);
+        infos.push(layout::MeshInfo {
+            origin: Vec4::new(g.origin.x, g.origin.y, g.origin.z, g.inv_cell),
+            dims: UVec4::new(g.dims[0], g.dims[1], g.dims[2], starts),
+            bases: UVec4::new(corners, triangles, ids, m.merge_cos.to_bits()),
+        });
+    }
+    (infos, data, index)
 }
 
 /// Each pair of materials' coefficients, row-major, as the kernels read them.
@@ -152,7 +183,7 @@ pub(super) fn phase_slots(plans: &Plans, stride: u64) -> (Vec<Phase>, Vec<u8>) {
 /// the scene, the constants, the walls, the control record and the phases.
 pub(super) fn scene_buffers(device: &wgpu::Device, scene: &Scene, params: &Params, walls: Vec<layout::Wall>, control: &Control, phase_bytes: &[u8]) -> Buffers {
     let g = &scene.grains;
-    let (n, hash_size, hist_blocks) = (g.len() as u64, params.hash_size as u64, params.hist_blocks as u64);
+    let (n, hash_size) = (g.len() as u64, params.hash_size as u64);
     let coeffs = pair_coeffs_of(scene);
     let v4 = |a: glam::DVec3, w: f64| [a[0] as f32, a[1] as f32, a[2] as f32, w as f32];
     let pos: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.position[i], g.radius[i])).collect();
@@ -182,6 +213,10 @@ pub(super) fn scene_buffers(device: &wgpu::Device, scene: &Scene, params: &Param
     let walls_bytes: Vec<layout::Wall> = if walls.is_empty() { vec![layout::Wall::default()] } else { walls };
     init(Buf::Walls, bytemuck::cast_slice(&walls_bytes), wgpu::BufferUsages::empty());
     init(Buf::Control, bytemuck::bytes_of(control), wgpu::BufferUsages::empty());
+    let (infos, data, index) = meshes_of(scene);
+    init(Buf::Meshes, if infos.is_empty() { &[0; 48] } else { bytemuck::cast_slice(&infos) }, wgpu::BufferUsages::empty());
+    init(Buf::MeshData, if data.is_empty() { &[0; 16] } else { bytemuck::cast_slice(&data) }, wgpu::BufferUsages::empty());
+    init(Buf::MeshIndex, if index.is_empty() { &[0; 16] } else { bytemuck::cast_slice(&index) }, wgpu::BufferUsages::empty());
     let mut dispatch_args = vec![DispatchArgs { x: 0, y: 1, z: 1 }; args::SLOTS as usize];
     (dispatch_args[args::STEP_GRAINS as usize], dispatch_args[args::STEP_ONE as usize]) = (DispatchArgs::items(n), DispatchArgs::ONE);
     init(Buf::Args, bytemuck::cast_slice(&dispatch_args), wgpu::BufferUsages::INDIRECT);
@@ -210,7 +245,7 @@ pub(super) fn scene_buffers(device: &wgpu::Device, scene: &Scene, params: &Param
     for name in [Buf::PairStart, Buf::RevStart] {
         zeroed(name, 4 * (n + 1));
     }
-    let wall_hist = if hist_blocks > 0 { 16 * n * scene.walls.len() as u64 * hist_blocks } else { 16 };
+    let wall_hist = 16 * n * params.wall_blocks as u64;
     zeroed(Buf::WallHist, wall_hist);
     // Per wall: the reaction, then the contacts' stiffness and damping (servo walls).
     let wall_partials = workgroup::rows(n) * 2 * MAX_WALLS as u64 * 16;

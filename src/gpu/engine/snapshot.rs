@@ -51,8 +51,31 @@ fn wall_geom(w: &layout::Wall) -> crate::walls::WallGeom<f32> {
     match w.kind {
         layout::wall_kind::PLANE => crate::walls::WallGeom::Plane { point: v3(w.point), normal: v3(w.normal) },
         layout::wall_kind::CYLINDER => crate::walls::WallGeom::Cylinder { cx: w.point[0], cy: w.point[1], radius: w.normal[3] },
+        layout::wall_kind::MESH => crate::walls::WallGeom::Mesh { mesh: w.normal[0].to_bits(), shift: v3(w.point) },
         _ => crate::walls::WallGeom::Piston { z: w.point[2] },
     }
+}
+
+/// The GPU's wall history (per grain, each wall's blocks from its `hist_at`) in the CPU
+/// engine's layout ([`crate::state::walls_reals`]): a wall's contact, or a mesh's slots of a
+/// contact and its normal.
+fn cpu_wall_history(blocks: &[[f32; 4]], walls: &[layout::Wall], hist_blocks: usize, slots: &crate::state::HistorySlots) -> Vec<f32> {
+    let mut out = Vec::new();
+    let mut at = 0;
+    while at < blocks.len() {
+        for w in walls {
+            let slots_of_wall = if w.kind == layout::wall_kind::MESH { crate::mesh::MESH_CONTACTS } else { 1 };
+            for _ in 0..slots_of_wall {
+                out.extend(cpu_history(&blocks[at..at + hist_blocks], slots));
+                at += hist_blocks;
+                if w.kind == layout::wall_kind::MESH {
+                    out.extend(&blocks[at][..3]);
+                    at += 1;
+                }
+            }
+        }
+    }
+    out
 }
 
 impl GpuEngine {
@@ -66,7 +89,7 @@ impl GpuEngine {
         let parts = self.read(&[
             (Buf::Material, 0, 4 * self.n as u64),
             (Buf::Walls, 0, (n_walls * std::mem::size_of::<layout::Wall>()) as u64),
-            (Buf::WallHist, 0, if blocks > 0 { 16 * (self.n as usize * n_walls * blocks) as u64 } else { 0 }),
+            (Buf::WallHist, 0, 16 * self.n as u64 * self.params.wall_blocks as u64),
         ])?;
         // Copied out: a wall's vectors are 16-byte aligned, the words read back 4.
         let walls: Vec<layout::Wall> = bytemuck::pod_collect_to_vec(&parts[1]);
@@ -86,7 +109,7 @@ impl GpuEngine {
             })
             .collect();
         let slots = HistorySlots::new(self.history);
-        let hist = cpu_history(gpu_hist, &slots);
+        let hist = cpu_wall_history(gpu_hist, &walls, blocks, &slots);
         let ctx = ForceContext {
             model: &self.model,
             coeffs: &self.coeffs,
@@ -97,7 +120,7 @@ impl GpuEngine {
             periodic: crate::periodic::Periodic::default(),
             residual: &residual,
             material,
-            meshes: &[],
+            meshes: &self.meshes,
         };
         Ok(wall_contact_records(&body, &prop, &(0..self.n).collect::<Vec<u32>>(), &states, &ctx, &hist))
     }
