@@ -281,7 +281,15 @@ pub fn check_report(scene: &Scene) -> String {
     let _ = writeln!(s, "radius (m): min {rmin:.4e}, mean {rmean:.4e}, max {rmax:.4e}");
     let _ = writeln!(s, "mass (kg): min {mmin:.4e}, mean {mmean:.4e}, max {mmax:.4e}, total {:.4e}", g.mass.iter().sum::<f64>());
     for w in &scene.walls {
-        let _ = writeln!(s, "wall {}: {:?}", w.name, w.shape);
+        match &w.shape {
+            WallShape::Mesh { mesh, .. } => {
+                let (lo, hi) = mesh.bounds();
+                let _ = writeln!(s, "wall {}: mesh {} ({} triangles, {} corners, from {:?} to {:?} m)", w.name, mesh.file.display(), mesh.triangles.len(), mesh.vertices.len(), lo.to_array(), hi.to_array());
+            }
+            shape => {
+                let _ = writeln!(s, "wall {}: {shape:?}", w.name);
+            }
+        }
     }
     match scene.method {
         crate::scene::Method::Dem => {
