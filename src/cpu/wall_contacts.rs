@@ -4,7 +4,7 @@
 use super::wall_springs::is_candidate;
 use crate::state::{mesh_contacts, wall_contact, wall_reals, Body, ForceContext, Load, Props, WallState};
 use crate::walls::WallGeom;
-use crate::model::{normal_damping, parted_normal_force, Geometry, NormalModel, Regime};
+use crate::model::{normal_damping, parted_normal_force, ContactForce, Geometry, NormalModel, PairCoeffs, Regime};
 use crate::real::{Real, Vec3};
 
 /// What one grain-wall contact adds to its wall's sums.
@@ -29,6 +29,24 @@ pub struct WallTouch<T> {
     /// ([`parted_normal_force`]): its force counts in the wall's reaction, not in its
     /// touching grains, stiffness, damping or regimes.
     pub touching: bool,
+}
+
+impl<T: Real> WallTouch<T> {
+    /// The touching contact of grain `id` with wall `w` whose force is `f`, with its geometry
+    /// `geo`, coefficients `c` and the spin's `power` (W).
+    #[inline(always)]
+    fn touching(id: u32, w: usize, f: &ContactForce<T>, ctx: &ForceContext<T>, c: &PairCoeffs<T>, geo: &Geometry<T>, power: T) -> Self {
+        WallTouch {
+            grain: id,
+            wall: w as u32,
+            force: f.f_i,
+            stiffness: ctx.model.normal.stiffness(c, geo),
+            damping: normal_damping(&ctx.model.damping, &ctx.model.normal, c, geo),
+            power,
+            regime: f.regime,
+            touching: true,
+        }
+    }
 }
 
 impl<T> WallTouch<T> {
@@ -74,16 +92,7 @@ pub fn wall_contacts<T: Real>(
             let touched = mesh_contacts(b, residual, p, material, wall, &ctx.meshes[mesh as usize], shift, ctx, h_slot, |_, geo, c, f| {
                 load.force += f.f_i;
                 load.torque += f.t_i;
-                touches.push(WallTouch {
-                    grain: id,
-                    wall: w as u32,
-                    force: f.f_i,
-                    stiffness: ctx.model.normal.stiffness(c, geo),
-                    damping: normal_damping(&ctx.model.damping, &ctx.model.normal, c, geo),
-                    power: T::ZERO,
-                    regime: f.regime,
-                    touching: true,
-                });
+                touches.push(WallTouch::touching(id, w, f, ctx, c, geo, T::ZERO));
             });
             if !touched {
                 *overflow = Some(id);
@@ -107,16 +116,7 @@ pub fn wall_contacts<T: Real>(
         let power = if wall.spin == Vec3::ZERO { T::ZERO } else { f.f_i.dot(wall.velocity_at(b.pos - n * dist) - wall.velocity) };
         load.force += f.f_i;
         load.torque += f.t_i;
-        touches.push(WallTouch {
-            grain: id,
-            wall: w as u32,
-            force: f.f_i,
-            stiffness: ctx.model.normal.stiffness(c, &geo),
-            damping: normal_damping(&ctx.model.damping, &ctx.model.normal, c, &geo),
-            power,
-            regime: f.regime,
-            touching: true,
-        });
+        touches.push(WallTouch::touching(id, w, &f, ctx, c, &geo, power));
     }
     load
 }
