@@ -310,8 +310,9 @@ impl<T: Real> Net<T> {
             Some(SimError::Capacity { grain, count, .. }) => [1, self.gid[*grain as usize] as u64, *count as u64],
             Some(SimError::Unstable { grain, .. }) => [2, self.gid.get(*grain as usize).copied().unwrap_or(*grain) as u64, 0],
             Some(SimError::Device { .. }) => [2, 0, 0],
-            // The GPU's pair buffers: no process of a distributed CPU run has them.
-            Some(SimError::Internal { .. } | SimError::PairBuffers { .. } | SimError::DeviceMemory { .. }) => [3, 0, 0],
+            // The GPU's pair buffers: no process of a distributed CPU run has them; nor mesh
+            // walls, which it refuses.
+            Some(SimError::Internal { .. } | SimError::PairBuffers { .. } | SimError::DeviceMemory { .. } | SimError::MeshContacts { .. }) => [3, 0, 0],
         };
         let mut all = vec![0u64; 3 * self.world.size() as usize];
         self.world.all_gather_into(&code[..], &mut all[..]);
