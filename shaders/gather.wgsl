@@ -122,6 +122,12 @@ fn wall_loads(i: u32, live: bool, lid: u32, row: u32) -> WallLoad {
         for (var w = 0u; w < params.n_walls; w++) {
             let wall = walls[w];
             let base = i * params.wall_blocks + wall.hist_at;
+            if ((wall.flags & WALL_ABSENT) != 0u) {
+                // Taken away: no contact, and its history forgotten.
+                let blocks = select(params.hist_blocks, MESH_CONTACTS * (params.hist_blocks + 1u), wall.kind == WALL_MESH);
+                for (var b = 0u; b < blocks; b++) { wall_hist[base + b] = vec4<f32>(0.0); }
+                continue;
+            }
             if (wall.kind == WALL_MESH) {
                 mesh_loads(i, w, wall, base, lid, &out);
                 continue;
@@ -191,7 +197,7 @@ fn wall_contact_at(i: u32, w: u32, wall: Wall, n: vec3<f32>, dist: f32, base: u3
     (*out).rolling += select(0u, 1u, f.regime == REGIME_ROLLING);
     if (WALL_RESPONSE) {
         var power = 0.0;
-        if (wall.driven == 1u && any(wall.drive.xyz != vec3<f32>(0.0))) {
+        if ((wall.flags & WALL_DRIVEN) != 0u && any(wall.drive.xyz != vec3<f32>(0.0))) {
             power = dot(f.f_i, surface - wall.velocity.xyz);
         }
         let r = vec3<f32>(normal_stiffness(c, g), normal_damping(c, g), power);

@@ -54,6 +54,9 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
             // The overlaps with the wall: one, or one per contact with a mesh.
             var overlaps: array<f32, MESH_CONTACTS>;
             var touching = 0u;
+            if ((walls[k].flags & WALL_ABSENT) != 0u) {
+                continue;
+            }
             if (walls[k].kind == WALL_MESH) {
                 let q = residual[i];
                 let t = mesh_touching(meshes[bitcast<u32>(walls[k].normal.x)], complete(p.xyz - walls[k].point.xyz, q.xyz, q.w), p.w);

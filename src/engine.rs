@@ -371,6 +371,10 @@ pub struct Frame {
     /// walls and the piston move). Not recorded in MCAP frames.
     #[serde(skip)]
     pub walls: Vec<crate::walls::WallGeom<f64>>,
+    /// Whether each wall is there (false while a stage has taken it away), in the scene's
+    /// wall order. Not recorded in MCAP frames.
+    #[serde(skip)]
+    pub walls_present: Vec<bool>,
 }
 
 /// One touching pair.
@@ -488,6 +492,10 @@ pub trait Engine {
     /// Sets wall `wall` (an index into the scene's walls: a plane or a cylinder, not the piston
     /// or a servo plane) moving as `drive` says from now on.
     fn set_wall_drive(&mut self, wall: usize, drive: &crate::scene::WallDrive);
+    /// Adds wall `wall` (index into the scene's walls) back among those grains meet
+    /// (`present`), or takes it away: it then touches no grain, its contacts' history is
+    /// forgotten, and it keeps its motion.
+    fn set_wall_present(&mut self, wall: usize, present: bool);
     /// Wets the sample with `volume` (m^3) of liquid: shared among the pairs closer than their
     /// rupture distance in proportion to their reduced diameter (Richefeu et al. (2009), docs/physics.md).
     fn wet(&mut self, volume: f64) -> anyhow::Result<()>;

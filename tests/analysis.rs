@@ -32,6 +32,7 @@ fn chain() -> Frame {
         contacts: Some(vec![rec(0, 1, 2.0), rec(1, 2, -0.5)]),
         wall_contacts: Some(vec![]),
         walls: Vec::new(),
+        walls_present: Vec::new(),
     }
 }
 

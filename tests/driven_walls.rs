@@ -185,11 +185,7 @@ fn driven_walls_run_on_the_gpu_as_on_the_cpu() {
 /// motion a stage set (here set as a stage would) comes back with it.
 #[test]
 fn a_run_with_driven_walls_resumes_bitwise() {
-    type Maker = Box<dyn Fn(&Scene) -> Option<Box<dyn Engine>>>;
-    let mut makers: Vec<(&str, Maker)> = vec![("cpu f64", Box::new(|s| Some(Box::new(common::engine::<f64>(s)) as Box<dyn Engine>)))];
-    if common::gpu().is_some() {
-        makers.push(("gpu", Box::new(|s| common::gpu_engine(s).map(|g| Box::new(g) as Box<dyn Engine>))));
-    }
+    let makers = common::resumable_engines();
     let spinning = grains::scene::WallDrive { velocity: glam::DVec3::ZERO, angular_velocity: glam::DVec3::new(0.0, 0.0, OMEGA) };
     for (s, set) in [(conveyor(2e-3), None), (pushed(1e-3), None), (drum(2e-3), Some(spinning))] {
         for (name, make) in &makers {

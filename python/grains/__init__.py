@@ -170,6 +170,12 @@ class Simulation:
         now on, as a stage's ``walls`` does; raises SceneError for a wall it cannot move."""
         self._sim.set_wall_motion(name, [float(v) for v in velocity], [float(w) for w in angular_velocity])
 
+    def set_wall_present(self, name: str, present: bool) -> None:
+        """Takes the walls ``name`` names away (``present=False``: grains pass through them,
+        a gate lifted out) or adds them back, as a stage's ``remove_walls`` and ``add_walls``
+        do (a box by its name: every face); adding one onto a grain is refused."""
+        self._sim.set_wall_present(name, bool(present))
+
     def set_servo(self, pressure: Optional[float] = None, axial_strain_rate: Optional[float] = None) -> None:
         """Sets the servo walls' target pressure (Pa) and the z walls' strain rate (1/s,
         positive closing; None: back to pressure control)."""

@@ -244,19 +244,39 @@ fn pool(threads: usize) -> PyResult<rayon::ThreadPool> {
     rayon::ThreadPoolBuilder::new().num_threads(threads).build().map_err(sim_err)
 }
 
-/// Where the scene's text lives for a checkpoint: its own file while unchanged, else
-/// `scene.toml` written into `dir`.
-fn scene_file_for(scene: &Scene, dir: Option<&Path>) -> PyResult<PathBuf> {
+/// Where the scene's text lives for a checkpoint, and that text: its own file while
+/// unchanged, else `scene.toml` written into `dir`, its files (meshes, grains read) named by
+/// absolute paths so that they resolve from there as they did from the scene's own folder.
+fn scene_file_for(scene: &Scene, dir: Option<&Path>) -> PyResult<(PathBuf, String)> {
     match (&scene.original, dir) {
-        (Some(_), _) => Ok(scene.path.clone()),
+        (Some(text), _) => Ok((scene.path.clone(), text.clone())),
         (None, Some(dir)) => {
             std::fs::create_dir_all(dir).map_err(|e| sim_err(anyhow::anyhow!("cannot create {}: {e}", dir.display())))?;
             let file = dir.join("scene.toml");
-            std::fs::write(&file, scene.text()).map_err(|e| sim_err(anyhow::anyhow!("cannot write {}: {e}", file.display())))?;
-            Ok(file)
+            let folder = std::path::absolute(&scene.path).map_err(sim_err)?.parent().map(Path::to_path_buf).unwrap_or_default();
+            let text = toml::to_string(&with_files_from(&scene.doc, &folder)).expect("a TOML table serialises");
+            std::fs::write(&file, &text).map_err(|e| sim_err(anyhow::anyhow!("cannot write {}: {e}", file.display())))?;
+            Ok((file, text))
         }
-        (None, None) => Ok(scene.path.clone()),
+        (None, None) => Ok((scene.path.clone(), scene.text())),
     }
+}
+
+/// `doc` with the relative `file` of each `[[wall]]` and `[[read]]` table made absolute from
+/// `folder`, the scene's own.
+fn with_files_from(doc: &toml::Table, folder: &Path) -> toml::Table {
+    let mut doc = doc.clone();
+    for table in ["wall", "read"] {
+        let Some(toml::Value::Array(items)) = doc.get_mut(table) else { continue };
+        for item in items.iter_mut() {
+            if let Some(toml::Value::String(f)) = item.get_mut("file") {
+                if Path::new(f.as_str()).is_relative() {
+                    *f = folder.join(&*f).display().to_string();
+                }
+            }
+        }
+    }
+    doc
 }
 
 #[pymethods]
@@ -273,8 +293,7 @@ impl Simulation {
         if !force {
             validated.check_practical().map_err(scene_err)?;
         }
-        let scene_file = scene_file_for(scene, out.as_deref())?;
-        let scene_text = scene.text();
+        let (scene_file, scene_text) = scene_file_for(scene, out.as_deref())?;
         let pool = pool(threads.unwrap_or(0))?;
         let (backend, precision) = (backend.to_string(), precision.map(str::to_string));
         let sim = py.detach(|| {
@@ -411,6 +430,18 @@ impl Simulation {
         let drives = sim.scene.wall_drives("set_wall_motion", name, velocity.into(), angular_velocity.into()).map_err(scene_err)?;
         for (wall, drive) in &drives {
             sim.engine.set_wall_drive(*wall, drive);
+        }
+        Ok(())
+    }
+
+    /// Takes the walls `name` names away (`present` false: grains pass through them) or adds
+    /// them back, as a stage's `remove_walls` and `add_walls` do.
+    fn set_wall_present(&self, name: &str, present: bool) -> PyResult<()> {
+        let mut sim = self.lock()?;
+        let walls = sim.scene.walls_to_add_or_remove("set_wall_present", name).map_err(scene_err)?;
+        let sim = &mut *sim;
+        for w in walls {
+            grains::protocol::set_wall_present(&sim.scene, sim.engine.as_mut(), w, present, "set_wall_present").map_err(sim_err)?;
         }
         Ok(())
     }

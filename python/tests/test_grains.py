@@ -128,25 +128,47 @@ def test_a_parameter_set_from_python_runs_as_the_same_toml_edit(tmp_path: Path) 
     assert (tmp_path / "plain" / "stats.csv").read_bytes() != (tmp_path / "py" / "stats.csv").read_bytes()
 
 
+def box_named_and_staged(tmp_path: Path, stage_keys: str) -> Path:
+    """The small scene with its box named "bin": run by the command line into tmp_path/cli with
+    `stage_keys` added to its second stage; returns the scene without them, for Python to do
+    the same between the stages."""
+    text = small_scene(tmp_path).read_text().replace('type = "box"', 'type = "box"\nname = "bin"')
+    named = tmp_path / "named.toml"
+    named.write_text(text)
+    staged = tmp_path / "staged.toml"
+    staged.write_text(text.replace('name = "hold"', f'name = "hold"\n{stage_keys}'))
+    done = run_cli("run", str(staged), "--out", str(tmp_path / "cli"), "--json", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    return named
+
+
 def test_a_wall_set_moving_from_python_moves_as_a_stages_walls_do(tmp_path: Path) -> None:
     """The small scene's box given a name: its second stage moving the box by its `walls` key
     (run by the command line) and the same motion set from Python between the stages end in the
     same files; a name that moves nothing raises SceneError naming it."""
-    path = small_scene(tmp_path)
-    text = path.read_text().replace('type = "box"', 'type = "box"\nname = "bin"')
-    named = tmp_path / "named.toml"
-    named.write_text(text)
-    staged = tmp_path / "staged.toml"
-    staged.write_text(text.replace('name = "hold"', 'name = "hold"\nwalls = { bin = { velocity = [0.02, 0.0, 0.0] } }'))
-    done = run_cli("run", str(staged), "--out", str(tmp_path / "cli"), "--json", cwd=tmp_path)
-    assert done.returncode == 0, done.stderr
-    sim = grains.Simulation(grains.Scene.load(named), out=tmp_path / "py", progress=False)
+    sim = grains.Simulation(grains.Scene.load(box_named_and_staged(tmp_path, "walls = { bin = { velocity = [0.02, 0.0, 0.0] } }")), out=tmp_path / "py", progress=False)
     sim.run_stage()
     sim.set_wall_motion("bin", velocity=(0.02, 0.0, 0.0))
     sim.run()
     same_files(tmp_path / "cli", tmp_path / "py")
     with pytest.raises(grains.SceneError, match=r'set_wall_motion = "gate": names no wall'):
         sim.set_wall_motion("gate", velocity=(1.0, 0.0, 0.0))
+
+
+def test_a_wall_taken_away_from_python_goes_as_a_stages_remove_walls_does(tmp_path: Path) -> None:
+    """The small scene's box given a name: its second stage taking the box's floor away by its
+    `remove_walls` key (run by the command line) and the same floor taken away from Python
+    between the stages end in the same files, the grains falling out of the box; adding it back
+    under the grains that fell through it raises SimulationError naming the wall."""
+    sim = grains.Simulation(grains.Scene.load(box_named_and_staged(tmp_path, 'remove_walls = ["bin.bottom"]')), out=tmp_path / "py", progress=False)
+    sim.run_stage()
+    floor = sim.state()["positions"][:, 2].min()
+    sim.set_wall_present("bin.bottom", False)
+    sim.run()
+    same_files(tmp_path / "cli", tmp_path / "py")
+    assert sim.state()["positions"][:, 2].min() < floor - 1e-3
+    with pytest.raises(grains.SimulationError, match=r"set_wall_present adds wall bin.bottom, which grain \d+ .* overlaps by"):
+        sim.set_wall_present("bin.bottom", True)
 
 
 def test_bad_scenes_raise_the_named_errors_with_the_clis_message(tmp_path: Path) -> None:
@@ -336,6 +358,24 @@ def test_a_progress_callback_hears_every_statistics_read_and_can_stop_the_run(tm
     assert (out / "stats.csv").read_text().count("\n") == 1 + 11
     with pytest.raises(grains.SimulationError, match="resume"):
         sim2.run_stage()
+
+
+def test_a_changed_scene_with_a_mesh_resumes_from_its_run_folder(tmp_path: Path) -> None:
+    """scenes/silo.toml names its mesh relative to its folder; changed from Python, its text is
+    kept in the run folder as scene.toml, with the mesh named by an absolute path, so that
+    `Simulation.resume` there reads the same plate and goes on after the first stage."""
+    scene = grains.Scene.load(REPO / "scenes" / "silo.toml")
+    scene.update({"generate.0.count": 200, "stage.0.duration": 0.01, "stage.1.duration": 0.005})
+    out = tmp_path / "run"
+    sim = grains.Simulation(scene, out=out, progress=False)
+    sim.run_stage()
+    kept = (out / "scene.toml").read_text()
+    plate = str((REPO / "scenes" / "meshes" / "orifice_plate_10mm.stl").resolve())
+    assert plate in kept, kept
+    resumed = grains.Simulation.resume(out, progress=False)
+    assert resumed.stages == (["fill", "discharge"], 1)
+    resumed.run()
+    assert resumed.time > sim.time
 
 
 def test_ctrl_c_stops_a_run_which_resumes_from_its_last_checkpoint(tmp_path: Path) -> None:

@@ -30,7 +30,7 @@ fn move_walls(drift: f32) {
         return;
     }
     for (var w = 0u; w < params.n_walls; w++) {
-        if (walls[w].driven != 1u) {
+        if ((walls[w].flags & WALL_DRIVEN) == 0u) {
             continue;
         }
         let v = walls[w].velocity.xyz;

@@ -58,6 +58,10 @@ const WALL_CYLINDER: u32 = 1u;
 const WALL_PISTON: u32 = 2u;
 const WALL_MESH: u32 = 3u;
 
+// Wall flags (src/gpu/layout.rs wall_flags), bits of Wall.flags.
+const WALL_DRIVEN: u32 = 1u;
+const WALL_ABSENT: u32 = 2u;
+
 // Where a contact's normal velocity sits in its history blocks (src/gpu/layout.rs normal_slot).
 const NORMAL_SLOT_NONE: u32 = 0u;
 const NORMAL_SLOT_TANGENTIAL_W: u32 = 1u;
@@ -74,7 +78,7 @@ fn add_wall_row(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
 struct Wall {
     kind: u32,
     material: u32,
-    driven: u32,         // 1: a prescribed motion moves it (velocity, drive.xyz)
+    flags: u32,          // WALL_DRIVEN: a prescribed motion moves it (velocity, drive.xyz); WALL_ABSENT: a stage took it away
     hist_at: u32,        // its first block in a grain's wall history (wall_hist[i * params.wall_blocks + hist_at])
     point: vec4<f32>,    // plane: a point; cylinder: axis (x, y); piston: (0, 0, z); mesh: its shift from the scene's place
     normal: vec4<f32>,   // plane: unit normal into the domain; cylinder: w = radius; mesh: x = bits of its index in `meshes`

@@ -17,7 +17,7 @@ fn wall_frame(w: Wall, p: vec3<f32>, r: vec4<f32>) -> vec4<f32> {
 
 // A driven wall's angular velocity (rad/s; zero for any other wall).
 fn wall_spin(w: Wall) -> vec3<f32> {
-    if (w.driven == 1u) { return w.drive.xyz; }
+    if ((w.flags & WALL_DRIVEN) != 0u) { return w.drive.xyz; }
     return vec3<f32>(0.0);
 }
 

@@ -131,6 +131,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
             velocity: self.body.iter().map(|b| b.vel.f64()).collect(),
             angular_velocity: self.body.iter().map(|b| b.omega.f64()).collect(),
             walls: self.walls.iter().map(|(geom, _)| geom.f64()).collect(),
+            walls_present: vec![true; self.walls.len()],
             ..Default::default()
         };
         if contacts {
@@ -265,6 +266,11 @@ impl<T: Real> Engine for ContactDynamics<T> {
 
     fn set_wall_drive(&mut self, _wall: usize, _drive: &crate::scene::WallDrive) {
         // Contact-dynamics scenes have no moving walls (refused at `ContactDynamics::new`).
+    }
+
+    fn set_wall_present(&mut self, _wall: usize, _present: bool) {
+        // Contact-dynamics scenes keep their walls (stages that add or remove one are refused
+        // at `ContactDynamics::new`).
     }
 
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {

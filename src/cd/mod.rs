@@ -292,6 +292,9 @@ impl<T: Real> ContactDynamics<T> {
         if scene.walls.iter().any(|w| w.drive.moves()) || scene.stages.iter().any(|s| !s.walls.is_empty()) {
             return unsupported("a wall with a prescribed velocity or spin", "use the DEM method (simulation.method = \"dem\")");
         }
+        if scene.stages.iter().any(|s| !s.presence.is_empty()) {
+            return unsupported("a stage that adds or removes a wall", "use the DEM method (simulation.method = \"dem\")");
+        }
         if !matches!(scene.model.cohesion, crate::model::CohesionLaw::None) {
             return unsupported("capillary cohesion", "drop [model] cohesion");
         }

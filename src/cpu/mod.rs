@@ -320,6 +320,10 @@ impl<T: Real> Engine for CpuEngine<T> {
         self.walls[wall].spin = Vec3::of(drive.angular_velocity);
     }
 
+    fn set_wall_present(&mut self, wall: usize, present: bool) {
+        self.walls[wall].present = present;
+    }
+
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
         if let Some(s) = &mut self.servo {
             if let Some(p) = pressure {

@@ -46,6 +46,7 @@ impl<T: Real> CpuEngine<T> {
                 wall_contact_records(&self.body, &self.prop, &self.id, &self.walls, &ctx, &self.wall_springs.dense(self.body.len(), walls_reals(&self.walls, self.slots.stride)))
             }),
             walls: self.walls.iter().map(|w| w.geom.f64()).collect(),
+            walls_present: self.walls.iter().map(|w| w.present).collect(),
         }
     }
 
@@ -93,6 +94,7 @@ impl<T: Real> CpuEngine<T> {
         // spin; and the spins' power.
         s.put_reals("driven_walls", self.drivable.iter().flat_map(|&w| [v3(&self.walls[w].geom.centre()), v3(&self.walls[w].velocity), v3(&self.walls[w].spin)].concat()));
         s.put_reals("wall_power", self.wall_power.iter().map(|x| x.f64()));
+        s.put_ints("wall_present", self.walls.iter().map(|w| w.present as u64));
         let l = &self.pairs;
         for (name, v) in [("owner_start", &l.owner_start), ("partner", &l.partner), ("rev_start", &l.rev_start), ("rev_pair", &l.rev_pair)] {
             s.put_ints(name, v.iter().map(|&x| x as u64));
@@ -194,6 +196,13 @@ impl<T: Real> CpuEngine<T> {
             for (&w, c) in self.drivable.iter().zip(s.reals("driven_walls", 9 * self.drivable.len())?.chunks_exact(9)) {
                 let wall = &mut self.walls[w];
                 (wall.geom, wall.velocity, wall.spin) = (wall.geom.centred_at(v3(&c[0..3])), v3(&c[3..6]), v3(&c[6..9]));
+            }
+        }
+        // Written before stages could add and remove walls: as the scene starts.
+        if s.ints.contains_key("wall_present") {
+            let present = s.ints("wall_present", Some(self.walls.len()))?;
+            for (wall, &p) in self.walls.iter_mut().zip(present) {
+                wall.present = p != 0;
             }
         }
         // Written before walls could spin: no power.

@@ -88,6 +88,10 @@ pub fn wall_contacts<T: Real>(
     for (w, wall) in walls.iter().enumerate() {
         let h_slot = &mut hist[at..at + wall_reals(wall, stride)];
         at += h_slot.len();
+        if !wall.present {
+            h_slot.fill(T::ZERO);
+            continue;
+        }
         if let WallGeom::Mesh { mesh, shift } = wall.geom {
             let touched = mesh_contacts(b, residual, p, material, wall, &ctx.meshes[mesh as usize], shift, ctx, h_slot, |_, geo, c, f| {
                 load.force += f.f_i;

@@ -133,6 +133,9 @@ pub struct GpuEngine {
     history: HistoryLayout,
     track_orientation: bool,
     wall_names: Vec<String>,
+    /// Each wall's [`layout::wall_flags`] as the walls buffer holds them (the host changes
+    /// them, the kernels only read them).
+    wall_flags: Vec<u32>,
     /// The mesh walls' surfaces in f32, for the host's re-evaluation of wall contacts.
     meshes: Vec<crate::mesh::MeshSurface<f32>>,
     /// The mesh walls' names, in their order.
@@ -217,6 +220,7 @@ impl GpuEngine {
         let pair_capacity = pairs.unwrap_or(n.max(1024)).max(1).min(binding / per_pair_bytes).min(binding / 16);
         let mut params = setup::params_of(scene, pair_capacity, hash_size, hist_blocks);
         let (walls, piston, wall_blocks) = setup::walls_of(scene, hist_blocks as u32);
+        let wall_flags = walls.iter().map(|w| w.flags).collect();
         params.wall_blocks = wall_blocks;
         limit("bytes of wall history", 16 * n * wall_blocks as u64, binding, "use fewer walls or grains")?;
         if let Some(p) = piston {
@@ -252,6 +256,7 @@ impl GpuEngine {
             history: layout_of_history,
             track_orientation: scene.track_orientation,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
+            wall_flags,
             meshes: scene.mesh_surfaces(),
             mesh_names: scene.walls.iter().filter(|w| matches!(w.shape, WallShape::Mesh { .. })).map(|w| w.name.clone()).collect(),
             piston,

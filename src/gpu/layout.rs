@@ -157,6 +157,14 @@ pub mod wall_kind {
     pub const MESH: u32 = 3;
 }
 
+/// A wall's flags (WGSL `WALL_*` flags), bits of [`Wall::flags`].
+pub mod wall_flags {
+    /// A prescribed motion moves it (velocity, the drive's spin).
+    pub const DRIVEN: u32 = 1;
+    /// A stage has taken it away: it touches no grain.
+    pub const ABSENT: u32 = 2;
+}
+
 /// A wall (WGSL `Wall`), of kind [`wall_kind`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
@@ -165,8 +173,9 @@ pub struct Wall {
     pub kind: u32,
     /// Material index.
     pub material: u32,
-    /// 1 where a prescribed motion moves the wall (`velocity`, `drive`'s spin).
-    pub driven: u32,
+    /// Its [`wall_flags`]: DRIVEN where a prescribed motion moves it (`velocity`, `drive`'s
+    /// spin), ABSENT while a stage has taken it away.
+    pub flags: u32,
     /// Its first vec4 block in a grain's wall history: `hist_blocks` per wall before it, a
     /// mesh's [`crate::mesh::MESH_CONTACTS`] slots of `hist_blocks + 1`.
     pub hist_at: u32,

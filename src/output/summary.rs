@@ -328,7 +328,8 @@ pub fn check_report(scene: &Scene) -> String {
         let _ = writeln!(s, "skin = {:.4e} m, stats every {} steps, neighbour capacity {}", scene.skin, scene.stats_interval, scene.max_neighbours);
     }
     for st in &scene.stages {
-        let _ = writeln!(s, "stage {}: {:?} for at most {:e} s ({} steps)", st.name, st.kind, st.duration, st.max_steps(ts.dt));
+        let changes: String = st.presence.iter().map(|&(w, present)| format!(", {} {}", if present { "adds" } else { "removes" }, scene.walls[w].name)).collect();
+        let _ = writeln!(s, "stage {}: {:?} for at most {:e} s ({} steps){changes}", st.name, st.kind, st.duration, st.max_steps(ts.dt));
     }
     let mib = |b: f64| b / (1024.0 * 1024.0);
     let _ = writeln!(s, "memory estimate (cpu, {ESTIMATE_PAIRS_PER_GRAIN} pairs/grain): {:.1} MiB in f64, {:.1} MiB in f32", mib(engine_bytes(scene, 8, ESTIMATE_PAIRS_PER_GRAIN)), mib(engine_bytes(scene, 4, ESTIMATE_PAIRS_PER_GRAIN)));

@@ -209,6 +209,9 @@ fn start_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine) -> anyhow:
     for (wall, drive) in &stage.walls {
         engine.set_wall_drive(*wall, drive);
     }
+    for &(wall, present) in &stage.presence {
+        set_wall_present(scene, engine, wall, present, &format!("stage {}", stage.name))?;
+    }
     let mut initial_void_ratio = None;
     if stage.lower_piston {
         let f = engine.frame(false)?;
@@ -217,6 +220,44 @@ fn start_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine) -> anyhow:
         initial_void_ratio = container_volume(scene, top).map(|v| void_ratio(solid_volume(&f), v));
     }
     Ok(StageProgress { done: 0, step0: engine.steps(), time0: engine.time(), initial_void_ratio })
+}
+
+/// Adds wall `wall` back (`present`) or takes it away, for `by` (`stage fill`, a Python
+/// call) as [`Engine::set_wall_present`] does; refuses to add one that is away where a grain
+/// overlaps it.
+pub fn set_wall_present(scene: &Scene, engine: &mut dyn Engine, wall: usize, present: bool, by: &str) -> anyhow::Result<()> {
+    if present {
+        let f = engine.frame(false)?;
+        if !f.walls_present[wall] {
+            clear_of_grains(scene, wall, &f, by)?;
+        }
+    }
+    engine.set_wall_present(wall, present);
+    Ok(())
+}
+
+/// Refuses to add wall `wall` (for `by`) where a grain of `frame` overlaps it: the first step
+/// would release the overlap's energy at once.
+fn clear_of_grains(scene: &Scene, wall: usize, frame: &Frame, by: &str) -> anyhow::Result<()> {
+    use crate::walls::WallGeom;
+    let distance = |p: glam::DVec3| match (&scene.walls[wall].shape, frame.walls[wall]) {
+        (crate::scene::WallShape::Mesh { mesh, .. }, WallGeom::Mesh { shift, .. }) => mesh.distance(p - shift.f64()),
+        (_, geom) => geom.frame(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).1,
+    };
+    for (i, (&p, &r)) in frame.position.iter().zip(&frame.radius).enumerate() {
+        let d = distance(p);
+        if d < r {
+            anyhow::bail!(
+                "{}: {by} adds wall {}, which grain {} (radius {r:.4e} m at {:?}) overlaps by {:.4e} m; fix: add the wall where no grain is (at an earlier stage, or outside the grains and moved in with the stage's `walls`)",
+                scene.path.display(),
+                scene.walls[wall].name,
+                frame.id[i],
+                p.to_array(),
+                r - d
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Runs a stage from its start, or from where a checkpoint inside it left it (the engine

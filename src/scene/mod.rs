@@ -8,6 +8,7 @@ mod model_specs;
 mod periodic_specs;
 mod read;
 mod stage_specs;
+mod wall_presence;
 mod wall_specs;
 mod wall_schema;
 pub mod schema;
@@ -22,6 +23,7 @@ use glam::DVec3;
 use model_specs::{bridge_limits, validate_method, validate_model};
 use periodic_specs::{check_periodic, validate_periodic};
 use stage_specs::validate_stages;
+use wall_presence::wall_presence;
 use wall_specs::{check_overlaps, finish_walls, servo_box, validate_walls};
 
 use crate::model::cohesion::DEFAULT_LIQUID_DENSITY;
@@ -109,7 +111,11 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         return Err(c.invalid("grain", "[]", "the scene has no grains", "add [[grain]] or [[generate]] tables"));
     }
     let servo = servo_box(&walls);
-    let walls = finish_walls(&c, walls, &grains, &periodic)?;
+    let mut walls = finish_walls(&c, walls, &grains, &periodic)?;
+    let (present, presence) = wall_presence(&c, &f.stages, &walls, servo)?;
+    for (w, p) in walls.iter_mut().zip(present) {
+        w.present = p;
+    }
     check_overlaps(&c, &origins, &grains, &walls)?;
     check_periodic(&c, &origins, &grains, &periodic, f.simulation.skin)?;
 
@@ -147,7 +153,7 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         Some(v) => positive(&c, "model.liquid_density", v, "give the liquid's density in kg/m^3, e.g. 1000")?,
         None => DEFAULT_LIQUID_DENSITY,
     };
-    let stages = validate_stages(&c, &f.stages, &grains, gravity, d_mean, &walls, servo, liquid_density)?;
+    let stages = validate_stages(&c, &f.stages, &presence, &grains, gravity, d_mean, &walls, servo, liquid_density)?;
     let bridges = bridge_limits(&c, &model, &stages, &grains)?;
     let output = Output {
         frame_interval: non_negative(&c, "output.frame_interval", f.output.frame_interval, "give seconds, or 0 for a frame per stage")?,

@@ -432,6 +432,15 @@ pub struct StageSpec {
     /// keep their motion.
     #[serde(default)]
     pub walls: std::collections::BTreeMap<String, WallDriveSpec>,
+    /// Walls (by name; a box's name adds all its faces) that grains meet from this stage's
+    /// start on: a wall that a stage adds before any removes it is not there at the start (a
+    /// lid, a shutter closing an orifice). No grain may overlap it when it comes.
+    #[serde(default)]
+    pub add_walls: Vec<String>,
+    /// Walls (by name) taken away at this stage's start (a gate lifted out): grains pass
+    /// through them until a later stage adds them again. A removed wall keeps its motion.
+    #[serde(default)]
+    pub remove_walls: Vec<String>,
 }
 
 /// A stage's motion for one wall (`[[stage]] walls = { gate = { velocity = [...] } }`).

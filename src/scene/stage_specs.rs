@@ -4,9 +4,11 @@
 use super::*;
 use super::wall_specs::stage_drives;
 
+#[allow(clippy::too_many_arguments)]
 pub(super) fn validate_stages(
     c: &Complainer,
     specs: &[StageSpec],
+    presence: &[Vec<(usize, bool)>],
     grains: &Grains,
     gravity: glam::DVec3,
     d_mean: f64,
@@ -91,6 +93,7 @@ pub(super) fn validate_stages(
                 other => other,
             },
             walls: stage_drives(c, i, &s.walls, walls, servo)?,
+            presence: presence[i].clone(),
             wet_volume: match s.water_content {
                 Some(w) => Some(positive(c, &key("water_content"), w, "give the gravimetric water content, e.g. 0.007")? * grains.mass.iter().sum::<f64>() / liquid_density),
                 None => None,
@@ -127,6 +130,7 @@ pub(super) fn validate_stages(
                 lower_piston: true,
                 records_compression: true,
                 seating: true,
+                presence: if first { base.presence.clone() } else { Vec::new() },
                 ..base.clone()
             });
             first = false;
@@ -139,6 +143,7 @@ pub(super) fn validate_stages(
                 lower_piston: first,
                 records_compression: true,
                 wet_volume: if first { base.wet_volume } else { None },
+                presence: if first { base.presence.clone() } else { Vec::new() },
                 ..base.clone()
             });
             first = false;

@@ -160,6 +160,9 @@ pub struct Wall {
     /// Its prescribed motion (zero for a fixed wall, and for the piston's and the servo box's,
     /// which their controllers move).
     pub drive: WallDrive,
+    /// Whether grains meet it from the start: false for a wall that a stage adds first
+    /// ([`Stage::presence`]).
+    pub present: bool,
 }
 
 /// A wall's prescribed motion: it translates at `velocity` and spins at `angular_velocity`
@@ -249,6 +252,9 @@ pub struct Stage {
     pub axial_strain_rate: Option<f64>,
     /// Walls (indices into [`Scene::walls`]) set moving at the start, with their motion.
     pub walls: Vec<(usize, WallDrive)>,
+    /// Walls (indices into [`Scene::walls`]) added (true) or removed (false) at the start: a
+    /// removed wall touches no grain and keeps its motion; an added one touches them again.
+    pub presence: Vec<(usize, bool)>,
 }
 
 /// What `--out` records.

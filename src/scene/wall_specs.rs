@@ -19,7 +19,7 @@ pub(super) fn validate_walls(
     material_of: &dyn Fn(String, &str) -> Result<u16, SceneError>,
 ) -> Result<Vec<PendingWall>, SceneError> {
     let mut out = Vec::new();
-    let driven = |name: String, shape: WallShape, material: u16, drive: WallDrive| PendingWall { wall: Wall { name, shape, material, drive }, piston_mass: None, piston_area: None, servo: None };
+    let driven = |name: String, shape: WallShape, material: u16, drive: WallDrive| PendingWall { wall: Wall { name, shape, material, drive, present: true }, piston_mass: None, piston_area: None, servo: None };
     let plain = |name: String, shape: WallShape, material: u16| driven(name, shape, material, WallDrive::default());
     for (i, w) in f.walls.iter().enumerate() {
         let key = |k: &str| format!("wall[{i}].{k}");
@@ -128,7 +128,7 @@ pub(super) fn validate_walls(
                     return Err(c.invalid(key("type"), "\"piston\"", "a scene has at most one piston", "remove the extra piston"));
                 }
                 out.push(PendingWall {
-                    wall: Wall { name: format!("wall[{i}]"), shape: WallShape::Piston { z: *z, pressure, mass: 0.0, area: 0.0 }, material: m, drive: WallDrive::default() },
+                    wall: Wall { name: format!("wall[{i}]"), shape: WallShape::Piston { z: *z, pressure, mass: 0.0, area: 0.0 }, material: m, drive: WallDrive::default(), present: true },
                     piston_mass,
                     piston_area,
                     servo: None,
@@ -235,7 +235,7 @@ pub(super) fn check_overlaps(c: &Complainer, origins: &Origins, grains: &Grains,
     let listed = origins.listed;
     let origin = |i: usize| origins.name(i);
     for i in 0..grains.len() {
-        for w in walls {
+        for w in walls.iter().filter(|w| w.present) {
             let d = wall_distance(&w.shape, grains.position[i]);
             let allowed = if origins.read(i) { READ_WALL_OVERLAP * grains.radius[i] } else { 0.0 };
             if d < grains.radius[i] - allowed {
@@ -273,18 +273,7 @@ pub(super) fn stage_drives(c: &Complainer, stage: usize, specs: &std::collection
 /// box's planes, which their controllers move, are refused. `at` is where the name is given
 /// (`stage[2].walls`), for errors.
 pub(super) fn drives_of(c: &Complainer, at: &str, name: &str, velocity: Option<DVec3>, angular_velocity: Option<DVec3>, walls: &[Wall], servo: Option<ServoBox>) -> Result<Vec<(usize, WallDrive)>, SceneError> {
-    let found: Vec<usize> = match walls.iter().position(|w| w.name == name) {
-        Some(k) => vec![k],
-        None => (0..walls.len()).filter(|&k| walls[k].name.strip_prefix(name).is_some_and(|rest| rest.starts_with('.'))).collect(),
-    };
-    if found.is_empty() {
-        let known: Vec<&str> = walls.iter().map(|w| w.name.as_str()).collect();
-        let fix = if known.is_empty() { "add a [[wall]] with this name".to_string() } else { format!("use one of {known:?} (a box by its name moves every face)") };
-        return Err(c.invalid(at, format!("\"{name}\""), "names no wall", fix));
-    }
-    if let Some(&k) = found.iter().find(|&&k| matches!(walls[k].shape, WallShape::Piston { .. }) || servo.is_some_and(|s| s.walls.contains(&k))) {
-        return Err(c.invalid(at, format!("\"{name}\""), format!("{} is moved by its controller (the piston or the servo box)", walls[k].name), "set the stage's piston_pressure or servo_pressure instead"));
-    }
+    let found = walls_named(c, at, name, walls, servo, "set the stage's piston_pressure or servo_pressure instead")?;
     let (axis, axis_name) = match walls[found[0]].shape {
         WallShape::Plane { normal, .. } if found.len() == 1 => (normal, "the plane's normal"),
         WallShape::Cylinder { .. } => (DVec3::Z, "the cylinder's axis (z)"),
@@ -294,10 +283,38 @@ pub(super) fn drives_of(c: &Complainer, at: &str, name: &str, velocity: Option<D
     Ok(found.into_iter().map(|k| (k, drive)).collect())
 }
 
+/// The fix for adding or removing the piston or a servo plane.
+pub(super) const PRESENCE_OF_CONTROLLED: &str = "it stays: its controller holds it on the grains";
+
+/// The walls (indices) that `name` names, given at `at`: a wall's name, or a box's for its
+/// faces; the piston and the servo box's planes, which their controllers move, are refused
+/// with the fix `controlled`.
+pub(super) fn walls_named(c: &Complainer, at: &str, name: &str, walls: &[Wall], servo: Option<ServoBox>, controlled: &str) -> Result<Vec<usize>, SceneError> {
+    let found: Vec<usize> = match walls.iter().position(|w| w.name == name) {
+        Some(k) => vec![k],
+        None => (0..walls.len()).filter(|&k| walls[k].name.strip_prefix(name).is_some_and(|rest| rest.starts_with('.'))).collect(),
+    };
+    if found.is_empty() {
+        let known: Vec<&str> = walls.iter().map(|w| w.name.as_str()).collect();
+        let fix = if known.is_empty() { "add a [[wall]] with this name".to_string() } else { format!("use one of {known:?} (a box's name names every face)") };
+        return Err(c.invalid(at, format!("\"{name}\""), "names no wall", fix));
+    }
+    if let Some(&k) = found.iter().find(|&&k| matches!(walls[k].shape, WallShape::Piston { .. }) || servo.is_some_and(|s| s.walls.contains(&k))) {
+        return Err(c.invalid(at, format!("\"{name}\""), format!("{} is moved by its controller (the piston or the servo box)", walls[k].name), controlled));
+    }
+    Ok(found)
+}
+
 impl Scene {
     /// The walls `name` moves and their motion, checked as a stage's `walls` are ([`drives_of`];
     /// `at` says where the name comes from, for the error).
     pub fn wall_drives(&self, at: &str, name: &str, velocity: DVec3, angular_velocity: DVec3) -> Result<Vec<(usize, WallDrive)>, SceneError> {
         drives_of(&Complainer { file: &self.path }, at, name, Some(velocity), Some(angular_velocity), &self.walls, self.servo)
+    }
+
+    /// The walls `name` names for adding or removing, checked as a stage's `add_walls` and
+    /// `remove_walls` are ([`walls_named`]; `at` says where the name comes from).
+    pub fn walls_to_add_or_remove(&self, at: &str, name: &str) -> Result<Vec<usize>, SceneError> {
+        walls_named(&Complainer { file: &self.path }, at, name, &self.walls, self.servo, PRESENCE_OF_CONTROLLED)
     }
 }

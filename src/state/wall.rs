@@ -23,6 +23,8 @@ pub struct WallState<T> {
     pub spin: Vec3<T>,
     /// Material index.
     pub material: u32,
+    /// False while a stage has taken the wall away: it touches no grain (and keeps moving).
+    pub present: bool,
 }
 
 impl<T: Real> WallState<T> {
@@ -38,6 +40,9 @@ impl<T: Real> WallState<T> {
 /// a wall of one contact, one per contact with a mesh (`meshes`); the count is the second.
 pub fn wall_overlaps<T: Real>(wall: &WallState<T>, meshes: &[MeshSurface<T>], x: Vec3<T>, r: Vec3<T>, radius: T) -> ([T; MESH_CONTACTS], usize) {
     let mut out = [T::ZERO; MESH_CONTACTS];
+    if !wall.present {
+        return (out, 0);
+    }
     if let WallGeom::Mesh { mesh, shift } = wall.geom {
         let t = meshes[mesh as usize].touching(complete(x - shift, r), radius);
         for (o, c) in out.iter_mut().zip(&t.contacts[..t.len]) {
@@ -143,6 +148,9 @@ pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[
         for (w, wall) in walls.iter().enumerate() {
             let block = &hist[at..at + wall_reals(wall, stride)];
             at += block.len();
+            if !wall.present {
+                continue;
+            }
             let record = |n: Vec3<T>, geo: &Geometry<T>, f: &ContactForce<T>| WallContactRecord { grain: id[i], wall: w as u32, overlap: geo.h.f64(), normal: n.f64(), lever: geo.rp_i.f64(), force: f.f_i.f64() };
             if let WallGeom::Mesh { mesh, shift } = wall.geom {
                 mesh_contacts(b, residual, p, ctx.material(i), wall, &ctx.meshes[mesh as usize], shift, ctx, &mut block.to_vec(), |n, geo, _, f| out.push(record(n, geo, f)));

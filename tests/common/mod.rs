@@ -65,6 +65,19 @@ pub fn gpu_engine(scene: &Scene) -> Option<grains::gpu::GpuEngine> {
     Some(grains::gpu::GpuEngine::new(gpu, scene).unwrap_or_else(|e| panic!("{e}")))
 }
 
+/// Makes an engine for a scene (None: no GPU adapter).
+pub type EngineMaker = Box<dyn Fn(&Scene) -> Option<Box<dyn Engine>>>;
+
+/// The engines a resume test compares, by name: the CPU in f64 and, where an adapter opens,
+/// the GPU.
+pub fn resumable_engines() -> Vec<(&'static str, EngineMaker)> {
+    let mut makers: Vec<(&str, EngineMaker)> = vec![("cpu f64", Box::new(|s| Some(Box::new(engine::<f64>(s)) as Box<dyn Engine>)))];
+    if gpu().is_some() {
+        makers.push(("gpu", Box::new(|s| gpu_engine(s).map(|g| Box::new(g) as Box<dyn Engine>))));
+    }
+    makers
+}
+
 /// `text` with each `(from, to)` replaced, failing loudly when a `from` is absent (so that a
 /// change to a shipped scene cannot silently leave a test on the wrong parameters).
 pub fn edit(text: &str, edits: &[(&str, &str)]) -> String {

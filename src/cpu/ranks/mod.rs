@@ -529,6 +529,12 @@ impl<T: Real> Engine for Distributed<T> {
             w.set_wall_drive(wall, drive);
         }
     }
+    fn set_wall_present(&mut self, wall: usize, present: bool) {
+        self.local.set_wall_present(wall, present);
+        if let Some(w) = &mut self.whole {
+            w.set_wall_present(wall, present);
+        }
+    }
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
         self.local.set_servo(pressure, axial_strain_rate);
         if let Some(w) = &mut self.whole {

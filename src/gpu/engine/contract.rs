@@ -74,10 +74,19 @@ impl Engine for GpuEngine {
     fn set_wall_drive(&mut self, wall: usize, drive: &crate::scene::WallDrive) {
         let base = (wall * std::mem::size_of::<layout::Wall>()) as u64;
         let (v, w) = (drive.velocity.as_vec3(), drive.angular_velocity.as_vec3());
+        let flags = &mut self.wall_flags[wall];
+        *flags = if drive.moves() { *flags | layout::wall_flags::DRIVEN } else { *flags & !layout::wall_flags::DRIVEN };
         let queue = &self.gpu.queue;
-        queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, driven) as u64, bytemuck::bytes_of(&(drive.moves() as u32)));
+        queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, flags) as u64, bytemuck::bytes_of(flags));
         queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, velocity) as u64, bytemuck::bytes_of(&v));
         queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, drive) as u64, bytemuck::bytes_of(&w));
+    }
+
+    fn set_wall_present(&mut self, wall: usize, present: bool) {
+        let flags = &mut self.wall_flags[wall];
+        *flags = if present { *flags & !layout::wall_flags::ABSENT } else { *flags | layout::wall_flags::ABSENT };
+        let at = (wall * std::mem::size_of::<layout::Wall>() + std::mem::offset_of!(layout::Wall, flags)) as u64;
+        self.gpu.queue.write_buffer(&self.buffers[Buf::Walls], at, bytemuck::bytes_of(flags));
     }
 
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {

@@ -102,9 +102,12 @@ pub(super) fn walls_of(scene: &Scene, hist_blocks: u32) -> (Vec<layout::Wall>, O
             }
             if wall.drive.moves() {
                 let (v, w) = (wall.drive.velocity, wall.drive.angular_velocity);
-                g.driven = 1; // as `set_wall_drive` sets it
+                g.flags |= layout::wall_flags::DRIVEN; // as `set_wall_drive` sets it
                 g.velocity = Vec4::new(v[0] as f32, v[1] as f32, v[2] as f32, 0.0);
                 g.drive = Vec4::new(w[0] as f32, w[1] as f32, w[2] as f32, 0.0);
+            }
+            if !wall.present {
+                g.flags |= layout::wall_flags::ABSENT;
             }
             g
         })

@@ -104,8 +104,9 @@ impl GpuEngine {
             .map(|w| WallState {
                 geom: wall_geom(w),
                 velocity: Vec3::new(w.velocity.x, w.velocity.y, w.velocity.z),
-                spin: if w.driven == 1 { Vec3::new(w.drive.x, w.drive.y, w.drive.z) } else { Vec3::ZERO },
+                spin: if w.flags & layout::wall_flags::DRIVEN != 0 { Vec3::new(w.drive.x, w.drive.y, w.drive.z) } else { Vec3::ZERO },
                 material: w.material,
+                present: w.flags & layout::wall_flags::ABSENT == 0,
             })
             .collect();
         let slots = HistorySlots::new(self.history);
@@ -188,6 +189,7 @@ impl GpuEngine {
             contacts: contact_records,
             wall_contacts: wall_records,
             walls: self.walls_now()?,
+            walls_present: self.wall_flags.iter().map(|f| f & layout::wall_flags::ABSENT == 0).collect(),
         })
     }
 
@@ -274,6 +276,11 @@ impl GpuEngine {
                 anyhow::bail!("the checkpoint's GPU buffer `{name}` holds {} bytes, this scene's {}; fix: resume with the scene the checkpoint was written for", bytes.len(), buffer.size());
             }
             self.gpu.queue.write_buffer(buffer, 0, &bytes[..bytes.len().min(buffer.size() as usize)]);
+            let walls_bytes = self.wall_flags.len() * std::mem::size_of::<layout::Wall>();
+            if name == Buf::Walls.name() && bytes.len() >= walls_bytes {
+                let walls: Vec<layout::Wall> = bytemuck::pod_collect_to_vec(&bytes[..walls_bytes]);
+                self.wall_flags = walls.iter().map(|w| w.flags).collect();
+            }
         }
         (self.step, self.forces_valid) = (counters[0], counters[1] != 0);
         self.time = s.reals("time", 1)?[0];

@@ -90,7 +90,8 @@ pub fn piece(scene: &Scene, f: &Frame) -> PolyData {
         piece.points.extend(corners);
         wall.push(w);
     };
-    for (w, geom) in f.walls.iter().enumerate() {
+    // A wall a stage has taken away is not drawn.
+    for (w, geom) in f.walls.iter().enumerate().filter(|&(w, _)| f.walls_present.get(w).copied().unwrap_or(true)) {
         match *geom {
             WallGeom::Plane { point, normal } => polygon(&mut piece, plane_quad(point.f64().to_array(), normal.f64().to_array(), lo, hi), w),
             WallGeom::Piston { z } => match cylinder {
