@@ -17,10 +17,10 @@ Mellmann (2001, Powder Technol. 118, 251) gives the regimes' ranges of Fr: slump
 (for a bed that does not slip on the wall). Writes drum.csv and, where matplotlib is
 installed, drum.png.
 
-    python examples/drum.py [--out DIR] [--threads N] [--froude 0.001,0.01,0.1,0.3,1,3]
+    python examples/drum.py [--out DIR] [--threads N] [--froude 0.001,0.01,0.1,0.3,1,1.5,2,3]
                             [--turn 2.0] [--measure 1.0]
 
-About 7 minutes on two cores for the default Froude numbers.
+About 10 minutes on two cores for the default Froude numbers.
 """
 
 from __future__ import annotations
@@ -110,7 +110,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("out/drum"))
     parser.add_argument("--threads", type=int, default=None)
-    parser.add_argument("--froude", default="0.001,0.01,0.1,0.3,1,3", help="Froude numbers, comma-separated")
+    parser.add_argument("--froude", default="0.001,0.01,0.1,0.3,1,1.5,2,3", help="Froude numbers, comma-separated")
     parser.add_argument("--turn", type=float, default=2.0, help="seconds the drum turns at each (at least a radian before the last --measure seconds)")
     parser.add_argument("--measure", type=float, default=1.0, help="the last seconds of each turn that are read")
     args = parser.parse_args()
