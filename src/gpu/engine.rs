@@ -233,7 +233,9 @@ impl GpuEngine {
         let (phases, phase_bytes) = setup::phase_slots(&plans, phase_stride);
         // A device without the memory reports it here, not through wgpu's handler (a panic).
         let out_of_memory = gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
-        let buffers = setup::scene_buffers(&gpu.device, scene, &params, walls, &control, &phase_bytes);
+        // The mesh walls' surfaces: the kernels' buffers and the host's re-evaluation share them.
+        let meshes = scene.mesh_surfaces::<f32>();
+        let buffers = setup::scene_buffers(&gpu.device, scene, &params, walls, &meshes, &control, &phase_bytes);
         if let Some(e) = pollster::block_on(out_of_memory.pop()) {
             let mib = buffers.bytes() as f64 / (1u64 << 20) as f64;
             return Err(GpuSetupError::Memory { adapter, mib, reason: e.to_string() }.into());
@@ -257,7 +259,7 @@ impl GpuEngine {
             track_orientation: scene.track_orientation,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
             wall_flags,
-            meshes: scene.mesh_surfaces(),
+            meshes,
             mesh_names: scene.walls.iter().filter(|w| matches!(w.shape, WallShape::Mesh { .. })).map(|w| w.name.clone()).collect(),
             piston,
             servo: scene.servo.map(|s| s.walls),

@@ -116,11 +116,11 @@ pub(super) fn walls_of(scene: &Scene, hist_blocks: u32) -> (Vec<layout::Wall>, O
 }
 
 /// The mesh walls' triangles as the kernels read them: each mesh's [`layout::MeshInfo`], the
-/// corners (`mesh_data`) and the triangles, cells and ids (`mesh_index`), of the f32 surfaces
-/// the CPU's twin holds ([`Scene::mesh_surfaces`]).
-pub(super) fn meshes_of(scene: &Scene) -> (Vec<layout::MeshInfo>, Vec<[f32; 4]>, Vec<u32>) {
+/// corners (`mesh_data`) and the triangles, cells and ids (`mesh_index`), of `meshes`, the f32
+/// surfaces the CPU's twin holds ([`Scene::mesh_surfaces`]).
+pub(super) fn meshes_of(meshes: &[crate::mesh::MeshSurface<f32>]) -> (Vec<layout::MeshInfo>, Vec<[f32; 4]>, Vec<u32>) {
     let (mut infos, mut data, mut index) = (Vec::new(), Vec::new(), Vec::new());
-    for m in scene.mesh_surfaces::<f32>() {
+    for m in meshes {
         let g = &m.grid;
         let (corners, triangles) = (data.len() as u32, index.len() as u32);
         data.extend(m.vertices.iter().map(|v| [v.x, v.y, v.z, 0.0]));
@@ -184,7 +184,7 @@ pub(super) fn phase_slots(plans: &Plans, stride: u64) -> (Vec<Phase>, Vec<u8>) {
 
 /// Every buffer of the step but the per-pair ones ([`GpuEngine::allocate_pairs`]), filled from
 /// the scene, the constants, the walls, the control record and the phases.
-pub(super) fn scene_buffers(device: &wgpu::Device, scene: &Scene, params: &Params, walls: Vec<layout::Wall>, control: &Control, phase_bytes: &[u8]) -> Buffers {
+pub(super) fn scene_buffers(device: &wgpu::Device, scene: &Scene, params: &Params, walls: Vec<layout::Wall>, meshes: &[crate::mesh::MeshSurface<f32>], control: &Control, phase_bytes: &[u8]) -> Buffers {
     let g = &scene.grains;
     let (n, hash_size) = (g.len() as u64, params.hash_size as u64);
     let coeffs = pair_coeffs_of(scene);
@@ -216,7 +216,7 @@ pub(super) fn scene_buffers(device: &wgpu::Device, scene: &Scene, params: &Param
     let walls_bytes: Vec<layout::Wall> = if walls.is_empty() { vec![layout::Wall::default()] } else { walls };
     init(Buf::Walls, bytemuck::cast_slice(&walls_bytes), wgpu::BufferUsages::empty());
     init(Buf::Control, bytemuck::bytes_of(control), wgpu::BufferUsages::empty());
-    let (infos, data, index) = meshes_of(scene);
+    let (infos, data, index) = meshes_of(meshes);
     init(Buf::Meshes, if infos.is_empty() { &[0; 48] } else { bytemuck::cast_slice(&infos) }, wgpu::BufferUsages::empty());
     init(Buf::MeshData, if data.is_empty() { &[0; 16] } else { bytemuck::cast_slice(&data) }, wgpu::BufferUsages::empty());
     init(Buf::MeshIndex, if index.is_empty() { &[0; 16] } else { bytemuck::cast_slice(&index) }, wgpu::BufferUsages::empty());
