@@ -17,6 +17,10 @@ fn detect_count(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation
         return;
     }
     rev_fill[i] = 0u;
+    if (!in_play(pos[i])) {
+        pair_start[i] = 0u;
+        return;
+    }
     var it = search(i);
     var count = 0u;
     while (next_partner(&it) != NONE) {

@@ -59,10 +59,15 @@ struct WallLoad {
 fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat_index(wid, lid, nwg);
     let live = i < params.n_grains;
+    // A grain out of play owns and partners no pair and feels no gravity and no wall.
+    var playing = false;
+    if (live) {
+        playing = in_play(pos[i]);
+    }
     var f = vec3<f32>(0.0);
     var t = vec3<f32>(0.0);
     var pushing = 0.0;
-    if (live) {
+    if (playing) {
         f = params.gravity.xyz * vel[i].w;
         let end = min(pair_start[i + 1u], params.pair_capacity);
         for (var k = pair_start[i]; k < end; k++) {
@@ -84,7 +89,7 @@ fn gather(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index
     var w = WallLoad(vec3<f32>(0.0), vec3<f32>(0.0), 0u, 0u);
     // (A uniform branch: every invocation of the workgroup reaches the reduction's barriers.)
     if (params.n_walls > 0u) {
-        w = wall_loads(i, live, lid, (wid.y * nwg.x + wid.x) * 2u * MAX_WALLS);
+        w = wall_loads(i, playing, lid, (wid.y * nwg.x + wid.x) * 2u * MAX_WALLS);
     }
     if (!live) {
         return;

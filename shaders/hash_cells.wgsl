@@ -53,6 +53,10 @@ fn hash_cells(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_i
         image[i] = image[i] + vec4<i32>(moved, 0);
     }
     built_at[i] = p;
+    if (!in_play(p)) {
+        cell_of[i] = NONE;
+        return;
+    }
     let k = class_of(p.w);
     let h = cell_hash(cell_coords(p.xyz, k), k);
     cell_of[i] = h;

@@ -24,7 +24,11 @@ var<workgroup> row: array<f32, WG * STAT_ROW>;
 fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocation_index) lid: u32, @builtin(num_workgroups) nwg: vec3<u32>) {
     let i = flat_index(wid, lid, nwg);
     clear_row(lid);
+    var playing = false;
     if (i < params.n_grains) {
+        playing = in_play(pos[i]);
+    }
+    if (playing) {
         let r = lid * STAT_ROW;
         let p = pos[i];
         let v = vel[i];

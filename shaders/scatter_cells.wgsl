@@ -13,6 +13,9 @@ fn scatter_cells(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
         return;
     }
     let h = cell_of[i];
+    if (h == NONE) {
+        return; // out of play
+    }
     let slot = cell_count[h] + atomicAdd(&cell_fill[h], 1u);
     cell_grains[slot] = i;
 }

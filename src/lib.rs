@@ -11,6 +11,7 @@ pub mod checkpoint;
 pub mod compare;
 pub mod cpu;
 pub mod engine;
+pub mod flow;
 pub mod gpu;
 pub mod lammps;
 pub mod mesh;

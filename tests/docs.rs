@@ -162,6 +162,9 @@ fn every_scene_key_the_parser_accepts_is_in_the_scene_reference() {
         ("`[[wall]]`", "[[wall]]\ntype = \"cylinder\"\nzzz_probe = 1"),
         ("`[[wall]]`", "[[wall]]\ntype = \"servo_box\"\nzzz_probe = 1"),
         ("`[[wall]]`", "[[wall]]\ntype = \"piston\"\nzzz_probe = 1"),
+        ("`[[inlet]]`", "[[inlet]]\nzzz_probe = 1"),
+        ("`[[inlet]]`", "[[inlet]]\nregion = { shape = \"box\", zzz_probe = 1 }"),
+        ("`[[outlet]]`", "[[outlet]]\nzzz_probe = 1"),
         ("`[periodic]`", "[periodic]\nzzz_probe = 1"),
         ("`[model]`", "[model]\nzzz_probe = 1"),
         ("`[simulation]`", "[simulation]\nzzz_probe = 1"),
@@ -169,7 +172,7 @@ fn every_scene_key_the_parser_accepts_is_in_the_scene_reference() {
         ("`[[stage]]`", "[[stage]]\nzzz_probe = 1"),
         ("`[output]`", "[output]\nzzz_probe = 1"),
     ];
-    let tables = ["material", "pair", "grain", "read", "generate", "wall", "periodic", "model", "simulation", "stage", "output", "contact_dynamics"];
+    let tables = ["material", "pair", "grain", "read", "generate", "wall", "inlet", "outlet", "periodic", "model", "simulation", "stage", "output", "contact_dynamics"];
     let mut missing = Vec::new();
     let mut count = 0;
     for (heading, probe) in probes {

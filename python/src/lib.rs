@@ -355,13 +355,15 @@ impl Simulation {
         let interval = sim.scene.stats_interval.max(1);
         let mut done = 0;
         while done < steps {
-            let Sim { engine, pool, guard, .. } = &mut *sim;
+            let Sim { engine, pool, guard, scene, .. } = &mut *sim;
             let n = (interval - engine.steps() % interval).min(steps - done);
             let engine = &mut **engine;
+            let scene = &*scene;
             py.detach(move || pool.install(move || -> anyhow::Result<()> {
-                engine.advance(n)?;
+                // The scene's inlets and outlets act at their steps on the way.
+                guard.advance(scene, engine, n)?;
                 if engine.steps() % interval == 0 {
-                    guard.check_stable(&engine.stats()?)?;
+                    guard.check_stable(&guard.stats(engine)?)?;
                 }
                 Ok(())
             }))
@@ -457,8 +459,8 @@ impl Simulation {
     /// The statistics now, as JSON (the fields of `stats.csv`).
     fn stats_json(&self, py: Python<'_>) -> PyResult<String> {
         let mut sim = self.lock()?;
-        let Sim { engine, pool, .. } = &mut *sim;
-        let stats = py.detach(|| pool.install(|| engine.stats())).map_err(sim_err)?;
+        let Sim { engine, pool, guard, .. } = &mut *sim;
+        let stats = py.detach(|| pool.install(|| guard.stats(engine.as_mut()))).map_err(sim_err)?;
         serde_json::to_string(&stats).map_err(sim_err)
     }
 

@@ -52,6 +52,14 @@ struct PairCoeffs {
     beta: f32,
 }
 
+// Whether a grain whose pos is p is in play: one out of play (waiting at an inlet, or gone
+// through an outlet) keeps its slot with its radius stored negated (src/state/arrays.rs
+// Props::in_play). It is in no cell and no pair, touches no wall, feels no gravity, does not
+// move and counts in no statistic.
+fn in_play(p: vec4<f32>) -> bool {
+    return p.w > 0.0;
+}
+
 // Wall kinds (src/gpu/layout.rs wall_kind).
 const WALL_PLANE: u32 = 0u;
 const WALL_CYLINDER: u32 = 1u;

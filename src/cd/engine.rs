@@ -59,7 +59,7 @@ impl<T: Real> Engine for ContactDynamics<T> {
     fn stats(&mut self) -> Result<Stats, SimError> {
         let n = self.body.len();
         let g = self.gravity.f64();
-        let mut s = Stats { step: self.steps, time: self.time(), rebuilds: self.near.searches, external_work: self.external_work, ..Default::default() };
+        let mut s = Stats { step: self.steps, time: self.time(), rebuilds: self.near.searches, external_work: self.external_work, grains: self.grain_count() as u64, ..Default::default() };
         for (b, p) in self.body.iter().zip(&self.prop) {
             let (m, v, w) = (p.mass.f64(), b.vel.f64(), b.omega.f64());
             s.ke_translational += 0.5 * m * b.vel.norm2().f64();
@@ -271,6 +271,14 @@ impl<T: Real> Engine for ContactDynamics<T> {
     fn set_wall_present(&mut self, _wall: usize, _present: bool) {
         // Contact-dynamics scenes keep their walls (stages that add or remove one are refused
         // at `ContactDynamics::new`).
+    }
+
+    fn remove_grains(&mut self, _ids: &[u32]) -> anyhow::Result<()> {
+        anyhow::bail!("contact dynamics keeps every grain in play: it takes no outlet yet; fix: run the scene with simulation.method = \"dem\"")
+    }
+
+    fn insert_grains(&mut self, _grains: &[crate::engine::Insertion]) -> anyhow::Result<()> {
+        anyhow::bail!("contact dynamics keeps every grain in play: it takes no inlet yet; fix: run the scene with simulation.method = \"dem\"")
     }
 
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {

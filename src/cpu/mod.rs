@@ -15,6 +15,7 @@ mod controllers;
 mod integrate;
 mod lanes;
 mod pair_force;
+mod play;
 // What a run over several processes reads and writes of the engine (ranks/).
 #[cfg(feature = "mpi")]
 mod parts;
@@ -44,7 +45,7 @@ use crate::state::{allocated, renew, walls_reals, Body, Counts, ForceContext, Hi
 
 use rebuild::kept_or_found;
 use crate::engine::EngineState;
-use crate::engine::{ContactRecord, Engine, Frame, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
+use crate::engine::{ContactRecord, Engine, Frame, Insertion, PistonStats, RegimeCounts, SimError, Stats, WallStats, RATTLER_CONTACTS};
 use crate::model::{capillary_potential, share_liquid, within_rupture, CohesionLaw, ContactModel, PairCoeffs};
 use crate::periodic::Periodic;
 use crate::position;
@@ -322,6 +323,16 @@ impl<T: Real> Engine for CpuEngine<T> {
 
     fn set_wall_present(&mut self, wall: usize, present: bool) {
         self.walls[wall].present = present;
+    }
+
+    fn remove_grains(&mut self, ids: &[u32]) -> anyhow::Result<()> {
+        self.take_out_of_play(ids);
+        Ok(())
+    }
+
+    fn insert_grains(&mut self, grains: &[Insertion]) -> anyhow::Result<()> {
+        self.put_into_play(grains);
+        Ok(())
     }
 
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {

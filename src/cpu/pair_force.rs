@@ -110,7 +110,9 @@ super::simd::dispatch! {
 fn owner_block_portable<T: Real>(mut block: OwnerBlock<'_, T>, scratch: &mut TaskScratch<T>, pairs: &PairList, body: &[Body<T>], prop: &[Props<T>], ctx: &ForceContext<T>, gravity: Vec3<T>) {
     let first = block.first;
     for (m, l) in block.load.iter_mut().enumerate() {
-        *l = Load { force: gravity * prop[first + m].mass, torque: Vec3::ZERO };
+        let p = &prop[first + m];
+        // A grain out of play feels no gravity (WGSL gather's twin).
+        *l = Load { force: if p.in_play() { gravity * p.mass } else { Vec3::ZERO }, torque: Vec3::ZERO };
     }
     let first_pair = pairs.owner_start[first] as usize;
     let (stride, n_pairs) = (ctx.slots.stride, block.f_n.len());

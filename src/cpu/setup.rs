@@ -14,7 +14,7 @@ impl<T: Real> CpuEngine<T> {
         let body: Vec<Body<T>> = (0..n).map(|i| Body { pos: positions[i], vel: Vec3::of(g.velocity[i]), omega: Vec3::of(g.angular_velocity[i]) }).collect();
         let residual = if T::COMPENSATED { residual } else { Vec::new() };
         let prop: Vec<Props<T>> = (0..n)
-            .map(|i| Props::sphere(g.radius[i], g.mass[i]))
+            .map(|i| Props::sphere(g.radius[i], g.mass[i]).with_play(g.starts_in_play(i)))
             .collect();
         let r_max = g.radius.iter().copied().fold(0.0, f64::max);
         let model = scene.model.cast::<T>();

@@ -8,11 +8,12 @@ impl<T: Real> CpuEngine<T> {
     /// wall contacts with their forces when `contacts`.
     pub(super) fn snapshot(&self, contacts: bool) -> Frame {
         let body = self.bodies();
-        Frame {
+        let prop = self.by_id(&self.prop);
+        let mut frame = Frame {
             time: self.time,
             id: (0..self.id.len() as u32).collect(),
             position: self.positions(),
-            radius: self.by_id(&self.prop).iter().map(|p| p.radius.f64()).collect(),
+            radius: prop.iter().map(|p| p.radius.f64()).collect(),
             velocity: body.iter().map(|b| b.vel.f64()).collect(),
             angular_velocity: body.iter().map(|b| b.omega.f64()).collect(),
             orientation: self.orientation.as_ref().map(|q| self.by_id(q).iter().map(|q| glam::DQuat::from_xyzw(q[1].f64(), q[2].f64(), q[3].f64(), q[0].f64())).collect()),
@@ -47,7 +48,9 @@ impl<T: Real> CpuEngine<T> {
             }),
             walls: self.walls.iter().map(|w| w.geom.f64()).collect(),
             walls_present: self.walls.iter().map(|w| w.present).collect(),
-        }
+        };
+        frame.retain_grains(|k| prop[k].in_play());
+        frame
     }
 
     /// The whole state, for a checkpoint.
@@ -106,6 +109,10 @@ impl<T: Real> CpuEngine<T> {
         s.put_reals("f_c", self.report.f_c.iter().map(|x| x.f64()));
         s.put_ints("pair_flags", self.report.flags.iter().map(|&x| x as u64));
         s.put_reals("force_i", self.force_i.iter().flat_map(v3));
+        // By slot, where a grain is out of play (an inlet's or an outlet's scene).
+        if !self.prop.iter().all(Props::in_play) {
+            s.put_ints("in_play", self.prop.iter().map(|p| p.in_play() as u64));
+        }
         s.put_reals("clock", [self.max_moved2.f64(), self.time, self.external_work]);
         s.put_ints("counters", [self.step, self.rebuilds, self.forces_valid as u64]);
         s
@@ -126,6 +133,11 @@ impl<T: Real> CpuEngine<T> {
         let r = Renumbering::new(id.iter().map(|&i| slot[i as usize]).collect());
         r.apply(&mut self.prop);
         r.apply(&mut self.material);
+        // Every grain in play where the checkpoint does not say otherwise.
+        let in_play = s.ints("in_play", Some(n)).ok();
+        for (k, p) in self.prop.iter_mut().enumerate() {
+            *p = p.with_play(in_play.is_none_or(|v| v[k] != 0));
+        }
         self.id = id;
         self.refresh_slots();
         let v3 = |a: &[f64]| Vec3::new(T::of(a[0]), T::of(a[1]), T::of(a[2]));

@@ -64,6 +64,9 @@ impl<T: Real> CpuEngine<T> {
             let mut s = GrainSums { wall_force: wall_force[r.start / CHUNK], ..Default::default() };
             for i in r.map(|id| slot[id] as usize) {
                 let (b, p, l) = (&self.body[i], &self.prop[i], &self.load[i]);
+                if !p.in_play() {
+                    continue;
+                }
                 let m = p.mass.f64();
                 let v = b.vel.f64();
                 let pos = self.periodic.unwrap(b.pos, self.image.get(i));
@@ -153,7 +156,7 @@ impl<T: Real> CpuEngine<T> {
             ps.force += s.force;
             ps.max_overlap = max_by_first(ps.max_overlap, s.max_overlap);
         }
-        let n = self.body.len() as f64;
+        let n = self.grains_in_play() as f64;
         // Each touching pair counts once per grain; each wall contact once.
         let contact_ends = 2 * ps.contacts + gs.wall_contacts;
         let unbalanced_force = crate::engine::unbalanced(gs.net_force, n, ps.force + gs.wall_force, contact_ends);
@@ -222,6 +225,7 @@ impl<T: Real> CpuEngine<T> {
             sliding: ps.regimes.sliding + self.wall_regimes.sliding,
             rolling: ps.regimes.rolling + self.wall_regimes.rolling,
             coordination: 2.0 * ps.contacts as f64 / n,
+            grains: n as u64,
             max_overlap,
             max_overlap_grain,
             unbalanced_force,
@@ -236,6 +240,7 @@ impl<T: Real> CpuEngine<T> {
             walls,
             piston,
             solver: None,
+            flow: Vec::new(),
         }
     }
 }

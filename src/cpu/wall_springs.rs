@@ -93,7 +93,8 @@ impl<T: Real> WallSprings<T> {
         for (s, (&at, p)) in built_at.iter().zip(prop).enumerate() {
             // The kept position's rounding ([`super::built_at`]) widens the reach.
             let (x, rounding) = (super::built_at::widen::<T>(at), super::built_at::bound::<T>(at));
-            let near = WallGeom::any_within(walls.iter().map(|w| &w.geom), meshes, x, p.radius + skin + rounding);
+            // A grain out of play touches no wall.
+            let near = p.in_play() && WallGeom::any_within(walls.iter().map(|w| &w.geom), meshes, x, p.radius + skin + rounding);
             b.push(s, near.then(|| old.springs_of(s, per_grain).unwrap_or(&zeros)));
         }
         b.finish(walls.iter().map(|w| w.geom).collect())

@@ -8,6 +8,7 @@
 mod buffers;
 mod contract;
 mod encode;
+mod play;
 mod readback;
 mod setup;
 mod snapshot;
@@ -136,6 +137,12 @@ pub struct GpuEngine {
     /// Each wall's [`layout::wall_flags`] as the walls buffer holds them (the host changes
     /// them, the kernels only read them).
     wall_flags: Vec<u32>,
+    /// Each grain's radius (m) and mass (kg) as the kernels hold them, for the grains the
+    /// host puts into play or out of it ([`play`]).
+    radius: Vec<f32>,
+    mass: Vec<f32>,
+    /// Whether each grain is in play, as `pos.w`'s sign says (WGSL `in_play`).
+    in_play: Vec<bool>,
     /// The mesh walls' surfaces in f32, for the host's re-evaluation of wall contacts.
     meshes: Vec<crate::mesh::MeshSurface<f32>>,
     /// The mesh walls' names, in their order.
@@ -259,6 +266,9 @@ impl GpuEngine {
             track_orientation: scene.track_orientation,
             wall_names: scene.walls.iter().map(|w| w.name.clone()).collect(),
             wall_flags,
+            radius: scene.grains.radius.iter().map(|&r| r as f32).collect(),
+            mass: scene.grains.mass.iter().map(|&m| m as f32).collect(),
+            in_play: (0..n as usize).map(|i| scene.grains.starts_in_play(i)).collect(),
             meshes,
             mesh_names: scene.walls.iter().filter(|w| matches!(w.shape, WallShape::Mesh { .. })).map(|w| w.name.clone()).collect(),
             piston,

@@ -33,6 +33,13 @@ fn stats_header(s: &Stats) -> String {
     if s.solver.is_some() {
         h.push_str(SOLVER_COLUMNS);
     }
+    // Scenes with inlets or outlets: the grains in play, and each one's running totals.
+    if !s.flow.is_empty() {
+        h.push_str(",grains_in_play");
+        for f in &s.flow {
+            h.push_str(&format!(",{0}_grains,{0}_mass_kg", f.name));
+        }
+    }
     h
 }
 
@@ -70,6 +77,12 @@ fn stats_row(stage: &str, s: &Stats) -> String {
     if let Some(c) = &s.solver {
         let q = &c.residuals;
         row.push_str(&format!(",{},{},{},{:e},{:e},{:e},{},{:e},{:e},{:e},{:e}", c.steps, c.unconverged_steps, c.max_iterations, c.mean_iterations, c.sweep_norm, c.unbalanced, c.contact_updates, q.normal, q.tangential, q.quadratic, q.maximum));
+    }
+    if !s.flow.is_empty() {
+        row.push_str(&format!(",{}", s.grains));
+        for f in &s.flow {
+            row.push_str(&format!(",{},{:e}", f.grains, f.mass));
+        }
     }
     row
 }

@@ -273,7 +273,8 @@ pub fn check_report(scene: &Scene) -> String {
     if !scene.description.is_empty() {
         let _ = writeln!(s, "  {}", scene.description);
     }
-    let _ = writeln!(s, "grains: {}", g.len());
+    let waiting: usize = scene.inlets.iter().map(|i| i.grains.len()).sum();
+    let _ = writeln!(s, "grains: {}{}", g.len(), if waiting > 0 { format!(" ({waiting} of them waiting at inlets)") } else { String::new() });
     for (i, m) in scene.materials.iter().enumerate() {
         let count = g.material.iter().filter(|&&x| x as usize == i).count();
         let _ = writeln!(s, "  material {:<10} {count} grains, E = {:e} Pa, nu = {}, mu_s = {}, mu_k = {}", m.name, m.constants.youngs_modulus, m.constants.poisson_ratio, m.constants.mu_s, m.constants.mu_k);
@@ -290,6 +291,14 @@ pub fn check_report(scene: &Scene) -> String {
                 let _ = writeln!(s, "wall {}: {shape:?}", w.name);
             }
         }
+    }
+    for i in &scene.inlets {
+        let mass: f64 = i.grains.clone().map(|k| g.mass[k as usize]).sum();
+        let every = i.every as f64 * ts.dt;
+        let _ = writeln!(s, "inlet {}: {} grains ({mass:.4e} kg) at {:e} kg/s into {:?} every {every:.4e} s from {:.4e} s", i.name, i.grains.len(), i.mass_rate, i.region, i.start_step as f64 * ts.dt);
+    }
+    for o in &scene.outlets {
+        let _ = writeln!(s, "outlet {}: takes the grains in {:?} every {:.4e} s", o.name, o.region, o.every as f64 * ts.dt);
     }
     match scene.method {
         crate::scene::Method::Dem => {

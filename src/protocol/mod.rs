@@ -4,6 +4,7 @@
 
 use crate::analysis::{container_volume, contact_moments, macroscopic_stress, solid_volume, void_ratio, Tensor};
 use crate::engine::{Engine, Frame, SimError, Stats};
+use crate::flow::FlowState;
 use crate::periodic::Periodic;
 use crate::scene::{Scene, Stage, StageKind};
 use serde::{Deserialize, Serialize};
@@ -111,6 +112,9 @@ pub struct Progress {
     /// Where stage `next_stage` stands, when the checkpoint was taken inside it.
     #[serde(default)]
     pub in_stage: Option<StageProgress>,
+    /// What the inlets and outlets have done.
+    #[serde(default)]
+    pub flow: FlowState,
 }
 
 /// Where a stage stands at a checkpoint taken inside it (at a statistics read).
@@ -161,7 +165,29 @@ impl Progress {
             guard: Guard::new(scene, &stats),
             next_frame: (scene.output.frame_interval > 0.0).then(|| engine.time()),
             in_stage: None,
+            flow: FlowState::new(scene),
         })
+    }
+
+    /// Advances `engine` by `n` steps, the inlets and outlets acting at their steps on the way.
+    pub fn advance(&mut self, scene: &Scene, engine: &mut dyn Engine, mut n: u64) -> anyhow::Result<()> {
+        while n > 0 {
+            let to_event = self.flow.steps_to_next(scene, engine.steps()).unwrap_or(u64::MAX);
+            let m = n.min(to_event);
+            engine.advance(m)?;
+            n -= m;
+            if m == to_event {
+                self.flow.act(scene, engine)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The engine's statistics with the inlets' and outlets' totals.
+    pub fn stats(&self, engine: &mut dyn Engine) -> Result<Stats, SimError> {
+        let mut s = engine.stats()?;
+        s.flow = self.flow.counts.clone();
+        Ok(s)
     }
 }
 
@@ -239,11 +265,7 @@ pub fn set_wall_present(scene: &Scene, engine: &mut dyn Engine, wall: usize, pre
 /// Refuses to add wall `wall` (for `by`) where a grain of `frame` overlaps it: the first step
 /// would release the overlap's energy at once.
 fn clear_of_grains(scene: &Scene, wall: usize, frame: &Frame, by: &str) -> anyhow::Result<()> {
-    use crate::walls::WallGeom;
-    let distance = |p: glam::DVec3| match (&scene.walls[wall].shape, frame.walls[wall]) {
-        (crate::scene::WallShape::Mesh { mesh, .. }, WallGeom::Mesh { shift, .. }) => mesh.distance(p - shift.f64()),
-        (_, geom) => geom.frame(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).1,
-    };
+    let distance = |p: glam::DVec3| crate::scene::wall_distance_now(&scene.walls[wall].shape, &frame.walls[wall], p);
     for (i, (&p, &r)) in frame.position.iter().zip(&frame.radius).enumerate() {
         let d = distance(p);
         if d < r {
@@ -272,15 +294,16 @@ fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dy
     let dt = scene.time_step.dt;
     let total = stage.max_steps(dt);
     let k = scene.stats_interval;
-    let n = engine.grain_count() as f64;
     let settles = stage.kind != StageKind::Run;
     let mut settled = false;
-    let mut stats = engine.stats()?;
+    let mut stats = progress.stats(engine)?;
     while done < total {
         let chunk = k.min(total - done);
-        engine.advance(chunk)?;
+        progress.advance(scene, engine, chunk)?;
         done += chunk;
-        stats = engine.stats()?;
+        stats = progress.stats(engine)?;
+        // Per grain in play (an inlet's waiting grains are not yet in the packing).
+        let n = stats.grains.max(1) as f64;
         guard.check(&stats)?;
         rec.stats(&stage.name, &stats)?;
         rec.progress(&stage.name, done, total);
@@ -328,7 +351,7 @@ fn run_stage(scene: &Scene, stage: &Stage, engine: &mut dyn Engine, rec: &mut dy
         time_start: time0,
         time_end: engine.time(),
         settled: settles.then_some(settled),
-        ke_per_grain: stats.ke_translational / n,
+        ke_per_grain: stats.ke_translational / stats.grains.max(1) as f64,
         unbalanced_force: stats.unbalanced_force,
         stats,
         compression,
@@ -389,8 +412,10 @@ impl Guard {
                 ", or, if the grains carry more load than their stiffness allows, stiffen them (youngs_modulus) or lower the pressure",
             ));
         }
-        let in_play = self.kinetic_elastic0 + (s.gravity_energy - self.gravity0).abs() + s.external_work.abs() + s.kinetic_energy() * 1e-6;
-        let growth = s.mechanical_energy() - self.energy0;
+        // Inlets bring energy in (counted positive), outlets take it out (counted negative).
+        let (brought, moved) = s.flow.iter().fold((0.0, 0.0), |(b, m), f| (b + f.energy, m + f.energy.abs()));
+        let in_play = self.kinetic_elastic0 + (s.gravity_energy - self.gravity0).abs() + s.external_work.abs() + s.kinetic_energy() * 1e-6 + moved;
+        let growth = s.mechanical_energy() - self.energy0 - brought;
         if growth > ENERGY_GROWTH_TOLERANCE * in_play && growth > 0.0 {
             return Err(unstable(
                 format!("mechanical energy grew by {growth:.3e} J with {in_play:.3e} J in play and no input"),

@@ -2,7 +2,7 @@
 //! overlap a grain already placed. Deterministic for a given scene seed.
 
 use super::error::Complainer;
-use super::schema::{GeneratorSpec, RegionSpec};
+use super::schema::{GeneratorSpec, RangeSpec, RegionSpec};
 use super::{sphere_mass, Grains, SceneError};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -115,10 +115,7 @@ impl PlacementGrid {
 
 /// The lower and upper corners of a box holding `region` and every grain of `grains` (m).
 fn bounds_of(region: &RegionSpec, grains: &Grains) -> [[f64; 3]; 2] {
-    let mut b = match *region {
-        RegionSpec::Box { min, max } => [min.to_array(), max.to_array()],
-        RegionSpec::Cylinder { center, radius, z_min, z_max } => [[center[0] - radius, center[1] - radius, z_min], [center[0] + radius, center[1] + radius, z_max]],
-    };
+    let mut b = region.bounds();
     for p in &grains.position {
         for a in 0..3 {
             b[0][a] = b[0][a].min(p[a]);
@@ -126,6 +123,17 @@ fn bounds_of(region: &RegionSpec, grains: &Grains) -> [[f64; 3]; 2] {
         }
     }
     b
+}
+
+/// `table.diameter` (`{ min, max }`, m): positive, `max` at least `min`.
+pub(super) fn check_diameters(c: &Complainer, table: &str, d: &RangeSpec) -> Result<(), SceneError> {
+    if !(d.min.is_finite() && d.min > 0.0) {
+        return Err(c.invalid(format!("{table}.diameter.min"), d.min, "must be a positive number", "give the smallest diameter in metres"));
+    }
+    if !(d.max.is_finite() && d.max >= d.min) {
+        return Err(c.invalid(format!("{table}.diameter.max"), d.max, format!("must be at least diameter.min = {:e}", d.min), "give the largest diameter in metres"));
+    }
+    Ok(())
 }
 
 /// Places generator `k`'s grains into `grains` (after those already there).
@@ -141,12 +149,7 @@ pub(super) fn place(
 ) -> Result<(), SceneError> {
     let key = |s: &str| format!("generate[{k}].{s}");
     let d = &spec.diameter;
-    if !(d.min.is_finite() && d.min > 0.0) {
-        return Err(c.invalid(key("diameter.min"), d.min, "must be a positive number", "give the smallest diameter in metres"));
-    }
-    if !(d.max.is_finite() && d.max >= d.min) {
-        return Err(c.invalid(key("diameter.max"), d.max, format!("must be at least diameter.min = {:e}", d.min), "give the largest diameter in metres"));
-    }
+    check_diameters(c, &format!("generate[{k}]"), d)?;
     if spec.count == 0 {
         return Err(c.invalid(key("count"), 0, "must be at least 1", "give the number of grains"));
     }
@@ -204,37 +207,67 @@ fn region_volume(region: &RegionSpec) -> f64 {
 
 /// A centre for a grain of radius `r` wholly inside the region.
 fn sample(c: &Complainer, k: usize, region: &RegionSpec, r: f64, rng: &mut ChaCha8Rng) -> Result<[f64; 3], SceneError> {
-    let too_small = |what: &str, size: f64| {
-        c.invalid(format!("generate[{k}].region"), format!("{what} {size:e} m"), format!("cannot hold a grain of diameter {:e} m", 2.0 * r), "enlarge the region")
-    };
-    match *region {
-        RegionSpec::Box { min, max } => {
-            let mut p = [0.0; 3];
-            for a in 0..3 {
-                let (lo, hi) = (min[a] + r, max[a] - r);
-                if !(hi >= lo) {
-                    return Err(too_small("side", max[a] - min[a]));
+    region.sample(r, rng).map_err(|(what, size)| c.invalid(format!("generate[{k}].region"), format!("{what} {size:e} m"), format!("cannot hold a grain of diameter {:e} m", 2.0 * r), "enlarge the region"))
+}
+
+impl RegionSpec {
+    /// A centre, uniform, for a grain of radius `r` (m) wholly inside the region; the side
+    /// (`"side"`, `"radius"` or `"height"`) and its size (m) where the region cannot hold one.
+    pub(crate) fn sample(&self, r: f64, rng: &mut ChaCha8Rng) -> Result<[f64; 3], (&'static str, f64)> {
+        match *self {
+            RegionSpec::Box { min, max } => {
+                let mut p = [0.0; 3];
+                for a in 0..3 {
+                    let (lo, hi) = (min[a] + r, max[a] - r);
+                    if !(hi >= lo) {
+                        return Err(("side", max[a] - min[a]));
+                    }
+                    p[a] = if hi > lo { rng.random_range(lo..hi) } else { lo };
                 }
-                p[a] = if hi > lo { rng.random_range(lo..hi) } else { lo };
+                Ok(p)
             }
-            Ok(p)
-        }
-        RegionSpec::Cylinder { center, radius, z_min, z_max } => {
-            let rr = radius - r;
-            if !(rr >= 0.0) {
-                return Err(too_small("radius", radius));
-            }
-            if !(z_max - r >= z_min + r) {
-                return Err(too_small("height", z_max - z_min));
-            }
-            let z = if z_max - r > z_min + r { rng.random_range(z_min + r..z_max - r) } else { z_min + r };
-            loop {
-                let (x, y) = (rng.random_range(-1.0..1.0f64), rng.random_range(-1.0..1.0f64));
-                if x * x + y * y <= 1.0 {
-                    return Ok([center[0] + rr * x, center[1] + rr * y, z]);
+            RegionSpec::Cylinder { center, radius, z_min, z_max } => {
+                let rr = radius - r;
+                if !(rr >= 0.0) {
+                    return Err(("radius", radius));
+                }
+                if !(z_max - r >= z_min + r) {
+                    return Err(("height", z_max - z_min));
+                }
+                let z = if z_max - r > z_min + r { rng.random_range(z_min + r..z_max - r) } else { z_min + r };
+                loop {
+                    let (x, y) = (rng.random_range(-1.0..1.0f64), rng.random_range(-1.0..1.0f64));
+                    if x * x + y * y <= 1.0 {
+                        return Ok([center[0] + rr * x, center[1] + rr * y, z]);
+                    }
                 }
             }
         }
+    }
+
+    /// Whether point `p` (m) lies inside the region (its boundary included).
+    pub fn contains(&self, p: glam::DVec3) -> bool {
+        match *self {
+            RegionSpec::Box { min, max } => (0..3).all(|a| p[a] >= min[a] && p[a] <= max[a]),
+            RegionSpec::Cylinder { center, radius, z_min, z_max } => {
+                let (dx, dy) = (p.x - center[0], p.y - center[1]);
+                dx * dx + dy * dy <= radius * radius && p.z >= z_min && p.z <= z_max
+            }
+        }
+    }
+
+    /// The lower and upper corners of the box around the region (m).
+    pub fn bounds(&self) -> [[f64; 3]; 2] {
+        match *self {
+            RegionSpec::Box { min, max } => [min.to_array(), max.to_array()],
+            RegionSpec::Cylinder { center, radius, z_min, z_max } => [[center[0] - radius, center[1] - radius, z_min], [center[0] + radius, center[1] + radius, z_max]],
+        }
+    }
+
+    /// Its centre (m).
+    pub fn centre(&self) -> glam::DVec3 {
+        let [lo, hi] = self.bounds();
+        glam::DVec3::new(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]))
     }
 }
 

@@ -3,6 +3,7 @@
 
 pub mod dotted;
 mod error;
+mod flow_specs;
 mod generate;
 mod model_specs;
 mod periodic_specs;
@@ -18,7 +19,7 @@ pub use error::SceneError;
 pub(crate) use generate::random_direction;
 pub use stage_specs::pressure_label;
 pub use types::*;
-pub use wall_specs::{cross_section, wall_distance};
+pub use wall_specs::{cross_section, wall_distance, wall_distance_now};
 use glam::DVec3;
 use model_specs::{bridge_limits, validate_method, validate_model};
 use periodic_specs::{check_periodic, validate_periodic};
@@ -107,8 +108,12 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         generate::place(&c, k, spec, m, rho, seed, &periodic, &mut grains)?;
         origins.blocks.push((format!("generate[{k}]"), grains.len() - before, false));
     }
+    let reservoirs = flow_specs::reservoirs(&c, &f, &material_of, &grain_density, seed, &mut grains)?;
+    for (k, ids) in reservoirs.iter().enumerate() {
+        origins.blocks.push((format!("inlet[{k}]"), ids.len(), false));
+    }
     if grains.is_empty() {
-        return Err(c.invalid("grain", "[]", "the scene has no grains", "add [[grain]] or [[generate]] tables"));
+        return Err(c.invalid("grain", "[]", "the scene has no grains", "add [[grain]], [[generate]] or [[inlet]] tables"));
     }
     let servo = servo_box(&walls);
     let mut walls = finish_walls(&c, walls, &grains, &periodic)?;
@@ -137,6 +142,14 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
     let method = validate_method(&c, sim, f.contact_dynamics.as_ref(), d_mean)?;
     let rigid = matches!(method, Method::ContactDynamics(_));
     let time_step = choose_time_step(&c, sim, rigid, &materials, &grains, &walls, &model, gravity, &mut warnings)?;
+    let (inlets, outlets) = flow_specs::inlets_and_outlets(&c, &f, reservoirs, time_step.dt, seed)?;
+    let flows = !(inlets.is_empty() && outlets.is_empty());
+    if rigid && flows {
+        return Err(c.invalid("simulation.method", "\"contact_dynamics\"", "keeps every grain in play: it takes no [[inlet]] or [[outlet]] yet", "use method = \"dem\", or leave out the inlets and outlets"));
+    }
+    if flows && !matches!(model.cohesion, CohesionLaw::None) {
+        return Err(c.invalid("model.cohesion", "\"capillary\"", "keeps liquid on the grains, which [[inlet]] and [[outlet]] do not carry yet", "leave out the cohesion, or the inlets and outlets"));
+    }
     let stats_interval = sim.stats_interval.unwrap_or(500);
     if stats_interval == 0 {
         return Err(c.invalid("simulation.stats_interval", 0, "must be at least 1", "give a number of steps, e.g. 500"));
@@ -171,6 +184,8 @@ fn validate(path: &Path, f: SceneFile) -> Result<Scene, SceneError> {
         pairs,
         grains,
         walls,
+        inlets,
+        outlets,
         servo,
         periodic,
         gravity,

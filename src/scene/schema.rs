@@ -36,6 +36,12 @@ pub struct SceneFile {
     /// `[[wall]]` tables.
     #[serde(default, rename = "wall")]
     pub walls: Vec<WallSpec>,
+    /// `[[inlet]]` tables: grains put into play at a mass rate.
+    #[serde(default, rename = "inlet")]
+    pub inlets: Vec<InletSpec>,
+    /// `[[outlet]]` tables: regions that take the grains entering them out of play.
+    #[serde(default, rename = "outlet")]
+    pub outlets: Vec<OutletSpec>,
     /// `[periodic]`: axes along which the domain wraps.
     #[serde(default)]
     pub periodic: PeriodicSpec,
@@ -182,6 +188,50 @@ pub struct GeneratorSpec {
     pub random_speed: f64,
 }
 
+/// `[[inlet]]`: grains of one material put into play in a region at a mass rate, each clear
+/// of the grains and walls there (`grains::flow`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct InletSpec {
+    /// Name: its columns in `stats.csv`.
+    pub name: String,
+    /// Material name.
+    pub material: String,
+    /// Diameters, uniform in `[min, max]` (m).
+    pub diameter: RangeSpec,
+    /// Where the centres go; each grain lies wholly inside the region.
+    pub region: RegionSpec,
+    /// Mass put into play per second (kg/s).
+    pub mass_rate: f64,
+    /// Mass put into play in all (kg); the inlet closes when it is in.
+    pub mass: f64,
+    /// Velocity of each grain put into play (m/s). Default 0.
+    #[serde(default)]
+    pub velocity: DVec3,
+    /// When it opens (s of simulated time). Default 0.
+    #[serde(default)]
+    pub start: f64,
+    /// Simulated time between insertions (s). Default [`DEFAULT_FLOW_INTERVAL`].
+    pub interval: Option<f64>,
+}
+
+/// `[[outlet]]`: a region whose grains (their centres inside it) leave play, counted
+/// (`grains::flow`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutletSpec {
+    /// Name: its columns in `stats.csv`.
+    pub name: String,
+    /// The region.
+    pub region: RegionSpec,
+    /// Simulated time between removals (s). Default [`DEFAULT_FLOW_INTERVAL`].
+    pub interval: Option<f64>,
+}
+
+/// Simulated time between an inlet's insertions and between an outlet's removals where the
+/// scene does not say (s).
+pub const DEFAULT_FLOW_INTERVAL: f64 = 0.005;
+
 /// A closed interval.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -193,7 +243,7 @@ pub struct RangeSpec {
 }
 
 /// A region of space.
-#[derive(Debug, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Deserialize)]
 #[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
 pub enum RegionSpec {
     /// Axis-aligned box.

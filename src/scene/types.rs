@@ -59,6 +59,9 @@ pub struct Grains {
     pub angular_velocity: Vec<DVec3>,
     /// Index into [`Scene::materials`].
     pub material: Vec<u16>,
+    /// Whether each grain starts in play; empty when all do. The grains an inlet will insert
+    /// wait out of play ([`crate::flow`]).
+    pub in_play: Vec<bool>,
 }
 
 impl Grains {
@@ -72,7 +75,13 @@ impl Grains {
             velocity: pick(&self.velocity),
             angular_velocity: pick(&self.angular_velocity),
             material: order.iter().map(|&i| self.material[i]).collect(),
+            in_play: if self.in_play.is_empty() { Vec::new() } else { order.iter().map(|&i| self.in_play[i]).collect() },
         }
+    }
+
+    /// Whether grain `i` starts in play.
+    pub fn starts_in_play(&self, i: usize) -> bool {
+        self.in_play.get(i).copied().unwrap_or(true)
     }
 
     /// Number of grains.
@@ -83,6 +92,16 @@ impl Grains {
     pub fn is_empty(&self) -> bool {
         self.radius.is_empty()
     }
+    /// Appends a grain waiting out of play, at rest at `position` (m).
+    pub(super) fn push_waiting(&mut self, radius: f64, mass: f64, position: DVec3, material: u16) {
+        let n = self.len();
+        self.push(radius, mass, position, DVec3::ZERO, DVec3::ZERO, material);
+        if self.in_play.is_empty() {
+            self.in_play = vec![true; n + 1];
+        }
+        self.in_play[n] = false;
+    }
+
     pub(super) fn push(&mut self, radius: f64, mass: f64, position: DVec3, velocity: DVec3, angular_velocity: DVec3, material: u16) {
         self.radius.push(radius);
         self.mass.push(mass);
@@ -90,6 +109,9 @@ impl Grains {
         self.velocity.push(velocity);
         self.angular_velocity.push(angular_velocity);
         self.material.push(material);
+        if !self.in_play.is_empty() {
+            self.in_play.push(true);
+        }
     }
 }
 
@@ -360,6 +382,10 @@ pub struct Scene {
     pub grains: Grains,
     /// Walls.
     pub walls: Vec<Wall>,
+    /// Inlets: grains put into play at a mass rate ([`crate::flow`]).
+    pub inlets: Vec<Inlet>,
+    /// Outlets: regions whose grains leave play ([`crate::flow`]).
+    pub outlets: Vec<Outlet>,
     /// The servo-controlled box, if any (its planes are among the walls).
     pub servo: Option<ServoBox>,
     /// Wrapping interval `[lo, hi)` (m) of each periodic axis.
@@ -395,6 +421,39 @@ pub struct Scene {
     /// Capillary scenes: the largest bridge volume (m^3) and the rupture distance it reaches
     /// (m), which the neighbour search adds to the skin; zero without cohesion.
     pub bridges: BridgeLimits,
+}
+
+/// `[[inlet]]`: its reservoir of grains waiting out of play, put into play in id order in
+/// its region at its mass rate ([`crate::flow`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Inlet {
+    /// Name in `stats.csv`.
+    pub name: String,
+    /// Where the grains' centres go, each grain wholly inside.
+    pub region: super::schema::RegionSpec,
+    /// Mass put into play per second (kg/s).
+    pub mass_rate: f64,
+    /// Velocity of the grains put into play (m/s).
+    pub velocity: DVec3,
+    /// The step at which it opens.
+    pub start_step: u64,
+    /// Steps between insertions.
+    pub every: u64,
+    /// The permanent ids of its reservoir, in the order they go into play.
+    pub grains: std::ops::Range<u32>,
+    /// The seed of its placements.
+    pub seed: u64,
+}
+
+/// `[[outlet]]`: a region whose grains leave play ([`crate::flow`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outlet {
+    /// Name in `stats.csv`.
+    pub name: String,
+    /// The region: a grain whose centre lies inside leaves.
+    pub region: super::schema::RegionSpec,
+    /// Steps between removals.
+    pub every: u64,
 }
 
 /// How the grains interact.

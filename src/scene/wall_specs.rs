@@ -228,13 +228,22 @@ pub fn wall_distance(shape: &WallShape, p: DVec3) -> f64 {
     }
 }
 
+/// Signed distance (m) from a point to a wall's surface where it stands now (`geom`, as a
+/// frame has it; `shape` the scene's), positive on the grains' side.
+pub fn wall_distance_now(shape: &WallShape, geom: &crate::walls::WallGeom<f64>, p: DVec3) -> f64 {
+    match (shape, geom) {
+        (WallShape::Mesh { mesh, .. }, crate::walls::WallGeom::Mesh { shift, .. }) => mesh.distance(p - shift.f64()),
+        (_, geom) => geom.frame(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).1,
+    }
+}
+
 /// Grains may not start overlapping a wall (grains read from a file: by more than
 /// [`READ_WALL_OVERLAP`]) or (listed grains) each other: the first step would release the
 /// stored energy at once.
 pub(super) fn check_overlaps(c: &Complainer, origins: &Origins, grains: &Grains, walls: &[Wall]) -> Result<(), SceneError> {
     let listed = origins.listed;
     let origin = |i: usize| origins.name(i);
-    for i in 0..grains.len() {
+    for i in (0..grains.len()).filter(|&i| grains.starts_in_play(i)) {
         for w in walls.iter().filter(|w| w.present) {
             let d = wall_distance(&w.shape, grains.position[i]);
             let allowed = if origins.read(i) { READ_WALL_OVERLAP * grains.radius[i] } else { 0.0 };

@@ -36,6 +36,21 @@ impl<T: Real> Props<T> {
     pub fn sphere(radius: f64, mass: f64) -> Self {
         Props { radius: T::of(radius), mass: T::of(mass), inertia: T::of(0.4 * mass * radius * radius) }
     }
+
+    /// Whether the grain is in play. A grain out of play (waiting in an inlet's reservoir, or
+    /// gone through an outlet: [`crate::flow`]) keeps its slot with its radius stored negated
+    /// (WGSL `in_play`, the radius in `pos.w`): it is in no cell and no pair, touches no wall,
+    /// feels no gravity, does not move and counts in no statistic.
+    #[inline(always)]
+    pub fn in_play(&self) -> bool {
+        self.radius > T::ZERO
+    }
+
+    /// The same grain in play or out of it ([`Self::in_play`]).
+    pub fn with_play(self, in_play: bool) -> Self {
+        let r = self.radius.abs();
+        Props { radius: if in_play { r } else { -r }, ..self }
+    }
 }
 
 /// Material index of slot `i` in `material`, the engine's indices by slot (empty in a scene

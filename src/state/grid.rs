@@ -52,19 +52,21 @@ impl<T: Real> CellGrid<T> {
 /// sorts grain indices by cell (counting sort: count, exclusive scan, stable scatter).
 /// Returns `false` when a position is not finite.
 pub fn hash_cells<T: Real>(body: &[Body<T>], cutoff: T, periodic: &Periodic<T>, grid: &mut CellGrid<T>) -> bool {
-    let Some(bounds) = bounds_of(body, periodic) else { return false };
+    let Some(bounds) = bounds_of(body, None, periodic) else { return false };
     place(body, None, bounds, cutoff, periodic, grid);
     true
 }
 
-/// The grains' bounding box, lower and upper corners (m; the period along a wrapping axis),
-/// or `None` when a position is not finite.
-pub(super) fn bounds_of<T: Real>(body: &[Body<T>], periodic: &Periodic<T>) -> Option<([f64; 3], [f64; 3])> {
-    let bounds = chunked(body.len(), |r| {
+/// The bounding box of the grains of slots `members` (every grain when `None`), lower and
+/// upper corners (m; the period along a wrapping axis), or `None` when a position is not
+/// finite.
+pub(super) fn bounds_of<T: Real>(body: &[Body<T>], members: Option<&[u32]>, periodic: &Periodic<T>) -> Option<([f64; 3], [f64; 3])> {
+    let bounds = chunked(members.map_or(body.len(), |m| m.len()), |r| {
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         let mut finite = true;
-        for b in &body[r] {
+        for k in r {
+            let b = &body[members.map_or(k, |m| m[k] as usize)];
             finite &= b.pos.is_finite();
             let p = b.pos.f64();
             for a in 0..3 {
@@ -84,6 +86,10 @@ pub(super) fn bounds_of<T: Real>(body: &[Body<T>], periodic: &Periodic<T>) -> Op
             lo[a] = lo[a].min(l[a]);
             hi[a] = hi[a].max(h[a]);
         }
+    }
+    if lo[0] > hi[0] {
+        // No grain: a grid of one cell at the origin.
+        (lo, hi) = ([0.0; 3], [0.0; 3]);
     }
     for a in 0..3 {
         if periodic.on[a] {

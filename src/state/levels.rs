@@ -41,17 +41,20 @@ impl<T: Real> Grids<T> {
     /// one per size class, each with cells of its largest pair plus `reach` (m: the skin and
     /// any bridge's rupture distance). Returns `None` when a position is not finite.
     pub fn hash(body: &[Body<T>], prop: &[Props<T>], cutoff: T, reach: T, periodic: &Periodic<T>) -> Option<Self> {
-        let bounds = bounds_of(body, periodic)?;
-        let tops = class_tops(prop.iter().map(|p| p.radius.f64()));
+        // Grains out of play ([`Props::in_play`]) are in no grid: the slots of those in play,
+        // when some are not.
+        let playing: Option<Vec<u32>> = if prop.iter().all(Props::in_play) { None } else { Some((0..prop.len() as u32).filter(|&i| prop[i as usize].in_play()).collect()) };
+        let bounds = bounds_of(body, playing.as_deref(), periodic)?;
+        let tops = class_tops(prop.iter().filter(|p| p.in_play()).map(|p| p.radius.f64()));
         let mut grids = Grids { classes: Vec::with_capacity(tops.len()) };
         if tops.len() <= 1 {
             let mut grid = CellGrid::default();
-            place(body, None, bounds, cutoff, periodic, &mut grid);
+            place(body, playing.as_deref(), bounds, cutoff, periodic, &mut grid);
             grids.classes.push((grid, T::of(tops.first().copied().unwrap_or(0.0))));
             return Some(grids);
         }
         let mut members = vec![Vec::new(); tops.len()];
-        for (i, p) in prop.iter().enumerate() {
+        for (i, p) in prop.iter().enumerate().filter(|(_, p)| p.in_play()) {
             members[class_index(&tops, p.radius.f64())].push(i as u32);
         }
         for (m, &largest) in members.iter().zip(&tops) {

@@ -71,7 +71,10 @@ impl PairList {
             let mut partners = Vec::new();
             for i in r {
                 let before = partners.len();
-                detect_pairs_in(i, body, residual, prop, id, grids, periodic, skin, &mut partners);
+                // A grain out of play owns no pair (and no grid holds it to be found).
+                if prop[i].in_play() {
+                    detect_pairs_in(i, body, residual, prop, id, grids, periodic, skin, &mut partners);
+                }
                 counts.push((partners.len() - before) as u32);
             }
             (counts, partners)

@@ -124,6 +124,9 @@ impl<T: Real> Distributed<T> {
         if scene.walls.iter().any(|w| matches!(w.shape, crate::scene::WallShape::Mesh { .. })) {
             anyhow::bail!("{file}: mesh walls run on one process so far; fix: run it without mpirun");
         }
+        if !(scene.inlets.is_empty() && scene.outlets.is_empty()) {
+            anyhow::bail!("{file}: [[inlet]] and [[outlet]] run on one process so far; fix: run it without mpirun");
+        }
         let world = SimpleCommunicator::world();
         let grid = Grid::new(scene, world.size() as usize)?;
         let mut whole = CpuEngine::<T>::new(scene)?;
@@ -534,6 +537,12 @@ impl<T: Real> Engine for Distributed<T> {
         if let Some(w) = &mut self.whole {
             w.set_wall_present(wall, present);
         }
+    }
+    fn remove_grains(&mut self, _ids: &[u32]) -> anyhow::Result<()> {
+        anyhow::bail!("a run over several processes keeps every grain in play: it takes no outlet yet; fix: run it without mpirun")
+    }
+    fn insert_grains(&mut self, _grains: &[crate::engine::Insertion]) -> anyhow::Result<()> {
+        anyhow::bail!("a run over several processes keeps every grain in play: it takes no inlet yet; fix: run it without mpirun")
     }
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
         self.local.set_servo(pressure, axial_strain_rate);

@@ -89,6 +89,16 @@ impl Engine for GpuEngine {
         self.gpu.queue.write_buffer(&self.buffers[Buf::Walls], at, bytemuck::bytes_of(flags));
     }
 
+    fn remove_grains(&mut self, ids: &[u32]) -> anyhow::Result<()> {
+        self.take_out_of_play(ids);
+        Ok(())
+    }
+
+    fn insert_grains(&mut self, grains: &[crate::engine::Insertion]) -> anyhow::Result<()> {
+        self.put_into_play(grains);
+        Ok(())
+    }
+
     fn set_servo(&mut self, pressure: Option<f64>, axial_strain_rate: Option<f64>) {
         if self.servo.is_none() {
             return;

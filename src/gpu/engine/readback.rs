@@ -242,7 +242,7 @@ impl GpuEngine {
         let p = |f: usize| s[STAT_ROW + f] as f64;
         let g_count = |f: usize| s[f].to_bits() as u64;
         let p_count = |f: usize| s[STAT_ROW + f].to_bits() as u64;
-        let n = self.n as f64;
+        let n = self.grains_in_play() as f64;
         let contacts = p_count(pr::CONTACTS);
         let wall_contacts = g_count(gr::WALL_CONTACTS);
         let contact_ends = 2 * contacts + wall_contacts;
@@ -285,6 +285,7 @@ impl GpuEngine {
             sliding: p_count(pr::SLIDING) + g_count(gr::WALL_SLIDING),
             rolling: p_count(pr::ROLLING) + g_count(gr::WALL_ROLLING),
             coordination: 2.0 * contacts as f64 / n,
+            grains: n as u64,
             max_overlap,
             max_overlap_grain: if max_overlap_grain == NONE { 0 } else { max_overlap_grain },
             unbalanced_force,
@@ -310,6 +311,7 @@ impl GpuEngine {
                 .collect(),
             piston,
             solver: None,
+            flow: Vec::new(),
         })
     }
 }

@@ -189,7 +189,8 @@ pub(super) fn scene_buffers(device: &wgpu::Device, scene: &Scene, params: &Param
     let (n, hash_size) = (g.len() as u64, params.hash_size as u64);
     let coeffs = pair_coeffs_of(scene);
     let v4 = |a: glam::DVec3, w: f64| [a[0] as f32, a[1] as f32, a[2] as f32, w as f32];
-    let pos: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.position[i], g.radius[i])).collect();
+    // The radius negated for a grain out of play (WGSL `in_play`).
+    let pos: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.position[i], if g.starts_in_play(i) { g.radius[i] } else { -g.radius[i] })).collect();
     // What rounding took off each position (src/position.rs), as the CPU's f32 engine keeps it.
     let residual: Vec<[f32; 4]> = g.position.iter().map(|&x| { let (_, r) = crate::position::split::<f32>(x); [r.x, r.y, r.z, 0.0] }).collect();
     let vel: Vec<[f32; 4]> = (0..g.len()).map(|i| v4(g.velocity[i], g.mass[i])).collect();

@@ -178,7 +178,7 @@ impl GpuEngine {
         } else {
             Some(Vec::new())
         };
-        Ok(Frame {
+        let mut frame = Frame {
             time: self.time,
             id: (0..self.n).collect(),
             position: pos.iter().zip(residual).map(|(p, r)| crate::position::absolute(v3(p), v3(r))).collect(),
@@ -190,7 +190,9 @@ impl GpuEngine {
             wall_contacts: wall_records,
             walls: self.walls_now()?,
             walls_present: self.wall_flags.iter().map(|f| f & layout::wall_flags::ABSENT == 0).collect(),
-        })
+        };
+        frame.retain_grains(|k| self.in_play[k]);
+        Ok(frame)
     }
 
     /// Every wall's surface where it stands now.
@@ -286,6 +288,7 @@ impl GpuEngine {
         self.time = s.reals("time", 1)?[0];
         self.marks.clear();
         self.marks_base = self.read_control()?.rebuild_checks;
+        self.read_in_play()?;
         Ok(())
     }
 }

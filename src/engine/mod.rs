@@ -1,9 +1,12 @@
 //! What the host loop needs from a backend: advance, read a few statistics, take a frame.
 
 use anyhow::{bail, Context};
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+
+mod frame;
+pub use frame::{scalar_first, ContactRecord, Frame, WallContactRecord};
 
 /// Why a run stopped early.
 #[derive(Debug, thiserror::Error)]
@@ -204,6 +207,29 @@ pub struct Stats {
     /// Contact dynamics: what its solver did since the last read (absent for DEM).
     #[serde(default)]
     pub solver: Option<SolverStats>,
+    /// Grains in play: all but those an inlet has yet to put into play and those an outlet
+    /// took out ([`crate::flow`]); 0 in checkpoints written before grains counted them.
+    #[serde(default)]
+    pub grains: u64,
+    /// The inlets' and outlets' running totals, in the scene's order (inlets first), where the
+    /// scene has any: the host loop fills them in.
+    #[serde(default)]
+    pub flow: Vec<FlowCount>,
+}
+
+/// What an inlet has put into play, or an outlet taken out of it, since the start.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FlowCount {
+    /// The inlet's or outlet's name.
+    pub name: String,
+    /// Grains.
+    pub grains: u64,
+    /// Their mass (kg).
+    pub mass: f64,
+    /// The mechanical energy they brought into play (J; negative for what an outlet took out):
+    /// kinetic and gravitational (`-m g.x`), as each went in or out.
+    #[serde(default)]
+    pub energy: f64,
 }
 
 /// What contact dynamics' solver did over the steps since the last statistics read.
@@ -326,101 +352,6 @@ impl Stats {
     }
 }
 
-/// Quaternions in MCAP frames as the engines keep them, scalar first: `[w, x, y, z]`
-/// (`#[serde(with = "scalar_first")]`; glam's own order is `[x, y, z, w]`).
-pub mod scalar_first {
-    use glam::DQuat;
-    use serde::{Deserialize, Deserializer, Serialize, Serializer};
-
-    /// Writes each quaternion as `[w, x, y, z]`.
-    pub fn serialize<S: Serializer>(q: &Option<Vec<DQuat>>, s: S) -> Result<S::Ok, S::Error> {
-        q.as_ref().map(|v| v.iter().map(|q| [q.w, q.x, q.y, q.z]).collect::<Vec<_>>()).serialize(s)
-    }
-
-    /// Reads `[w, x, y, z]` quaternions.
-    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<DQuat>>, D::Error> {
-        Ok(Option::<Vec<[f64; 4]>>::deserialize(d)?.map(|v| v.into_iter().map(|[w, x, y, z]| DQuat::from_xyzw(x, y, z, w)).collect()))
-    }
-}
-
-/// One recorded instant: what an MCAP frame holds.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Frame {
-    /// Simulated time (s).
-    pub time: f64,
-    /// Permanent grain ids.
-    pub id: Vec<u32>,
-    /// Centre positions (m).
-    pub position: Vec<DVec3>,
-    /// Radii (m).
-    pub radius: Vec<f64>,
-    /// Velocities (m/s).
-    pub velocity: Vec<DVec3>,
-    /// Angular velocities (rad/s).
-    pub angular_velocity: Vec<DVec3>,
-    /// Orientation quaternions, when the scene tracks orientation; written scalar first,
-    /// `[w, x, y, z]` ([`scalar_first`]).
-    #[serde(with = "scalar_first")]
-    pub orientation: Option<Vec<DQuat>>,
-    /// Touching grain pairs with their forces, when asked for.
-    pub contacts: Option<Vec<ContactRecord>>,
-    /// Grain-wall contacts with their forces, when contacts are asked for.
-    #[serde(default)]
-    pub wall_contacts: Option<Vec<WallContactRecord>>,
-    /// Every wall's surface where it stands at this instant, in the scene's wall order (servo
-    /// walls and the piston move). Not recorded in MCAP frames.
-    #[serde(skip)]
-    pub walls: Vec<crate::walls::WallGeom<f64>>,
-    /// Whether each wall is there (false while a stage has taken it away), in the scene's
-    /// wall order. Not recorded in MCAP frames.
-    #[serde(skip)]
-    pub walls_present: Vec<bool>,
-}
-
-/// One touching pair.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ContactRecord {
-    /// Permanent id of grain i (the lower id).
-    pub i: u32,
-    /// Permanent id of grain j.
-    pub j: u32,
-    /// Overlap (m).
-    pub overlap: f64,
-    /// Total normal force (N, compressive positive, tensile negative): elastic + damping +
-    /// capillary, less an adhesive law's pull-off.
-    pub normal_force: f64,
-    /// Total force on i (N).
-    pub force: DVec3,
-    /// Total force on j (N): `-force` except in Oquendo et al.'s rolling regime.
-    pub force_j: DVec3,
-    /// Tangential spring `xi` (m), zero when the model keeps none.
-    pub tangential_spring: DVec3,
-    /// Rolling spring `psi` (m), zero when the model keeps none.
-    #[serde(default)]
-    pub rolling_spring: DVec3,
-    /// Liquid in the pair's bridge (m^3), zero without one.
-    #[serde(default)]
-    pub bridge_volume: f64,
-}
-
-/// One grain touching one wall. Its force is evaluated from the state of the frame (springs
-/// as they stand, not advanced).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct WallContactRecord {
-    /// Permanent id of the grain.
-    pub grain: u32,
-    /// Wall index.
-    pub wall: u32,
-    /// Overlap (m).
-    pub overlap: f64,
-    /// Unit normal from the wall to the grain.
-    pub normal: DVec3,
-    /// Distance from the grain's centre to the contact point (m).
-    pub lever: f64,
-    /// Force on the grain (N).
-    pub force: DVec3,
-}
-
 /// An engine's state as named arrays.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct EngineState {
@@ -462,13 +393,30 @@ fn missing(name: &str) -> String {
     format!("the checkpoint has no `{name}`: another version of grains wrote it; fix: run the scene again from its start with this version")
 }
 
+/// A grain an inlet puts into play ([`Engine::insert_grains`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Insertion {
+    /// Its permanent id: a grain waiting out of play.
+    pub id: u32,
+    /// Where its centre goes (m).
+    pub position: DVec3,
+    /// Its velocity (m/s).
+    pub velocity: DVec3,
+}
+
+/// Where an engine records a grain taken into or out of play as kept at the last neighbour
+/// build (m, each axis): far from any grain, so that the next rebuild check finds it moved
+/// and rebuilds (its square, 3e36 m^2, is still finite in f32).
+pub const FAR_BUILT_AT: f32 = 1.0e18;
+
 /// A backend the host loop can drive.
 pub trait Engine {
     /// "cpu" or "gpu".
     fn backend(&self) -> &'static str;
     /// "f32" or "f64".
     fn precision(&self) -> &'static str;
-    /// Number of grains.
+    /// Number of grains the engine holds, in play or not ([`Stats::grains`] counts those in
+    /// play).
     fn grain_count(&self) -> usize;
     /// Steps taken so far.
     fn steps(&self) -> u64;
@@ -496,6 +444,17 @@ pub trait Engine {
     /// (`present`), or takes it away: it then touches no grain, its contacts' history is
     /// forgotten, and it keeps its motion.
     fn set_wall_present(&mut self, wall: usize, present: bool);
+    /// Takes the grains of permanent ids `ids` out of play (an outlet removed them): each keeps
+    /// its slot and its id, and from the next step is in no pair, touches no wall, feels no
+    /// gravity, stops, and leaves the frames and the statistics. The next step rebuilds the
+    /// neighbour list. Ids out of play already, or of no grain, are ignored. An error where
+    /// the engine cannot (contact dynamics).
+    fn remove_grains(&mut self, ids: &[u32]) -> anyhow::Result<()>;
+    /// Puts grains waiting out of play into play (an inlet inserted them) where each
+    /// [`Insertion`] says, spinning not, with their weight as their load; the next step
+    /// rebuilds the neighbour list. The caller places them clear of the grains and walls. An
+    /// error where the engine cannot (contact dynamics).
+    fn insert_grains(&mut self, grains: &[Insertion]) -> anyhow::Result<()>;
     /// Wets the sample with `volume` (m^3) of liquid: shared among the pairs closer than their
     /// rupture distance in proportion to their reduced diameter (Richefeu et al. (2009), docs/physics.md).
     fn wet(&mut self, volume: f64) -> anyhow::Result<()>;
