@@ -84,11 +84,13 @@ impl FlowState {
                 continue;
             }
             engine.insert_grains(&placed)?;
+            // The next inlet places its grains clear of these too.
             for p in &placed {
-                let id = p.id as usize;
                 frame.id.push(p.id);
                 frame.position.push(p.position);
-                frame.radius.push(scene.grains.radius[id]);
+                frame.radius.push(scene.grains.radius[p.id as usize]);
+                frame.velocity.push(p.velocity);
+                frame.angular_velocity.push(DVec3::ZERO);
             }
         }
         Ok(())

@@ -24,6 +24,10 @@ impl<T: Real> CpuEngine<T> {
             (b.vel, b.omega) = (Vec3::ZERO, Vec3::ZERO);
             self.load[s] = Load::default();
             self.built_at[s] = Vec3::new(FAR_BUILT_AT, FAR_BUILT_AT, FAR_BUILT_AT);
+            // Its share of the walls' contacts leaves the per-grain sums with it, as the
+            // GPU's zeroed torque (whose w holds it) does; the walls' sums keep it until the
+            // next evaluation, on both.
+            self.wall_touches.retain(|t| t.grain != id);
         }
     }
 

@@ -224,7 +224,7 @@ impl<T: Real> CpuEngine<T> {
             clamped: ps.clamped,
             sliding: ps.regimes.sliding + self.wall_regimes.sliding,
             rolling: ps.regimes.rolling + self.wall_regimes.rolling,
-            coordination: 2.0 * ps.contacts as f64 / n,
+            coordination: crate::engine::coordination(ps.contacts, n),
             grains: n as u64,
             max_overlap,
             max_overlap_grain,

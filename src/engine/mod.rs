@@ -307,6 +307,12 @@ pub fn infinite_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
 }
 
+/// The coordination number `2 contacts / grains` (-); 0 without grains (all of them waiting
+/// at an inlet, or gone through an outlet).
+pub fn coordination(contacts: u64, grains: f64) -> f64 {
+    if grains > 0.0 { 2.0 * contacts as f64 / grains } else { 0.0 }
+}
+
 /// Contacts counted per tangential regime.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RegimeCounts {

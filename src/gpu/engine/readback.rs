@@ -284,7 +284,7 @@ impl GpuEngine {
             clamped: p_count(pr::CLAMPED),
             sliding: p_count(pr::SLIDING) + g_count(gr::WALL_SLIDING),
             rolling: p_count(pr::ROLLING) + g_count(gr::WALL_ROLLING),
-            coordination: 2.0 * contacts as f64 / n,
+            coordination: crate::engine::coordination(contacts, n),
             grains: n as u64,
             max_overlap,
             max_overlap_grain: if max_overlap_grain == NONE { 0 } else { max_overlap_grain },
