@@ -219,12 +219,16 @@ fn wall_contact_at(i: u32, w: u32, wall: Wall, n: vec3<f32>, dist: f32, base: u3
 // A grain touching the mesh at more places than it keeps stops the run (control.mesh_overflow).
 fn mesh_loads(i: u32, w: u32, wall: Wall, base: u32, lid: u32, out: ptr<function, WallLoad>) {
     let p = pos[i];
-    let r = residual[i];
     let m = meshes[bitcast<u32>(wall.normal.x)];
-    let t = mesh_touching(m, complete(p.xyz - wall.point.xyz, r.xyz, r.w), p.w);
+    var t = mesh_touching(m, mesh_local(wall, p.xyz, residual[i]), p.w);
     if (t.overflow) {
         atomicMin(&control.mesh_overflow, i);
         return;
+    }
+    if ((wall.flags & WALL_TURNS) != 0u) {
+        for (var k = 0u; k < t.len; k++) {
+            t.normal[k] = turn_apply(wall.turn, t.normal[k]);
+        }
     }
     let size = params.hist_blocks + 1u;
     var last: array<vec3<f32>, MESH_CONTACTS>;

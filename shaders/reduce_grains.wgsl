@@ -62,8 +62,7 @@ fn reduce_grains(@builtin(workgroup_id) wid: vec3<u32>, @builtin(local_invocatio
                 continue;
             }
             if (walls[k].kind == WALL_MESH) {
-                let q = residual[i];
-                let t = mesh_touching(meshes[bitcast<u32>(walls[k].normal.x)], complete(p.xyz - walls[k].point.xyz, q.xyz, q.w), p.w);
+                let t = mesh_touching(meshes[bitcast<u32>(walls[k].normal.x)], mesh_local(walls[k], p.xyz, residual[i]), p.w);
                 for (var j = 0u; j < t.len; j++) {
                     overlaps[j] = p.w - t.dist[j];
                 }

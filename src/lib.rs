@@ -27,5 +27,6 @@ pub mod scene;
 pub mod state;
 pub mod sweep;
 pub mod timestep;
+pub mod turn;
 pub mod walls;
 pub mod workgroup;

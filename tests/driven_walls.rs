@@ -186,7 +186,7 @@ fn driven_walls_run_on_the_gpu_as_on_the_cpu() {
 #[test]
 fn a_run_with_driven_walls_resumes_bitwise() {
     let makers = common::resumable_engines();
-    let spinning = grains::scene::WallDrive { velocity: glam::DVec3::ZERO, angular_velocity: glam::DVec3::new(0.0, 0.0, OMEGA) };
+    let spinning = grains::scene::WallDrive { velocity: glam::DVec3::ZERO, angular_velocity: glam::DVec3::new(0.0, 0.0, OMEGA), turns: false };
     for (s, set) in [(conveyor(2e-3), None), (pushed(1e-3), None), (drum(2e-3), Some(spinning))] {
         for (name, make) in &makers {
             let n = steps(&s, s.stages[0].duration);

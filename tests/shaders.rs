@@ -162,7 +162,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     ]);
     check_struct!(&m, layout::Phase, "Phase", [kick, drift, elapsed, then_kick]);
     check_struct!(&m, layout::PairCoeffs, "PairCoeffs", [v_eff, g_eff, mu_s, mu_k, tan_roll, gamma_n, gamma_nt, beta]);
-    check_struct!(&m, layout::Wall, "Wall", [kind, material, flags, hist_at, point, normal, velocity, drive]);
+    check_struct!(&m, layout::Wall, "Wall", [kind, material, flags, hist_at, point, normal, velocity, drive, turn]);
     check_struct!(&m, layout::Control, "Control", [max_disp2, rebuild, rebuilds, n_pairs, overflow_grain, overflow_count, pair_overflow, non_finite, rebuild_checks, mesh_overflow]);
     check_struct!(&m, layout::MeshInfo, "MeshInfo", [origin, dims, bases]);
     check_struct!(&m, layout::DispatchArgs, "DispatchArgs", [x, y, z]);
@@ -185,7 +185,7 @@ fn rust_mirrors_match_the_wgsl_structures() {
     for (name, slot) in [("NORMAL_SLOT_NONE", normal_slot::NONE), ("NORMAL_SLOT_TANGENTIAL_W", normal_slot::TANGENTIAL_W), ("NORMAL_SLOT_ROLLING_W", normal_slot::ROLLING_W), ("NORMAL_SLOT_BRIDGE_Y", normal_slot::BRIDGE_Y), ("NORMAL_SLOT_OWN", normal_slot::OWN)] {
         assert_eq!(constant(name), slot, "{name}");
     }
-    for (name, flag) in [("WALL_DRIVEN", layout::wall_flags::DRIVEN), ("WALL_ABSENT", layout::wall_flags::ABSENT)] {
+    for (name, flag) in [("WALL_DRIVEN", layout::wall_flags::DRIVEN), ("WALL_ABSENT", layout::wall_flags::ABSENT), ("WALL_TURNS", layout::wall_flags::TURNS)] {
         assert_eq!(constant(name), flag, "{name}");
     }
     for (name, kind) in [("WALL_PLANE", layout::wall_kind::PLANE), ("WALL_CYLINDER", layout::wall_kind::CYLINDER), ("WALL_PISTON", layout::wall_kind::PISTON), ("WALL_MESH", layout::wall_kind::MESH)] {

@@ -165,9 +165,10 @@ class Simulation:
         self._sim.set_piston_pressure(float(pressure))
 
     def set_wall_motion(self, name: str, velocity: Sequence[float] = (0.0, 0.0, 0.0), angular_velocity: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
-        """Sets wall ``name`` (a plane or a cylinder, or a box for every face) moving at
-        ``velocity`` (m/s) and spinning at ``angular_velocity`` (rad/s) about its own axis from
-        now on, as a stage's ``walls`` does; raises SceneError for a wall it cannot move."""
+        """Sets wall ``name`` (a plane, a cylinder or a mesh, or a box for every face) moving
+        at ``velocity`` (m/s) and spinning at ``angular_velocity`` (rad/s) about its pivot from
+        now on, as a stage's ``walls`` does (a plane off its normal and a mesh turn); raises
+        SceneError for a wall it cannot move."""
         self._sim.set_wall_motion(name, [float(v) for v in velocity], [float(w) for w in angular_velocity])
 
     def set_wall_present(self, name: str, present: bool) -> None:

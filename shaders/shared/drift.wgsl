@@ -1,17 +1,6 @@
-// The drift of a grain (needs `pos`, `residual`, `vel`, `omega`, `quat`, `built_at`, `control`).
+// The drift of a grain (needs `turn`, `pos`, `residual`, `vel`, `omega`, `quat`, `built_at`,
+// `control`).
 override TRACK_ORIENTATION: bool = false;
-
-// q + (tau/2 (0, w) * q - 2 a q) / (1 + a), a = tau^2 |w|^2 / 16; quaternions scalar first
-// (x = scalar).
-fn rotate(q: vec4<f32>, w: vec3<f32>, tau: f32) -> vec4<f32> {
-    let a = tau * tau * dot(w, w) / 16.0;
-    let h = 0.5 * tau;
-    let qv = q.yzw;
-    let s = -dot(w, qv);
-    let v = w * q.x + cross(w, qv);
-    let inv = 1.0 / (1.0 + a);
-    return q + (h * vec4<f32>(s, v) - 2.0 * a * q) * inv;
-}
 
 // Grain i by tau (s): x += v tau, compensated (the sum's rounding kept in residual), its
 // orientation by Omelyan's norm-preserving update; records how far it has moved since the

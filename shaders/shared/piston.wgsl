@@ -23,8 +23,10 @@ fn move_piston(kick: f32, drift: f32) {
 }
 
 // The driven walls drifted by `drift` (s) at their velocity (a cylinder, infinite along z, in x
-// and y), booking the work they do on the grains in drive.w: their velocity against the
-// grains' push, plus their spin's power; a zero duration skips it.
+// and y) and turned by their spin where it turns them (a plane's normal, kept of unit length; a
+// mesh's rotation; src/walls.rs WallGeom::turned), booking the work they do on the grains in
+// drive.w: their velocity against the grains' push, plus their spin's power; a zero duration
+// skips it.
 fn move_walls(drift: f32) {
     if (drift <= 0.0) {
         return;
@@ -38,6 +40,15 @@ fn move_walls(drift: f32) {
             walls[w].point = vec4<f32>(walls[w].point.xy + v.xy * drift, walls[w].point.zw);
         } else {
             walls[w].point = vec4<f32>(walls[w].point.xyz + v * drift, walls[w].point.w);
+        }
+        let spin = walls[w].drive.xyz;
+        if ((walls[w].flags & WALL_TURNS) != 0u && any(spin != vec3<f32>(0.0))) {
+            if (walls[w].kind == WALL_PLANE) {
+                let n = turn_apply(rotate(vec4<f32>(1.0, 0.0, 0.0, 0.0), spin, drift), walls[w].normal.xyz);
+                walls[w].normal = vec4<f32>(n * (1.0 / sqrt(dot(n, n))), walls[w].normal.w);
+            } else {
+                walls[w].turn = rotate(walls[w].turn, spin, drift);
+            }
         }
         walls[w].drive.w += (wall_reaction[MAX_WALLS + w].z - dot(wall_reaction[w].xyz, v)) * drift;
     }

@@ -69,6 +69,7 @@ const WALL_MESH: u32 = 3u;
 // Wall flags (src/gpu/layout.rs wall_flags), bits of Wall.flags.
 const WALL_DRIVEN: u32 = 1u;
 const WALL_ABSENT: u32 = 2u;
+const WALL_TURNS: u32 = 4u;
 
 // Where a contact's normal velocity sits in its history blocks (src/gpu/layout.rs normal_slot).
 const NORMAL_SLOT_NONE: u32 = 0u;
@@ -86,14 +87,17 @@ fn add_wall_row(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
 struct Wall {
     kind: u32,
     material: u32,
-    flags: u32,          // WALL_DRIVEN: a prescribed motion moves it (velocity, drive.xyz); WALL_ABSENT: a stage took it away
+    flags: u32,          // WALL_DRIVEN: a prescribed motion moves it (velocity, drive.xyz); WALL_ABSENT: a stage took it away;
+                         // WALL_TURNS: its spin turns it (a plane's normal, a mesh's turn)
     hist_at: u32,        // its first block in a grain's wall history (wall_hist[i * params.wall_blocks + hist_at])
     point: vec4<f32>,    // plane: a point; cylinder: axis (x, y); piston: (0, 0, z); mesh: its shift from the scene's place
-    normal: vec4<f32>,   // plane: unit normal into the domain; cylinder: w = radius; mesh: x = bits of its index in `meshes`
+    normal: vec4<f32>,   // plane: unit normal into the domain; cylinder: w = radius; mesh: x = bits of its index in
+                         // `meshes`, yzw = the point it turns about, where the scene put it (m)
     velocity: vec4<f32>, // m/s
     drive: vec4<f32>,    // piston: mass (kg), area (m^2), target pressure (Pa), external work (J);
                          // other walls: angular velocity (rad/s) about the axis through the
-                         // centre, work on the grains (J)
+                         // pivot, work on the grains (J)
+    turn: vec4<f32>,     // a turning mesh's rotation from the scene's place (turn.wgsl); the identity otherwise
 }
 
 // The servo box's control state.

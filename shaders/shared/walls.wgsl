@@ -21,18 +21,30 @@ fn wall_spin(w: Wall) -> vec3<f32> {
     return vec3<f32>(0.0);
 }
 
-// The point on a wall's axis of symmetry that its spin turns about.
-fn wall_centre(w: Wall) -> vec3<f32> {
-    if (w.kind == WALL_PLANE || w.kind == WALL_MESH) { return w.point.xyz; }
+// The point a wall's spin turns it about (src/walls.rs WallGeom::pivot): a mesh's where its
+// translation has taken it.
+fn wall_pivot(w: Wall) -> vec3<f32> {
+    if (w.kind == WALL_PLANE) { return w.point.xyz; }
+    if (w.kind == WALL_MESH) { return w.normal.yzw + w.point.xyz; }
     if (w.kind == WALL_CYLINDER) { return vec3<f32>(w.point.xy, 0.0); }
     return vec3<f32>(0.0, 0.0, w.point.z);
 }
 
-// The velocity of a wall's surface at x: its velocity, plus spin x (x - centre) where it spins.
+// The velocity of a wall's surface at x: its velocity, plus spin x (x - pivot) where it spins.
 fn wall_velocity_at(w: Wall, x: vec3<f32>) -> vec3<f32> {
     let spin = wall_spin(w);
     if (all(spin == vec3<f32>(0.0))) { return w.velocity.xyz; }
-    return w.velocity.xyz + cross(spin, x - wall_centre(w));
+    return w.velocity.xyz + cross(spin, x - wall_pivot(w));
+}
+
+// A compensated position p + r in mesh wall w's rest frame, where its triangles are
+// (src/walls.rs MeshPose::local).
+fn mesh_local(w: Wall, p: vec3<f32>, r: vec4<f32>) -> vec3<f32> {
+    if ((w.flags & WALL_TURNS) == 0u) {
+        return complete(p - w.point.xyz, r.xyz, r.w);
+    }
+    let pivot = w.normal.yzw;
+    return pivot + turn_unapply(w.turn, complete(p - (pivot + w.point.xyz), r.xyz, r.w));
 }
 
 // The statistics' count of a grain's wall contacts, packed into its force.w beside the pairs

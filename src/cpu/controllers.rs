@@ -86,8 +86,9 @@ impl<T: Real> CpuEngine<T> {
         }
     }
 
-    /// Moves each driven wall by its velocity for `tau` (s) and books the work it did on the
-    /// grains: its velocity against the grains' push, and its spin's power.
+    /// Moves each driven wall by its velocity for `tau` (s), turns one that turns by its spin,
+    /// and books the work it did on the grains: its velocity against the grains' push, and
+    /// its spin's power.
     pub(super) fn drive_walls(&mut self, tau: T) {
         for &w in &self.drivable {
             let wall = &mut self.walls[w];
@@ -95,6 +96,9 @@ impl<T: Real> CpuEngine<T> {
                 continue;
             }
             wall.geom = wall.geom.translated(wall.velocity * tau);
+            if wall.turns && wall.spin != Vec3::ZERO {
+                wall.geom = wall.geom.turned(wall.spin, tau);
+            }
             self.external_work += ((self.wall_power[w] - self.wall_reaction[w].dot(wall.velocity)) * tau).f64();
         }
     }

@@ -45,27 +45,3 @@ fn kick_drift_portable<T: Real>(body: &mut [Body<T>], residual: &mut [Vec3<T>], 
     moved
 }
 
-/// Omelyan's norm-preserving rotation of a unit quaternion (scalar first) by the world-frame
-/// angular velocity `w` over `tau` (Oquendo et al. eqs. 16-18):
-/// `q' = ((1 - a) q + tau/2 (0, w) * q) / (1 + a)`, `a = tau^2 |w|^2 / 16`, a rotation by
-/// `4 atan(tau |w| / 4)` about `w`. The body-frame form of eq. 18, `Q(w_b) q`, equals
-/// `1/2 (0, w) * q` because `w = q w_b q*`. It is evaluated as `q + (tau/2 (0, w) * q - 2 a q) / (1 + a)`
-/// so that rounding touches only the small increment: the norm then drifts by about 1e-19
-/// per step in f64 instead of 1e-16.
-#[inline(always)]
-pub fn rotate<T: Real>(q: [T; 4], w: Vec3<T>, tau: T) -> [T; 4] {
-    let a = tau * tau * w.norm2() / T::of(16.0);
-    let h = tau * T::of(0.5);
-    let qv = Vec3::new(q[1], q[2], q[3]);
-    // (0, w) * (q0, qv) = (-w.qv, q0 w + w x qv)
-    let s = -w.dot(qv);
-    let v = w * q[0] + w.cross(qv);
-    let inv = T::ONE / (T::ONE + a);
-    let two_a = T::of(2.0) * a;
-    [
-        q[0] + (h * s - two_a * q[0]) * inv,
-        q[1] + (h * v.x - two_a * q[1]) * inv,
-        q[2] + (h * v.y - two_a * q[2]) * inv,
-        q[3] + (h * v.z - two_a * q[3]) * inv,
-    ]
-}

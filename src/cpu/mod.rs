@@ -36,7 +36,6 @@ mod wall_springs;
 mod wall_sums;
 mod warm;
 
-pub use integrate::rotate;
 #[cfg(feature = "mpi")]
 pub(crate) use parts::{state_of_rows, touch_of_row, touches_state, RowWidths, Rows, BRIDGE_ROW, TOUCH_ROW};
 #[cfg(feature = "mpi")]
@@ -317,8 +316,11 @@ impl<T: Real> Engine for CpuEngine<T> {
 
     fn set_wall_drive(&mut self, wall: usize, drive: &crate::scene::WallDrive) {
         debug_assert!(self.drivable.contains(&wall), "wall {wall} is moved by a controller");
-        self.walls[wall].velocity = Vec3::of(drive.velocity);
-        self.walls[wall].spin = Vec3::of(drive.angular_velocity);
+        let turned = self.walls[wall].turns;
+        self.walls[wall].drive(Vec3::of(drive.velocity), Vec3::of(drive.angular_velocity), drive.turns);
+        if self.walls[wall].turns && !turned {
+            self.wall_springs.expire();
+        }
     }
 
     fn set_wall_present(&mut self, wall: usize, present: bool) {

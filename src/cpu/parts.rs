@@ -19,7 +19,7 @@ const PAIR_ARRAYS: [(&str, bool); 6] = [("hist", false), ("share", false), ("f_n
 pub(crate) const BRIDGE_ROW: usize = 6;
 
 /// The arrays that hold one value for the whole engine, not one per grain or pair.
-const GLOBAL_ARRAYS: [&str; 13] = ["wall_touch_ids", "wall_touches", "wall_touch_power", "wall_reaction", "wall_count", "wall_power", "piston", "servo", "driven_walls", "wall_present", "clock", "built_margin", "counters"];
+const GLOBAL_ARRAYS: [&str; 14] = ["wall_touch_ids", "wall_touches", "wall_touch_power", "wall_reaction", "wall_count", "wall_power", "piston", "servo", "driven_walls", "wall_turns", "wall_present", "clock", "built_margin", "counters"];
 
 /// Values per grain and per pair of each array of [`GRAIN_ARRAYS`] and [`PAIR_ARRAYS`] (0
 /// where the scene keeps none).

@@ -28,7 +28,9 @@ impl<T: Real> CpuEngine<T> {
                 if let WallShape::Piston { pressure, mass, area, .. } = wall.shape {
                     piston = Some(Piston { wall: w, mass: T::of(mass), area: T::of(area), pressure: T::of(pressure) });
                 }
-                WallState { geom: WallGeom::of(&wall.shape), velocity: Vec3::of(wall.drive.velocity), spin: Vec3::of(wall.drive.angular_velocity), material: wall.material as u32, present: wall.present }
+                let mut state = WallState { geom: WallGeom::of(&wall.shape), velocity: Vec3::ZERO, spin: Vec3::ZERO, turns: false, material: wall.material as u32, present: wall.present };
+                state.drive(Vec3::of(wall.drive.velocity), Vec3::of(wall.drive.angular_velocity), wall.drive.turns);
+                state
             })
             .collect();
         let n_walls = walls.len();

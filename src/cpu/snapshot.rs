@@ -96,6 +96,11 @@ impl<T: Real> CpuEngine<T> {
         // Where each wall a prescribed motion may move stands (its centre), its velocity and
         // spin; and the spins' power.
         s.put_reals("driven_walls", self.drivable.iter().flat_map(|&w| [v3(&self.walls[w].geom.centre()), v3(&self.walls[w].velocity), v3(&self.walls[w].spin)].concat()));
+        // Where a wall turns: 1, then a plane's normal (and 0) or a mesh's rotation; 0 and four
+        // zeros where it does not.
+        if self.walls.iter().any(|w| w.turns) {
+            s.put_reals("wall_turns", self.walls.iter().flat_map(|w| turned_state(w)));
+        }
         s.put_reals("wall_power", self.wall_power.iter().map(|x| x.f64()));
         s.put_ints("wall_present", self.walls.iter().map(|w| w.present as u64));
         let l = &self.pairs;
@@ -210,6 +215,13 @@ impl<T: Real> CpuEngine<T> {
                 (wall.geom, wall.velocity, wall.spin) = (wall.geom.centred_at(v3(&c[0..3])), v3(&c[3..6]), v3(&c[6..9]));
             }
         }
+        // Written while no wall turned: none has turned since the scene started.
+        if s.reals.contains_key("wall_turns") {
+            let turns = s.reals("wall_turns", 5 * self.walls.len())?;
+            for (wall, t) in self.walls.iter_mut().zip(turns.chunks_exact(5)) {
+                restore_turned(wall, t);
+            }
+        }
         // Written before stages could add and remove walls: as the scene starts.
         if s.ints.contains_key("wall_present") {
             let present = s.ints("wall_present", Some(self.walls.len()))?;
@@ -248,5 +260,31 @@ impl<T: Real> CpuEngine<T> {
         let counters = s.ints("counters", Some(3))?;
         (self.step, self.rebuilds, self.forces_valid) = (counters[0], counters[1], counters[2] != 0);
         Ok(())
+    }
+}
+
+/// A wall's turning state as checkpoints keep it: 1, then a plane's normal and 0, or a mesh's
+/// rotation; five zeros for a wall that does not turn.
+fn turned_state<T: Real>(wall: &WallState<T>) -> [f64; 5] {
+    match (wall.turns, wall.geom) {
+        (true, WallGeom::Plane { normal, .. }) => [1.0, normal.x.f64(), normal.y.f64(), normal.z.f64(), 0.0],
+        (true, WallGeom::Mesh { pose, .. }) => {
+            let q = pose.turn.unwrap_or_else(crate::turn::identity);
+            [1.0, q[0].f64(), q[1].f64(), q[2].f64(), q[3].f64()]
+        }
+        _ => [0.0; 5],
+    }
+}
+
+/// Sets a wall's turning state from [`turned_state`]'s five values `t`.
+fn restore_turned<T: Real>(wall: &mut WallState<T>, t: &[f64]) {
+    if t[0] == 0.0 {
+        return;
+    }
+    wall.turns = true;
+    match &mut wall.geom {
+        WallGeom::Plane { normal, .. } => *normal = Vec3::new(T::of(t[1]), T::of(t[2]), T::of(t[3])),
+        WallGeom::Mesh { pose, .. } => pose.turn = Some([t[1], t[2], t[3], t[4]].map(T::of)),
+        _ => {}
     }
 }

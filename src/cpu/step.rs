@@ -63,7 +63,7 @@ impl<T: Real> CpuEngine<T> {
         }
         if let Some(q) = &mut self.orientation {
             let body = &self.body;
-            q.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, q)| *q = integrate::rotate(*q, body[i].omega, tau));
+            q.par_iter_mut().with_min_len(PAR_MIN_ITEMS).enumerate().for_each(|(i, q)| *q = crate::turn::rotate(*q, body[i].omega, tau));
         }
         if let Some(p) = self.piston {
             let wall = &mut self.walls[p.wall];

@@ -92,11 +92,11 @@ pub fn wall_contacts<T: Real>(
             h_slot.fill(T::ZERO);
             continue;
         }
-        if let WallGeom::Mesh { mesh, shift } = wall.geom {
-            let touched = mesh_contacts(b, residual, p, material, wall, &ctx.meshes[mesh as usize], shift, ctx, h_slot, |_, geo, c, f| {
+        if let WallGeom::Mesh { mesh, pose } = wall.geom {
+            let touched = mesh_contacts(b, residual, p, material, wall, &ctx.meshes[mesh as usize], &pose, ctx, h_slot, |n, dist, geo, c, f| {
                 load.force += f.f_i;
                 load.torque += f.t_i;
-                touches.push(WallTouch::touching(id, w, f, ctx, c, geo, T::ZERO));
+                touches.push(WallTouch::touching(id, w, f, ctx, c, geo, wall.spin_power(f.f_i, b.pos - n * dist)));
             });
             if !touched {
                 *overflow = Some(id);
@@ -117,7 +117,7 @@ pub fn wall_contacts<T: Real>(
             continue;
         }
         let (geo, c, f) = wall_contact(n, dist, b, p, material, wall, ctx, h_slot);
-        let power = if wall.spin == Vec3::ZERO { T::ZERO } else { f.f_i.dot(wall.velocity_at(b.pos - n * dist) - wall.velocity) };
+        let power = wall.spin_power(f.f_i, b.pos - n * dist);
         load.force += f.f_i;
         load.torque += f.t_i;
         touches.push(WallTouch::touching(id, w, &f, ctx, c, &geo, power));

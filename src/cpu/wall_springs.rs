@@ -17,6 +17,24 @@ use crate::real::{Real, Vec3};
 use crate::mesh::MeshSurface;
 use crate::walls::WallGeom;
 
+/// How far from `wall`'s pivot ([`WallGeom::pivot`]) a point whose distance to it matters
+/// lies (m), for a wall that turns ([`WallGeom::moved_since`]): a mesh's farthest corner, or
+/// the farthest grain in play (kept at `built_at`, moving less than the skin before the next
+/// choice, which dwarfs the kept position's rounding); 0 for a wall that does not turn.
+fn reach<T: Real>(wall: &WallState<T>, meshes: &[MeshSurface<T>], built_at: &[Vec3<f32>], prop: &[Props<T>], skin: T) -> T {
+    if !wall.turns {
+        return T::ZERO;
+    }
+    let farthest = |points: &mut dyn Iterator<Item = Vec3<T>>, from: Vec3<T>| points.map(|x| (x - from).norm()).fold(T::ZERO, T::max);
+    match wall.geom {
+        WallGeom::Mesh { mesh, pose } => farthest(&mut meshes[mesh as usize].vertices.iter().copied(), pose.pivot),
+        geom => {
+            let mut grains = built_at.iter().zip(prop).filter(|(_, p)| p.in_play()).map(|(&at, _)| super::built_at::widen::<T>(at));
+            farthest(&mut grains, geom.pivot()) + skin
+        }
+    }
+}
+
 /// One word of candidate bits per run of slots.
 const _: () = assert!(ALIGN == u64::BITS as usize);
 
@@ -33,6 +51,11 @@ pub struct WallSprings<T> {
     pub springs: Vec<T>,
     /// The walls' surfaces when the candidates were chosen.
     chosen_at: Vec<WallGeom<T>>,
+    /// How far from its pivot a point that matters to each wall could lie then (m; 0 for a
+    /// wall that does not turn, [`reach`]).
+    reach: Vec<T>,
+    /// Set when a wall started turning since the choice ([`Self::expire`]).
+    expired: bool,
 }
 
 /// True when slot `m` (counted from a multiple of [`ALIGN`]) is a candidate in `words`, the
@@ -74,9 +97,9 @@ impl<T: Real> Builder<T> {
         }
     }
 
-    fn finish(mut self, chosen_at: Vec<WallGeom<T>>) -> WallSprings<T> {
+    fn finish(mut self, chosen_at: Vec<WallGeom<T>>, reach: Vec<T>) -> WallSprings<T> {
         self.run_start.push(self.count);
-        WallSprings { candidate: self.candidate, run_start: self.run_start, springs: self.springs, chosen_at }
+        WallSprings { candidate: self.candidate, run_start: self.run_start, springs: self.springs, chosen_at, reach, expired: false }
     }
 }
 
@@ -97,7 +120,8 @@ impl<T: Real> WallSprings<T> {
             let near = p.in_play() && WallGeom::any_within(walls.iter().map(|w| &w.geom), meshes, x, p.radius + skin + rounding);
             b.push(s, near.then(|| old.springs_of(s, per_grain).unwrap_or(&zeros)));
         }
-        b.finish(walls.iter().map(|w| w.geom).collect())
+        let reach = walls.iter().map(|w| reach(w, meshes, built_at, prop, skin)).collect();
+        b.finish(walls.iter().map(|w| w.geom).collect(), reach)
     }
 
     /// The same candidates and springs in new slots: new slot `s` is old slot `from[s]`.
@@ -109,7 +133,7 @@ impl<T: Real> WallSprings<T> {
         for (s, &o) in from.iter().enumerate() {
             b.push(s, self.springs_of(o as usize, per_grain));
         }
-        b.finish(self.chosen_at.clone())
+        b.finish(self.chosen_at.clone(), self.reach.clone())
     }
 
     /// Slot `s`'s entry, where it is a candidate.
@@ -127,8 +151,17 @@ impl<T: Real> WallSprings<T> {
     /// True when a wall has moved half the skin or more since the candidates were chosen, so
     /// that they must be chosen again before the walls' next contacts.
     pub fn stale(&self, walls: &[WallState<T>], skin: T) -> bool {
+        if self.expired {
+            return true;
+        }
         let half = skin * T::of(0.5);
-        walls.iter().zip(&self.chosen_at).any(|(w, &before)| !(w.geom.moved_since(&before) < half))
+        walls.iter().zip(&self.chosen_at).zip(&self.reach).any(|((w, &before), &reach)| !(w.geom.moved_since(&before, reach) < half))
+    }
+
+    /// Marks the choice [`Self::stale`]: a wall has started turning, and the reach its
+    /// turns need ([`reach`]) was not measured when the candidates were chosen.
+    pub fn expire(&mut self) {
+        self.expired = true;
     }
 
     /// Every grain's springs, `per_grain` reals each (zeros where a grain has no entry): the
@@ -152,7 +185,7 @@ impl<T: Real> WallSprings<T> {
         for s in 0..built_at.len() {
             every.push(s, dense.get(s * per_grain..(s + 1) * per_grain));
         }
-        Self::choose(built_at, prop, walls, meshes, skin, per_grain, &every.finish(Vec::new()))
+        Self::choose(built_at, prop, walls, meshes, skin, per_grain, &every.finish(Vec::new(), Vec::new()))
     }
 
     /// The first entry at or after `slot`, a multiple of [`ALIGN`] or the number of grains

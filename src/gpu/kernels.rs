@@ -146,6 +146,7 @@ pub fn shared(name: &str) -> &'static str {
         "model/twisting" => include_str!("../../shaders/shared/model/twisting.wgsl"),
         "model/cohesion" => include_str!("../../shaders/shared/model/cohesion.wgsl"),
         "neighbours" => include_str!("../../shaders/shared/neighbours.wgsl"),
+        "turn" => include_str!("../../shaders/shared/turn.wgsl"),
         "walls" => include_str!("../../shaders/shared/walls.wgsl"),
         "mesh" => include_str!("../../shaders/shared/mesh.wgsl"),
         "reduce" => include_str!("../../shaders/shared/reduce.wgsl"),
@@ -195,15 +196,15 @@ impl Kernel {
 use Access::{Phase, Read, ReadWrite, Uniform, Write};
 
 const BASE: &[&str] = &["types", "dispatch"];
-const PISTON: &[&str] = &["types", "dispatch", "piston"];
-const INTEGRATE: &[&str] = &["types", "dispatch", "kick", "piston", "position", "drift"];
+const PISTON: &[&str] = &["types", "dispatch", "turn", "piston"];
+const INTEGRATE: &[&str] = &["types", "dispatch", "kick", "turn", "piston", "position", "drift"];
 const GRID: &[&str] = &["types", "dispatch", "position", "grid"];
 const DETECT: &[&str] = &["types", "dispatch", "position", "grid", "neighbours"];
 const FORCES: &[&str] = &["types", "dispatch", "position", "grid", "model"];
-const GATHER: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "mesh", "kick", "drift"];
+const GATHER: &[&str] = &["types", "dispatch", "position", "grid", "model", "turn", "walls", "mesh", "kick", "drift"];
 const CD: &[&str] = &["types", "dispatch", "cd"];
-const STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "reduce"];
-const GRAIN_STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "walls", "mesh", "reduce"];
+const STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "turn", "walls", "reduce"];
+const GRAIN_STATS: &[&str] = &["types", "dispatch", "position", "grid", "model", "turn", "walls", "mesh", "reduce"];
 
 macro_rules! kernel {
     ($name:literal, $inc:expr, [$($b:ident: $a:expr),* $(,)?]) => {

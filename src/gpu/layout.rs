@@ -163,6 +163,9 @@ pub mod wall_flags {
     pub const DRIVEN: u32 = 1;
     /// A stage has taken it away: it touches no grain.
     pub const ABSENT: u32 = 2;
+    /// Its spin turns it (a plane's normal, a mesh's `turn`): set by the first drive that
+    /// turns it ([`crate::walls::turns_with`]), and kept.
+    pub const TURNS: u32 = 4;
 }
 
 /// A wall (WGSL `Wall`), of kind [`wall_kind`].
@@ -181,13 +184,17 @@ pub struct Wall {
     pub hist_at: u32,
     /// Plane point; cylinder axis (x, y); piston (0, 0, z); a mesh's shift (m).
     pub point: Vec4,
-    /// Plane unit normal; cylinder w = radius; a mesh's index in `meshes` in x's bits.
+    /// Plane unit normal; cylinder w = radius; a mesh's index in `meshes` in x's bits and the
+    /// point it turns about, where the scene put it, in y, z, w (m).
     pub normal: Vec4,
     /// Velocity (m/s).
     pub velocity: Vec4,
     /// Piston: mass (kg), area (m^2), target pressure (Pa), external work (J); other walls:
-    /// angular velocity (rad/s) about the axis through the centre, work on the grains (J).
+    /// angular velocity (rad/s) about the axis through the pivot, work on the grains (J).
     pub drive: Vec4,
+    /// A turning mesh's rotation from where the scene put it ([`crate::turn`], scalar first);
+    /// the identity for every other wall.
+    pub turn: Vec4,
 }
 
 /// The servo box's control state (WGSL `Servo`).

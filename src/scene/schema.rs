@@ -499,7 +499,8 @@ pub struct StageSpec {
 pub struct WallDriveSpec {
     /// Velocity (m/s). Default 0.
     pub velocity: Option<DVec3>,
-    /// Angular velocity (rad/s) about the wall's axis of symmetry. Default 0.
+    /// Angular velocity (rad/s): a plane's about the axis through its point, a cylinder's
+    /// about its own axis, a mesh's about the axis through its `center`. Default 0.
     pub angular_velocity: Option<DVec3>,
 }
 

@@ -138,6 +138,8 @@ pub enum WallShape {
         mesh: std::sync::Arc<crate::mesh::TriMesh>,
         /// Its rank among the scene's mesh walls (the engines' mesh tables).
         index: u32,
+        /// The point (m) it turns about, where the scene puts it.
+        pivot: DVec3,
     },
     /// Horizontal plate facing down, driven by a target pressure.
     Piston {
@@ -188,15 +190,18 @@ pub struct Wall {
 }
 
 /// A wall's prescribed motion: it translates at `velocity` and spins at `angular_velocity`
-/// about its own axis of symmetry (a plane about its normal through its point, a cylinder
-/// about its axis), so that its surface stays where the translation takes it while each point
-/// of it moves at `velocity + angular_velocity x (x - centre)`.
+/// about an axis through its pivot (a plane's point, a cylinder's axis, a mesh's `center`),
+/// each point of it moving at `velocity + angular_velocity x (x - pivot)`. A spin along a
+/// plane's normal or a cylinder's axis leaves the surface in place; a plane's about another
+/// axis, and a mesh's, turn it ([`crate::walls::turns_with`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct WallDrive {
     /// Velocity (m/s).
     pub velocity: DVec3,
     /// Angular velocity (rad/s).
     pub angular_velocity: DVec3,
+    /// Whether the spin turns the surface ([`crate::walls::turns_with`]).
+    pub turns: bool,
 }
 
 impl WallDrive {

@@ -20,8 +20,9 @@ pub enum WallSpec {
         normal: DVec3,
         /// Prescribed velocity (m/s). Default 0.
         velocity: Option<DVec3>,
-        /// Prescribed angular velocity (rad/s), along the normal: the plane spins about the
-        /// normal through `point` (a turntable). Default 0.
+        /// Prescribed angular velocity (rad/s) about the axis through `point`: along the normal
+        /// the plane spins in place (a turntable); any other way it turns (a tilting floor, a
+        /// gate swinging about a hinge through `point`). Default 0.
         angular_velocity: Option<DVec3>,
     },
     /// Five or six planes bounding an axis-aligned box; grains live inside.
@@ -74,6 +75,12 @@ pub enum WallSpec {
         offset: Option<DVec3>,
         /// Prescribed velocity (m/s). Default 0.
         velocity: Option<DVec3>,
+        /// Prescribed angular velocity (rad/s): the mesh turns about the axis through `center`
+        /// (a mixer's blade, a tumbling drum). Default 0.
+        angular_velocity: Option<DVec3>,
+        /// The point (m) the mesh turns about, carried along by its velocity. Default `offset`
+        /// (where the file's origin is placed).
+        center: Option<DVec3>,
     },
     /// Six planes bounding a box, each moved along its normal by a servo that holds a target
     /// pressure: wall speed = gain x (target - measured pressure), capped at `max_speed`

@@ -47,8 +47,9 @@ pub(super) fn validate_walls(
                     return Err(c.invalid(key("normal"), format!("{:?}", normal.to_array()), "is the zero vector", "give the direction into the domain, e.g. [0, 0, 1]"));
                 }
                 let normal = DVec3::new(normal[0] / len, normal[1] / len, normal[2] / len);
-                let drive = drive_of(c, &format!("wall[{i}]"), *velocity, *angular_velocity, normal, "the plane's normal")?;
-                out.push(driven(name, WallShape::Plane { point, normal }, m, drive));
+                let shape = WallShape::Plane { point, normal };
+                let drive = turning(drive_of(c, &format!("wall[{i}]"), *velocity, *angular_velocity, SpinRule::AnyAxis)?, &shape);
+                out.push(driven(name, shape, m, drive));
             }
             WallSpec::Box { material, min, max, open_top, velocity, .. } => {
                 let m = material_of(key("material"), material)?;
@@ -68,7 +69,7 @@ pub(super) fn validate_walls(
                     if *open_top && face == "top" {
                         continue;
                     }
-                    let drive = drive_of(c, &format!("wall[{i}]"), *velocity, None, normal, "")?;
+                    let drive = drive_of(c, &format!("wall[{i}]"), *velocity, None, SpinRule::Refused)?;
                     out.push(driven(format!("{name}.{face}"), WallShape::Plane { point, normal }, m, drive));
                 }
             }
@@ -101,10 +102,10 @@ pub(super) fn validate_walls(
             WallSpec::Cylinder { material, center, radius, velocity, angular_velocity, .. } => {
                 let m = material_of(key("material"), material)?;
                 let radius = positive(c, &key("radius"), *radius, "give the radius in metres")?;
-                let drive = drive_of(c, &format!("wall[{i}]"), *velocity, *angular_velocity, DVec3::Z, "the cylinder's axis (z)")?;
+                let drive = drive_of(c, &format!("wall[{i}]"), *velocity, *angular_velocity, SpinRule::Along(DVec3::Z, "the cylinder's axis (z)"))?;
                 out.push(driven(name, WallShape::Cylinder { center: *center, radius }, m, drive));
             }
-            WallSpec::Mesh { material, file, scale, rotation, offset, velocity, .. } => {
+            WallSpec::Mesh { material, file, scale, rotation, offset, velocity, angular_velocity, center, .. } => {
                 let m = material_of(key("material"), material)?;
                 let scale = positive(c, &key("scale"), scale.unwrap_or(1.0), "give the factor from the file's units to metres, e.g. 0.001 for millimetres")?;
                 let rotation_deg = finite3(c, &key("rotation"), rotation.unwrap_or_default())?;
@@ -112,9 +113,11 @@ pub(super) fn validate_walls(
                 let path = c.file.parent().unwrap_or(std::path::Path::new("")).join(file);
                 let mesh = crate::mesh::read::read_stl(&path, &crate::mesh::MeshPlacement { scale, rotation_deg, offset })
                     .map_err(|e| c.invalid(key("file"), format!("\"{file}\""), format!("{}: {}", e.file.display(), e.problem), e.fix))?;
-                let drive = drive_of(c, &format!("wall[{i}]"), *velocity, None, DVec3::Z, "")?;
+                let pivot = center.map(|p| finite3(c, &key("center"), p)).transpose()?.unwrap_or(offset);
                 let index = out.iter().filter(|p: &&PendingWall| matches!(p.wall.shape, WallShape::Mesh { .. })).count() as u32;
-                out.push(driven(name, WallShape::Mesh { mesh: std::sync::Arc::new(mesh), index }, m, drive));
+                let shape = WallShape::Mesh { mesh: std::sync::Arc::new(mesh), index, pivot };
+                let drive = turning(drive_of(c, &format!("wall[{i}]"), *velocity, *angular_velocity, SpinRule::AnyAxis)?, &shape);
+                out.push(driven(name, shape, m, drive));
             }
             WallSpec::Piston { material, z, pressure, mass, area } => {
                 let m = material_of(key("material"), material)?;
@@ -139,29 +142,47 @@ pub(super) fn validate_walls(
     Ok(out)
 }
 
-/// Largest sine of the angle between a wall's angular velocity and its axis of symmetry: a
-/// spin off the axis would turn the surface, which a wall cannot do yet.
-const SPIN_OFF_AXIS: f64 = 1e-9;
+/// Which spins a wall takes.
+#[derive(Clone, Copy)]
+pub(super) enum SpinRule {
+    /// Any axis through its pivot (a plane, a mesh).
+    AnyAxis,
+    /// Only along this axis of symmetry, named so in errors (a cylinder spins in place).
+    Along(DVec3, &'static str),
+    /// None: it only translates (a box's faces).
+    Refused,
+}
+
+/// `drive` for a wall of `shape`, marked where its spin turns it.
+fn turning(drive: WallDrive, shape: &WallShape) -> WallDrive {
+    WallDrive { turns: crate::walls::turns_with(shape, drive.angular_velocity), ..drive }
+}
 
 /// The prescribed motion given at `at` (`wall[0]`, `stage[2].walls.gate`): `velocity` and
-/// `angular_velocity` (finite; the spin along `axis`, the wall's axis of symmetry, named
-/// `axis_name` in the error; none allowed where `axis_name` is empty).
-pub(super) fn drive_of(c: &Complainer, at: &str, velocity: Option<DVec3>, angular_velocity: Option<DVec3>, axis: DVec3, axis_name: &str) -> Result<WallDrive, SceneError> {
+/// `angular_velocity` (finite; a spin as `spin` allows).
+pub(super) fn drive_of(c: &Complainer, at: &str, velocity: Option<DVec3>, angular_velocity: Option<DVec3>, spin: SpinRule) -> Result<WallDrive, SceneError> {
     let key = |k: &str| format!("{at}.{k}");
     let velocity = velocity.map(|v| finite3(c, &key("velocity"), v)).transpose()?.unwrap_or_default();
     let angular_velocity = angular_velocity.map(|w| finite3(c, &key("angular_velocity"), w)).transpose()?.unwrap_or_default();
-    if axis_name.is_empty() && angular_velocity != DVec3::ZERO {
-        return Err(c.invalid(key("angular_velocity"), format!("{:?}", angular_velocity.to_array()), "is given to a box or a mesh, which only translate", "give it a velocity only"));
+    let given = format!("{:?}", angular_velocity.to_array());
+    match spin {
+        SpinRule::AnyAxis => {}
+        SpinRule::Refused if angular_velocity != DVec3::ZERO => {
+            return Err(c.invalid(key("angular_velocity"), given, "is given to a box, which only translates", "give it a velocity only, or build the box as a mesh wall, which turns"));
+        }
+        SpinRule::Refused => {}
+        SpinRule::Along(axis, axis_name) => {
+            if angular_velocity.cross(axis).length() > crate::walls::SPIN_OFF_AXIS * angular_velocity.length() {
+                return Err(c.invalid(
+                    key("angular_velocity"),
+                    given,
+                    format!("is not along {axis_name} {:?}: the wall spins about its own axis only", axis.to_array()),
+                    format!("give a multiple of {:?} (rad/s), or a mesh wall, which turns about any axis", axis.to_array()),
+                ));
+            }
+        }
     }
-    if angular_velocity.cross(axis).length() > SPIN_OFF_AXIS * angular_velocity.length() {
-        return Err(c.invalid(
-            key("angular_velocity"),
-            format!("{:?}", angular_velocity.to_array()),
-            format!("is not along {axis_name} {:?}: the wall spins about its own axis only", axis.to_array()),
-            format!("give a multiple of {:?} (rad/s)", axis.to_array()),
-        ));
-    }
-    Ok(WallDrive { velocity, angular_velocity })
+    Ok(WallDrive { velocity, angular_velocity, turns: false })
 }
 
 /// Fills in the piston's default mass (total grain mass) and area (cross-section of the
@@ -232,7 +253,7 @@ pub fn wall_distance(shape: &WallShape, p: DVec3) -> f64 {
 /// frame has it; `shape` the scene's), positive on the grains' side.
 pub fn wall_distance_now(shape: &WallShape, geom: &crate::walls::WallGeom<f64>, p: DVec3) -> f64 {
     match (shape, geom) {
-        (WallShape::Mesh { mesh, .. }, crate::walls::WallGeom::Mesh { shift, .. }) => mesh.distance(p - shift.f64()),
+        (WallShape::Mesh { mesh, .. }, crate::walls::WallGeom::Mesh { pose, .. }) => mesh.distance(pose.local(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).f64()),
         (_, geom) => geom.frame(crate::real::Vec3::of(p), crate::real::Vec3::ZERO).1,
     }
 }
@@ -283,12 +304,12 @@ pub(super) fn stage_drives(c: &Complainer, stage: usize, specs: &std::collection
 /// (`stage[2].walls`), for errors.
 pub(super) fn drives_of(c: &Complainer, at: &str, name: &str, velocity: Option<DVec3>, angular_velocity: Option<DVec3>, walls: &[Wall], servo: Option<ServoBox>) -> Result<Vec<(usize, WallDrive)>, SceneError> {
     let found = walls_named(c, at, name, walls, servo, "set the stage's piston_pressure or servo_pressure instead")?;
-    let (axis, axis_name) = match walls[found[0]].shape {
-        WallShape::Plane { normal, .. } if found.len() == 1 => (normal, "the plane's normal"),
-        WallShape::Cylinder { .. } => (DVec3::Z, "the cylinder's axis (z)"),
-        _ => (DVec3::Z, ""),
+    let spin = match walls[found[0]].shape {
+        WallShape::Plane { .. } | WallShape::Mesh { .. } if found.len() == 1 => SpinRule::AnyAxis,
+        WallShape::Cylinder { .. } => SpinRule::Along(DVec3::Z, "the cylinder's axis (z)"),
+        _ => SpinRule::Refused,
     };
-    let drive = drive_of(c, &format!("{at}.{name}"), velocity, angular_velocity, axis, axis_name)?;
+    let drive = turning(drive_of(c, &format!("{at}.{name}"), velocity, angular_velocity, spin)?, &walls[found[0]].shape);
     Ok(found.into_iter().map(|k| (k, drive)).collect())
 }
 

@@ -7,9 +7,8 @@ use crate::engine::WallContactRecord;
 use crate::mesh::slots::{assign, mesh_reals, slot_reals, SlotUse};
 use crate::mesh::{MeshSurface, MESH_CONTACTS};
 use crate::model::{contact_force, Bodies, ContactForce, Geometry, KickWindow, Kinematics, PairCoeffs};
-use crate::position::complete;
 use crate::real::{Real, Vec3};
-use crate::walls::WallGeom;
+use crate::walls::{MeshPose, WallGeom};
 
 /// A wall as the force pass sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -18,9 +17,12 @@ pub struct WallState<T> {
     pub geom: WallGeom<T>,
     /// Velocity (m/s).
     pub velocity: Vec3<T>,
-    /// Angular velocity (rad/s) about its axis of symmetry through [`WallGeom::centre`]; zero
-    /// but for a driven wall that spins (`crate::scene::WallDrive`).
+    /// Angular velocity (rad/s) about the axis through [`WallGeom::pivot`]; zero but for a
+    /// driven wall that spins (`crate::scene::WallDrive`).
     pub spin: Vec3<T>,
+    /// Whether the spin turns the surface ([`WallGeom::turned`]): on from the first drive
+    /// that turns it ([`crate::walls::turns_with`]).
+    pub turns: bool,
     /// Material index.
     pub material: u32,
     /// False while a stage has taken the wall away: it touches no grain (and keeps moving).
@@ -29,10 +31,28 @@ pub struct WallState<T> {
 
 impl<T: Real> WallState<T> {
     /// The velocity (m/s) of the wall's surface at `x` (m): its velocity, plus `spin x (x -
-    /// centre)` where it spins.
+    /// pivot)` where it spins.
     #[inline(always)]
     pub fn velocity_at(&self, x: Vec3<T>) -> Vec3<T> {
-        if self.spin == Vec3::ZERO { self.velocity } else { self.velocity + self.spin.cross(x - self.geom.centre()) }
+        if self.spin == Vec3::ZERO { self.velocity } else { self.velocity + self.spin.cross(x - self.geom.pivot()) }
+    }
+
+    /// The power (W) of the wall's spin through a contact force `f` (N, on the grain) at `x`
+    /// (m): `f . (velocity_at(x) - velocity)`, zero where it does not spin.
+    #[inline(always)]
+    pub fn spin_power(&self, f: Vec3<T>, x: Vec3<T>) -> T {
+        if self.spin == Vec3::ZERO { T::ZERO } else { f.dot(self.velocity_at(x) - self.velocity) }
+    }
+
+    /// Takes a drive (m/s, rad/s): a spin that turns the wall turns it from now on.
+    pub fn drive(&mut self, velocity: Vec3<T>, spin: Vec3<T>, turns: bool) {
+        (self.velocity, self.spin) = (velocity, spin);
+        if turns && !self.turns {
+            self.turns = true;
+            if let WallGeom::Mesh { pose, .. } = &mut self.geom {
+                pose.turn = Some(crate::turn::identity());
+            }
+        }
     }
 }
 
@@ -43,8 +63,8 @@ pub fn wall_overlaps<T: Real>(wall: &WallState<T>, meshes: &[MeshSurface<T>], x:
     if !wall.present {
         return (out, 0);
     }
-    if let WallGeom::Mesh { mesh, shift } = wall.geom {
-        let t = meshes[mesh as usize].touching(complete(x - shift, r), radius);
+    if let WallGeom::Mesh { mesh, pose } = wall.geom {
+        let t = meshes[mesh as usize].touching(pose.local(x, r), radius);
         for (o, c) in out.iter_mut().zip(&t.contacts[..t.len]) {
             *o = radius - c.dist;
         }
@@ -85,9 +105,10 @@ pub fn walls_reals<T>(walls: &[WallState<T>], stride: usize) -> usize {
 }
 
 /// The contacts of a grain (its body `b` with position residual `residual`) with mesh wall
-/// `wall` (`surface`, moved by `shift` (m)): each one's slot in `block` ([`wall_reals`]) is
+/// `wall` (`surface`, where `pose` puts it): each one's slot in `block` ([`wall_reals`]) is
 /// chosen ([`assign`]), its history advanced and its normal kept, and `each` is given its
-/// normal, geometry, coefficients and force; slots left without a contact are cleared. False
+/// normal, the grain's distance (m) from the mesh along it, geometry, coefficients and force;
+/// slots left without a contact are cleared. False
 /// when the grain touches the mesh at more places than it has slots
 /// ([`MeshSurface::touching`]); its contacts are then not evaluated.
 #[inline(always)]
@@ -99,14 +120,17 @@ pub fn mesh_contacts<'c, T: Real>(
     material: usize,
     wall: &WallState<T>,
     surface: &MeshSurface<T>,
-    shift: Vec3<T>,
+    pose: &MeshPose<T>,
     ctx: &ForceContext<'c, T>,
     block: &mut [T],
-    mut each: impl FnMut(Vec3<T>, &Geometry<T>, &'c PairCoeffs<T>, &ContactForce<T>),
+    mut each: impl FnMut(Vec3<T>, T, &Geometry<T>, &'c PairCoeffs<T>, &ContactForce<T>),
 ) -> bool {
-    let touches = surface.touching(complete(b.pos - shift, residual), p.radius);
+    let mut touches = surface.touching(pose.local(b.pos, residual), p.radius);
     if touches.overflow {
         return false;
+    }
+    for c in &mut touches.contacts[..touches.len] {
+        c.normal = pose.world_direction(c.normal);
     }
     let (stride, size) = (ctx.slots.stride, slot_reals(ctx.slots.stride));
     let last: [Vec3<T>; MESH_CONTACTS] = std::array::from_fn(|j| {
@@ -130,7 +154,7 @@ pub fn mesh_contacts<'c, T: Real>(
         let c = touches.contacts[k];
         let (geo, coeffs, f) = wall_contact(c.normal, c.dist, b, p, material, wall, ctx, &mut slot[..stride]);
         slot[stride..].copy_from_slice(&[c.normal.x, c.normal.y, c.normal.z]);
-        each(c.normal, &geo, coeffs, &f);
+        each(c.normal, c.dist, &geo, coeffs, &f);
     }
     true
 }
@@ -152,8 +176,8 @@ pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[
                 continue;
             }
             let record = |n: Vec3<T>, geo: &Geometry<T>, f: &ContactForce<T>| WallContactRecord { grain: id[i], wall: w as u32, overlap: geo.h.f64(), normal: n.f64(), lever: geo.rp_i.f64(), force: f.f_i.f64() };
-            if let WallGeom::Mesh { mesh, shift } = wall.geom {
-                mesh_contacts(b, residual, p, ctx.material(i), wall, &ctx.meshes[mesh as usize], shift, ctx, &mut block.to_vec(), |n, geo, _, f| out.push(record(n, geo, f)));
+            if let WallGeom::Mesh { mesh, pose } = wall.geom {
+                mesh_contacts(b, residual, p, ctx.material(i), wall, &ctx.meshes[mesh as usize], &pose, ctx, &mut block.to_vec(), |n, _, geo, _, f| out.push(record(n, geo, f)));
                 continue;
             }
             let (n, dist) = wall.geom.frame(b.pos, residual);

@@ -127,6 +127,9 @@ impl<T: Real> Distributed<T> {
         if !(scene.inlets.is_empty() && scene.outlets.is_empty()) {
             anyhow::bail!("{file}: [[inlet]] and [[outlet]] run on one process so far; fix: run it without mpirun");
         }
+        if scene.walls.iter().map(|w| &w.drive).chain(scene.stages.iter().flat_map(|s| s.walls.iter().map(|(_, d)| d))).any(|d| d.turns) {
+            anyhow::bail!("{file}: walls that turn (a spin off a plane's normal) run on one process so far; fix: run it without mpirun");
+        }
         let world = SimpleCommunicator::world();
         let grid = Grid::new(scene, world.size() as usize)?;
         let mut whole = CpuEngine::<T>::new(scene)?;

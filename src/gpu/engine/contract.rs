@@ -76,6 +76,9 @@ impl Engine for GpuEngine {
         let (v, w) = (drive.velocity.as_vec3(), drive.angular_velocity.as_vec3());
         let flags = &mut self.wall_flags[wall];
         *flags = if drive.moves() { *flags | layout::wall_flags::DRIVEN } else { *flags & !layout::wall_flags::DRIVEN };
+        if drive.turns {
+            *flags |= layout::wall_flags::TURNS;
+        }
         let queue = &self.gpu.queue;
         queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, flags) as u64, bytemuck::bytes_of(flags));
         queue.write_buffer(&self.buffers[Buf::Walls], base + std::mem::offset_of!(layout::Wall, velocity) as u64, bytemuck::bytes_of(&v));

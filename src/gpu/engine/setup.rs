@@ -75,7 +75,7 @@ pub(super) fn walls_of(scene: &Scene, hist_blocks: u32) -> (Vec<layout::Wall>, O
         .iter()
         .enumerate()
         .map(|(w, wall)| {
-            let mut g = layout::Wall { material: wall.material as u32, hist_at, ..Default::default() };
+            let mut g = layout::Wall { material: wall.material as u32, hist_at, turn: Vec4::X, ..Default::default() };
             hist_at += hist_blocks;
             match &wall.shape {
                 &WallShape::Plane { point, normal } => {
@@ -88,9 +88,9 @@ pub(super) fn walls_of(scene: &Scene, hist_blocks: u32) -> (Vec<layout::Wall>, O
                     g.point = Vec4::new(center[0] as f32, center[1] as f32, 0.0, 0.0);
                     g.normal = Vec4::new(0.0, 0.0, 0.0, radius as f32);
                 }
-                WallShape::Mesh { index, .. } => {
+                WallShape::Mesh { index, pivot, .. } => {
                     g.kind = layout::wall_kind::MESH;
-                    g.normal = Vec4::new(f32::from_bits(*index), 0.0, 0.0, 0.0);
+                    g.normal = Vec4::new(f32::from_bits(*index), pivot[0] as f32, pivot[1] as f32, pivot[2] as f32);
                     hist_at += crate::mesh::MESH_CONTACTS as u32 * (hist_blocks + 1) - hist_blocks;
                 }
                 &WallShape::Piston { z, pressure, mass, area } => {
@@ -105,6 +105,9 @@ pub(super) fn walls_of(scene: &Scene, hist_blocks: u32) -> (Vec<layout::Wall>, O
                 g.flags |= layout::wall_flags::DRIVEN; // as `set_wall_drive` sets it
                 g.velocity = Vec4::new(v[0] as f32, v[1] as f32, v[2] as f32, 0.0);
                 g.drive = Vec4::new(w[0] as f32, w[1] as f32, w[2] as f32, 0.0);
+                if wall.drive.turns {
+                    g.flags |= layout::wall_flags::TURNS;
+                }
             }
             if !wall.present {
                 g.flags |= layout::wall_flags::ABSENT;

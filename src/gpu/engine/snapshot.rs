@@ -45,13 +45,27 @@ fn cpu_history(blocks: &[[f32; 4]], slots: &crate::state::HistorySlots) -> Vec<f
     out
 }
 
+/// A checkpoint's walls buffer (`bytes`, `n` walls) in today's layout: one written before
+/// walls could turn lacks each wall's `turn`, which is then the identity.
+fn walls_turning(bytes: Vec<u8>, n: usize) -> Vec<u8> {
+    let before = std::mem::offset_of!(layout::Wall, turn);
+    if bytes.len() != n * before {
+        return bytes;
+    }
+    let identity = glam::Vec4::X;
+    bytes.chunks_exact(before).flat_map(|w| w.iter().copied().chain(bytemuck::bytes_of(&identity).iter().copied())).collect()
+}
+
 /// A wall's surface as the GPU holds it.
 fn wall_geom(w: &layout::Wall) -> crate::walls::WallGeom<f32> {
     let v3 = |a: glam::Vec4| crate::real::Vec3::new(a.x, a.y, a.z);
     match w.kind {
         layout::wall_kind::PLANE => crate::walls::WallGeom::Plane { point: v3(w.point), normal: v3(w.normal) },
         layout::wall_kind::CYLINDER => crate::walls::WallGeom::Cylinder { cx: w.point[0], cy: w.point[1], radius: w.normal[3] },
-        layout::wall_kind::MESH => crate::walls::WallGeom::Mesh { mesh: w.normal[0].to_bits(), shift: v3(w.point) },
+        layout::wall_kind::MESH => {
+            let turn = (w.flags & layout::wall_flags::TURNS != 0).then_some(w.turn.to_array());
+            crate::walls::WallGeom::Mesh { mesh: w.normal[0].to_bits(), pose: crate::walls::MeshPose { shift: v3(w.point), pivot: crate::real::Vec3::new(w.normal.y, w.normal.z, w.normal.w), turn } }
+        }
         _ => crate::walls::WallGeom::Piston { z: w.point[2] },
     }
 }
@@ -107,6 +121,7 @@ impl GpuEngine {
                 spin: if w.flags & layout::wall_flags::DRIVEN != 0 { Vec3::new(w.drive.x, w.drive.y, w.drive.z) } else { Vec3::ZERO },
                 material: w.material,
                 present: w.flags & layout::wall_flags::ABSENT == 0,
+                turns: w.flags & layout::wall_flags::TURNS != 0,
             })
             .collect();
         let slots = HistorySlots::new(self.history);
@@ -272,7 +287,10 @@ impl GpuEngine {
         for (key, words) in &s.ints {
             let Some(name) = key.strip_prefix("gpu:") else { continue };
             let buffer = Buf::of_name(name).and_then(|b| self.buffers.get(b)).ok_or_else(|| anyhow::anyhow!("the checkpoint holds a GPU buffer `{name}` this engine lacks; fix: resume with the grains version that wrote it"))?;
-            let bytes: Vec<u8> = words.iter().flat_map(|&w| w.to_le_bytes()).collect();
+            let mut bytes: Vec<u8> = words.iter().flat_map(|&w| w.to_le_bytes()).collect();
+            if name == Buf::Walls.name() {
+                bytes = walls_turning(bytes, self.wall_flags.len().max(1));
+            }
             // A list of an odd number of words was padded with one (beyond the live pairs).
             if bytes.len() as u64 > buffer.size() + 4 {
                 anyhow::bail!("the checkpoint's GPU buffer `{name}` holds {} bytes, this scene's {}; fix: resume with the scene the checkpoint was written for", bytes.len(), buffer.size());
@@ -290,5 +308,24 @@ impl GpuEngine {
         self.marks_base = self.read_control()?.rebuild_checks;
         self.read_in_play()?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A walls buffer written before walls could turn (each wall's bytes up to `turn`) comes
+    /// back whole, each wall's rotation the identity; one of today's is kept as it is.
+    #[test]
+    fn old_walls_buffers_gain_the_identity_rotation() {
+        let walls: Vec<layout::Wall> = (0..3u32)
+            .map(|k| layout::Wall { kind: k, material: k + 1, flags: 1, hist_at: 4 * k, point: glam::Vec4::splat(k as f32), normal: glam::Vec4::Z, velocity: glam::Vec4::W, drive: glam::Vec4::ONE, turn: glam::Vec4::X })
+            .collect();
+        let now: Vec<u8> = bytemuck::cast_slice(&walls).to_vec();
+        let before = std::mem::offset_of!(layout::Wall, turn);
+        let old: Vec<u8> = now.chunks_exact(std::mem::size_of::<layout::Wall>()).flat_map(|w| w[..before].to_vec()).collect();
+        assert_eq!(walls_turning(old, 3), now);
+        assert_eq!(walls_turning(now.clone(), 3), now);
     }
 }

@@ -45,9 +45,9 @@ pub fn domain(scene: &Scene, f: &Frame) -> ([f64; 3], [f64; 3]) {
                 include(1, cy + radius);
             }
             WallGeom::Piston { z } => include(2, z),
-            WallGeom::Mesh { mesh, shift } => {
+            WallGeom::Mesh { mesh, pose } => {
                 for v in &mesh_of(scene, mesh).vertices {
-                    for (a, x) in (*v + shift.f64()).to_array().into_iter().enumerate() {
+                    for (a, x) in pose.world_point(crate::real::Vec3::of(*v)).f64().to_array().into_iter().enumerate() {
                         include(a, x);
                     }
                 }
@@ -63,7 +63,7 @@ fn mesh_of(scene: &Scene, index: u32) -> &crate::mesh::TriMesh {
         .walls
         .iter()
         .find_map(|w| match &w.shape {
-            crate::scene::WallShape::Mesh { mesh, index: i } if *i == index => Some(&**mesh),
+            crate::scene::WallShape::Mesh { mesh, index: i, .. } if *i == index => Some(&**mesh),
             _ => None,
         })
         .expect("a frame's mesh walls are its scene's")
@@ -98,10 +98,10 @@ pub fn piece(scene: &Scene, f: &Frame) -> PolyData {
                 Some((cx, cy, radius)) => polygon(&mut piece, circle(cx, cy, radius).map(|(x, y)| [x, y, z]).collect(), w),
                 None => polygon(&mut piece, vec![[lo[0], lo[1], z], [hi[0], lo[1], z], [hi[0], hi[1], z], [lo[0], hi[1], z]], w),
             },
-            WallGeom::Mesh { mesh, shift } => {
+            WallGeom::Mesh { mesh, pose } => {
                 let m = mesh_of(scene, mesh);
                 for t in 0..m.triangles.len() {
-                    polygon(&mut piece, m.corners(t).map(|v| (v + shift.f64()).to_array()).to_vec(), w);
+                    polygon(&mut piece, m.corners(t).map(|v| pose.world_point(crate::real::Vec3::of(v)).f64().to_array()).to_vec(), w);
                 }
             }
             WallGeom::Cylinder { cx, cy, radius } => {
