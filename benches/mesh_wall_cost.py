@@ -1,11 +1,12 @@
 """What a mesh wall costs against a plane (docs/performance.md, "Mesh walls").
 
 A bed of 2,000 beads of 2 mm settled in a 30 mm box on a floor that is a plane, a mesh of two
-triangles, or a mesh of 450 triangles (2 mm squares, as fine as the beads), the walls around
-planes: each floor's bed, once settled, is advanced in interleaved rounds, and the time above
-the plane's, per bead-step of a bead touching the floor, is the mesh's cost (the medians of
-the rounds). The beads near the floor that do not touch it pay their look-up too, and are in
-the figure.
+triangles, or a mesh of 450 triangles (2 mm squares, as fine as the beads), still or turning
+at 1 rad/s about the vertical through the box's middle (a turntable: the surface stays in
+place, the turning mesh's arithmetic runs), the walls around planes: each floor's bed, once
+settled, is advanced in interleaved rounds, and the time above the plane's, per bead-step of
+a bead touching the floor, is the mesh's cost (the medians of the rounds). The beads near the
+floor that do not touch it pay their look-up too, and are in the figure.
 
     python benches/mesh_wall_cost.py [--steps 2000] [--rounds 5] [--threads N]
 """
@@ -89,11 +90,15 @@ def main() -> None:
         for n in (1, 15):
             make.write_stl(dir / f"floor_{n}.stl", "floor", square(n))
             floors[f"mesh of {2 * n * n} triangles"] = f'[[wall]]\ntype = "mesh"\nmaterial = "glass"\nfile = "floor_{n}.stl"\nscale = 0.001'
+        # Settled still, then set turning.
+        floors["mesh of 450 triangles, turning"] = floors["mesh of 450 triangles"] + '\nname = "floor"\ncenter = [0.015, 0.015, 0.0]'
         sims = {}
         for name, floor in floors.items():
             scene = grains.Scene.from_toml(SCENE.format(floor=floor), path=dir / "bed.toml")
             sims[name] = grains.Simulation(scene, threads=args.threads)
             sims[name].run_stage()
+            if name.endswith("turning"):
+                sims[name].set_wall_motion("floor", angular_velocity=(0.0, 0.0, 1.0))
         times = {name: [] for name in sims}
         for _ in range(args.rounds):
             for name, sim in sims.items():

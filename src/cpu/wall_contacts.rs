@@ -93,10 +93,10 @@ pub fn wall_contacts<T: Real>(
             continue;
         }
         if let WallGeom::Mesh { mesh, pose } = wall.geom {
-            let touched = mesh_contacts(b, residual, p, material, wall, &ctx.meshes[mesh as usize], &pose, ctx, h_slot, |n, dist, geo, c, f| {
+            let touched = mesh_contacts(b, residual, p, material, wall, &ctx.meshes[mesh as usize], &pose, ctx, h_slot, |_, geo, c, f, power| {
                 load.force += f.f_i;
                 load.torque += f.t_i;
-                touches.push(WallTouch::touching(id, w, f, ctx, c, geo, wall.spin_power(f.f_i, b.pos - n * dist)));
+                touches.push(WallTouch::touching(id, w, f, ctx, c, geo, power));
             });
             if !touched {
                 *overflow = Some(id);
@@ -116,8 +116,7 @@ pub fn wall_contacts<T: Real>(
             }
             continue;
         }
-        let (geo, c, f) = wall_contact(n, dist, b, p, material, wall, ctx, h_slot);
-        let power = wall.spin_power(f.f_i, b.pos - n * dist);
+        let (geo, c, f, power) = wall_contact(n, dist, b, p, material, wall, ctx, h_slot);
         load.force += f.f_i;
         load.torque += f.t_i;
         touches.push(WallTouch::touching(id, w, &f, ctx, c, &geo, power));

@@ -37,13 +37,6 @@ impl<T: Real> WallState<T> {
         if self.spin == Vec3::ZERO { self.velocity } else { self.velocity + self.spin.cross(x - self.geom.pivot()) }
     }
 
-    /// The power (W) of the wall's spin through a contact force `f` (N, on the grain) at `x`
-    /// (m): `f . (velocity_at(x) - velocity)`, zero where it does not spin.
-    #[inline(always)]
-    pub fn spin_power(&self, f: Vec3<T>, x: Vec3<T>) -> T {
-        if self.spin == Vec3::ZERO { T::ZERO } else { f.dot(self.velocity_at(x) - self.velocity) }
-    }
-
     /// Takes a drive (m/s, rad/s): a spin that turns the wall turns it from now on.
     pub fn drive(&mut self, velocity: Vec3<T>, spin: Vec3<T>, turns: bool) {
         (self.velocity, self.spin) = (velocity, spin);
@@ -75,12 +68,14 @@ pub fn wall_overlaps<T: Real>(wall: &WallState<T>, meshes: &[MeshSurface<T>], x:
 }
 
 /// The contact of a grain of material `material` with a wall it touches, seen from the wall's
-/// frame (`n`, `dist`: [`WallGeom::frame`]): its geometry, coefficients and force; the history
-/// in `h_slot` advances by `ctx.elapsed`. The wall moves at its surface velocity where the
-/// grain's centre projects onto it ([`WallState::velocity_at`]) and turns at its spin.
+/// frame (`n`, `dist`: [`WallGeom::frame`]): its geometry, coefficients, force, and the power
+/// (W) of the wall's spin through it (`f . (surface - velocity)`, zero where it does not
+/// spin); the history in `h_slot` advances by `ctx.elapsed`. The wall moves at its surface
+/// velocity where the grain's centre projects onto it ([`WallState::velocity_at`]) and turns
+/// at its spin.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, material: usize, wall: &WallState<T>, ctx: &ForceContext<'c, T>, h_slot: &mut [T]) -> (Geometry<T>, &'c PairCoeffs<T>, ContactForce<T>) {
+pub fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>, material: usize, wall: &WallState<T>, ctx: &ForceContext<'c, T>, h_slot: &mut [T]) -> (Geometry<T>, &'c PairCoeffs<T>, ContactForce<T>, T) {
     let geo = Geometry::grain_wall(n, dist, p.radius, p.mass);
     // The wall's surface velocity where the grain's centre projects onto it.
     let kin = Kinematics { v_i: b.vel, v_j: wall.velocity_at(b.pos - n * dist), w_i: b.omega, w_j: wall.spin };
@@ -89,7 +84,8 @@ pub fn wall_contact<'c, T: Real>(n: Vec3<T>, dist: T, b: &Body<T>, p: &Props<T>,
     let mut h = ctx.slots.load(h_slot);
     let f = contact_force(ctx.model, c, &geo, &kin, &bodies, &mut h, ctx.elapsed, KickWindow::centred(ctx.window));
     ctx.slots.store(&h, h_slot);
-    (geo, c, f)
+    let power = if wall.spin == Vec3::ZERO { T::ZERO } else { f.f_i.dot(kin.v_j - wall.velocity) };
+    (geo, c, f, power)
 }
 
 /// Reals of wall history a grain keeps for `wall`: `stride` for a wall of one contact,
@@ -107,8 +103,8 @@ pub fn walls_reals<T>(walls: &[WallState<T>], stride: usize) -> usize {
 /// The contacts of a grain (its body `b` with position residual `residual`) with mesh wall
 /// `wall` (`surface`, where `pose` puts it): each one's slot in `block` ([`wall_reals`]) is
 /// chosen ([`assign`]), its history advanced and its normal kept, and `each` is given its
-/// normal, the grain's distance (m) from the mesh along it, geometry, coefficients and force;
-/// slots left without a contact are cleared. False
+/// normal, geometry, coefficients, force and spin's power ([`wall_contact`]); slots left
+/// without a contact are cleared. False
 /// when the grain touches the mesh at more places than it has slots
 /// ([`MeshSurface::touching`]); its contacts are then not evaluated.
 #[inline(always)]
@@ -123,7 +119,7 @@ pub fn mesh_contacts<'c, T: Real>(
     pose: &MeshPose<T>,
     ctx: &ForceContext<'c, T>,
     block: &mut [T],
-    mut each: impl FnMut(Vec3<T>, T, &Geometry<T>, &'c PairCoeffs<T>, &ContactForce<T>),
+    mut each: impl FnMut(Vec3<T>, &Geometry<T>, &'c PairCoeffs<T>, &ContactForce<T>, T),
 ) -> bool {
     let mut touches = surface.touching(pose.local(b.pos, residual), p.radius);
     if touches.overflow {
@@ -152,9 +148,9 @@ pub fn mesh_contacts<'c, T: Real>(
             SlotUse::Carried(k) => k,
         };
         let c = touches.contacts[k];
-        let (geo, coeffs, f) = wall_contact(c.normal, c.dist, b, p, material, wall, ctx, &mut slot[..stride]);
+        let (geo, coeffs, f, power) = wall_contact(c.normal, c.dist, b, p, material, wall, ctx, &mut slot[..stride]);
         slot[stride..].copy_from_slice(&[c.normal.x, c.normal.y, c.normal.z]);
-        each(c.normal, c.dist, &geo, coeffs, &f);
+        each(c.normal, &geo, coeffs, &f, power);
     }
     true
 }
@@ -177,14 +173,14 @@ pub fn wall_contact_records<T: Real>(body: &[Body<T>], prop: &[Props<T>], id: &[
             }
             let record = |n: Vec3<T>, geo: &Geometry<T>, f: &ContactForce<T>| WallContactRecord { grain: id[i], wall: w as u32, overlap: geo.h.f64(), normal: n.f64(), lever: geo.rp_i.f64(), force: f.f_i.f64() };
             if let WallGeom::Mesh { mesh, pose } = wall.geom {
-                mesh_contacts(b, residual, p, ctx.material(i), wall, &ctx.meshes[mesh as usize], &pose, ctx, &mut block.to_vec(), |n, _, geo, _, f| out.push(record(n, geo, f)));
+                mesh_contacts(b, residual, p, ctx.material(i), wall, &ctx.meshes[mesh as usize], &pose, ctx, &mut block.to_vec(), |n, geo, _, f, _| out.push(record(n, geo, f)));
                 continue;
             }
             let (n, dist) = wall.geom.frame(b.pos, residual);
             if dist >= p.radius {
                 continue;
             }
-            let (geo, _, f) = wall_contact(n, dist, b, p, ctx.material(i), wall, ctx, &mut block.to_vec());
+            let (geo, _, f, _) = wall_contact(n, dist, b, p, ctx.material(i), wall, ctx, &mut block.to_vec());
             out.push(record(n, &geo, &f));
         }
     }
