@@ -17,8 +17,12 @@ Mellmann (2001, Powder Technol. 118, 251) gives the regimes' ranges of Fr: slump
 (for a bed that does not slip on the wall). Writes drum.csv and, where matplotlib is
 installed, drum.png.
 
+With --facets N the drum is a triangle mesh instead, a tube of N facets whose middles touch
+the cylinder, turning about its axis (the mesh itself turns; the cylinder wall spins in place):
+the turning mesh's check against the analytic wall.
+
     python examples/drum.py [--out DIR] [--threads N] [--froude 0.001,0.01,0.1,0.3,1,1.5,2,3]
-                            [--turn 2.0] [--measure 1.0]
+                            [--turn 2.0] [--measure 1.0] [--facets N]
 
 About 10 minutes on two cores for the default Froude numbers.
 """
@@ -27,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import importlib.util
 import math
 from pathlib import Path
 
@@ -72,13 +77,37 @@ def reading(s: dict) -> tuple[float, float, float, float]:
     return surface_angle(p, r), math.degrees(math.atan2(cm[0], -cm[1])), float(np.hypot(*cm)) / DRUM_RADIUS, flying
 
 
-def turn(froude: float, threads: int | None, out: Path, duration: float, measure: float) -> dict:
+CYLINDER = """[[wall]]
+name = "drum"
+type = "cylinder"
+material = "liner"
+center = [0.0, 0.0]
+radius = 25.0e-3
+"""
+
+
+def faceted(facets: int, run: Path) -> grains.Scene:
+    """scenes/drum.toml with its cylinder replaced by a mesh tube of `facets` facets whose
+    middles touch it, longer than the periodic slice (z from -2 to 10 mm), written into `run`
+    and turning about the z axis."""
+    spec = importlib.util.spec_from_file_location("make_meshes", REPO / "scenes" / "meshes" / "make_meshes.py")
+    make = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(make)
+    make.write_stl(run / "drum.stl", "drum", make.tube(DRUM_RADIUS * 1e3, facets, -2.0, 10.0))
+    text = (REPO / "scenes" / "drum.toml").read_text()
+    assert CYLINDER in text, "scenes/drum.toml's drum wall changed: update examples/drum.py"
+    mesh = 'name = "drum"\ntype = "mesh"\nmaterial = "liner"\nfile = "drum.stl"\nscale = 0.001\ncenter = [0.0, 0.0, 0.0]\n'
+    return grains.Scene.from_toml(text.replace(CYLINDER, "[[wall]]\n" + mesh), path=run / "drum.toml")
+
+
+def turn(froude: float, threads: int | None, out: Path, duration: float, measure: float, facets: int | None = None) -> dict:
     """Fills the drum, turns it at `froude` for `duration` (s), or longer where the drum would
     not turn by a radian before the last `measure` seconds (the bed rises to its angle over
-    about half a radian), and averages the readings of those last seconds."""
+    about half a radian), and averages the readings of those last seconds; with `facets`, the
+    drum is a mesh of that many facets ([`faceted`])."""
     run = out / f"Fr_{froude:g}"
     run.mkdir(parents=True, exist_ok=True)
-    scene = grains.Scene.load(REPO / "scenes" / "drum.toml")
+    scene = grains.Scene.load(REPO / "scenes" / "drum.toml") if facets is None else faceted(facets, run)
     sim = grains.Simulation(scene, threads=threads, out=run, progress=False)
     fill = sim.run_stage()
     omega = omega_of(froude)
@@ -113,12 +142,13 @@ def main() -> None:
     parser.add_argument("--froude", default="0.001,0.01,0.1,0.3,1,1.5,2,3", help="Froude numbers, comma-separated")
     parser.add_argument("--turn", type=float, default=2.0, help="seconds the drum turns at each (at least a radian before the last --measure seconds)")
     parser.add_argument("--measure", type=float, default=1.0, help="the last seconds of each turn that are read")
+    parser.add_argument("--facets", type=int, default=None, help="a turning mesh drum of this many facets instead of the cylinder")
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
 
     rows = []
     for fr in (float(x) for x in args.froude.split(",")):
-        r = turn(fr, args.threads, args.out, args.turn, args.measure)
+        r = turn(fr, args.threads, args.out, args.turn, args.measure, args.facets)
         rows.append(r)
         print(f"Fr = {fr:g} (omega {r['omega_rad_s']:.3g} rad/s, {r['turns']:.2f} turns): surface {r['surface_deg']:.1f} +- {r['surface_sd_deg']:.1f} deg, "
               f"centre of mass {r['cm_deg']:.1f} +- {r['cm_sd_deg']:.1f} deg at {r['cm_radius']:.2f} R, {100 * r['in_flight']:.1f}% of the beads in flight"

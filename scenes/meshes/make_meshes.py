@@ -1,6 +1,7 @@
 """Writes the mesh walls the shipped scenes read, as ASCII STL in millimetres (the scenes give
 scale = 0.001): a flat plate with a circular orifice (scenes/silo.toml) and a conical hopper
-(scenes/hopper.toml). Plain Python, no packages.
+(scenes/hopper.toml); `tube` gives examples/drum.py its faceted drum. Plain Python, no
+packages.
 
     python scenes/meshes/make_meshes.py [--orifice MM] [--out DIR]
 
@@ -47,6 +48,17 @@ def ring(inner: list, outer: list) -> list:
         j = (k + 1) % SIDES
         out += [(inner[k], outer[k], outer[j]), (inner[k], outer[j], inner[j])]
     return out
+
+
+def tube(radius: float, facets: int, z_lo: float, z_hi: float) -> list:
+    """An open tube along z from z_lo to z_hi (mm) of `facets` flat facets whose middles touch
+    the circle of `radius` (a drum), one facet's middle facing +x; two triangles a facet."""
+    out = radius / math.cos(math.pi / facets)
+    corner = lambda k, z: (out * math.cos(2 * math.pi * (k - 0.5) / facets), out * math.sin(2 * math.pi * (k - 0.5) / facets), z)
+    tris = []
+    for k in range(facets):
+        tris += [(corner(k, z_lo), corner(k + 1, z_lo), corner(k + 1, z_hi)), (corner(k, z_lo), corner(k + 1, z_hi), corner(k, z_hi))]
+    return tris
 
 
 def orifice_plate(orifice: float, outer: float) -> list:
