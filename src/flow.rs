@@ -30,13 +30,24 @@ pub struct FlowState {
     pub counts: Vec<FlowCount>,
     /// The last step whose events have run.
     pub through_step: u64,
+    /// Grains in play times the steps they ran, summed (a flow scene's particle-steps: an
+    /// inlet's grains count from their insertion, an outlet's until their removal).
+    #[serde(default)]
+    pub grain_steps: u64,
 }
 
 impl FlowState {
     /// Nothing in or out yet.
     pub fn new(scene: &Scene) -> Self {
         let names = scene.inlets.iter().map(|i| &i.name).chain(scene.outlets.iter().map(|o| &o.name));
-        FlowState { counts: names.map(|n| FlowCount { name: n.clone(), ..Default::default() }).collect(), through_step: 0 }
+        FlowState { counts: names.map(|n| FlowCount { name: n.clone(), ..Default::default() }).collect(), through_step: 0, grain_steps: 0 }
+    }
+
+    /// Grains in play now: those in play from the start, plus the inlets', less the outlets'.
+    pub fn in_play(&self, scene: &Scene) -> u64 {
+        let start = (0..scene.grains.len()).filter(|&i| scene.grains.starts_in_play(i)).count() as u64;
+        let (inlets, outlets) = self.counts.split_at(scene.inlets.len());
+        start + inlets.iter().map(|c| c.grains).sum::<u64>() - outlets.iter().map(|c| c.grains).sum::<u64>()
     }
 
     /// Steps from `step` to the next step after it at which an inlet or outlet acts, if any.

@@ -172,7 +172,7 @@ impl Run {
         let Run { rec, out, progress, progress_bar, wall_seconds } = self;
         rec.finish()?;
         let threads = if engine.backend() == "cpu" { rayon::current_num_threads() } else { 1 };
-        let summary = Summary::new(scene, engine, threads, wall_seconds, progress.results)?;
+        let summary = Summary::new(scene, engine, threads, wall_seconds, progress.results, &progress.flow)?;
         let Some(dir) = out.as_deref() else { return Ok(summary) };
         if !summary.compression.is_empty() {
             let path = dir.join("compression.csv");

@@ -136,6 +136,23 @@ fn an_outlet_counts_each_grain_once() {
     assert!(f.position.iter().all(|p| p.z > 3.0e-3), "no grain in play lies in the outlet");
 }
 
+/// A flow scene's particle-steps (the summary's speed) count each grain from its insertion to
+/// its removal: the grains in play summed over the steps, read a step at a time.
+#[test]
+fn particle_steps_count_the_grains_in_play() {
+    let s = common::parse(&rain(0.02, 0.002, true, 0.35));
+    let mut e: grains::cpu::CpuEngine<f64> = common::engine(&s);
+    let mut progress = Progress::start(&s, &mut e).unwrap();
+    let (mut sum, total) = (0u64, s.max_steps());
+    while e.steps() < total {
+        sum += e.frame(false).unwrap().id.len() as u64;
+        progress.advance(&s, &mut e, 1).unwrap();
+    }
+    println!("{} grain-steps in play over {total} steps of {} slots", progress.flow.grain_steps, s.grains.len());
+    assert!(progress.flow.counts[1].grains > 0, "the outlet must have taken grains out");
+    assert_eq!(progress.flow.grain_steps, sum);
+}
+
 /// The GPU puts the same grains in at the same places and takes the same ones out as its CPU
 /// f32 twin: bitwise on a software adapter.
 #[test]

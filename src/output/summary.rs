@@ -45,7 +45,8 @@ pub struct Summary {
     pub simulated_time: f64,
     /// Wall-clock time of the stages (s).
     pub wall_seconds: f64,
-    /// Grains x steps / wall seconds.
+    /// Grains x steps / wall seconds; where grains enter and leave, the steps each grain ran
+    /// in play ([`crate::flow::FlowState::grain_steps`]).
     pub particle_steps_per_second: f64,
     /// Per-stage results.
     pub stages: Vec<StageResult>,
@@ -73,7 +74,7 @@ pub struct Summary {
 
 impl Summary {
     /// Summarises a finished run.
-    pub fn new(scene: &Scene, engine: &dyn Engine, threads: usize, wall_seconds: f64, stages: Vec<StageResult>) -> Result<Self, crate::engine::SimError> {
+    pub fn new(scene: &Scene, engine: &dyn Engine, threads: usize, wall_seconds: f64, stages: Vec<StageResult>, flow: &crate::flow::FlowState) -> Result<Self, crate::engine::SimError> {
         let last = stages.last().map(|s| &s.stats);
         let frame = engine.frame(false)?;
         let piston_z = last.and_then(|s| s.piston.as_ref().map(|p| p.z));
@@ -101,7 +102,7 @@ impl Summary {
             dt: scene.time_step.dt,
             simulated_time: engine.time(),
             wall_seconds,
-            particle_steps_per_second: engine.grain_count() as f64 * engine.steps() as f64 / wall_seconds.max(1e-9),
+            particle_steps_per_second: if scene.has_flow() { flow.grain_steps as f64 } else { engine.grain_count() as f64 * engine.steps() as f64 } / wall_seconds.max(1e-9),
             final_state: FinalState {
                 kinetic_energy: last.map_or(0.0, |s| s.kinetic_energy()),
                 packing_fraction: packing_fraction(scene, &frame, piston_z),

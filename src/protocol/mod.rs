@@ -174,6 +174,9 @@ impl Progress {
         while n > 0 {
             let to_event = self.flow.steps_to_next(scene, engine.steps()).unwrap_or(u64::MAX);
             let m = n.min(to_event);
+            if scene.has_flow() {
+                self.flow.grain_steps += self.flow.in_play(scene) * m;
+            }
             engine.advance(m)?;
             n -= m;
             if m == to_event {

@@ -324,6 +324,11 @@ impl Stage {
 }
 
 impl Scene {
+    /// Whether grains enter or leave (an `[[inlet]]` or an `[[outlet]]`).
+    pub fn has_flow(&self) -> bool {
+        !(self.inlets.is_empty() && self.outlets.is_empty())
+    }
+
     /// The mixed constants of materials `a` and `b` (indices into [`Self::materials`]).
     pub fn mixed(&self, a: usize, b: usize) -> MixedConstants {
         mixed_table(&self.materials, &self.pairs)[a * self.materials.len() + b]

@@ -124,7 +124,7 @@ impl<T: Real> Distributed<T> {
         if scene.walls.iter().any(|w| matches!(w.shape, crate::scene::WallShape::Mesh { .. })) {
             anyhow::bail!("{file}: mesh walls run on one process so far; fix: run it without mpirun");
         }
-        if !(scene.inlets.is_empty() && scene.outlets.is_empty()) {
+        if scene.has_flow() {
             anyhow::bail!("{file}: [[inlet]] and [[outlet]] run on one process so far; fix: run it without mpirun");
         }
         if scene.walls.iter().map(|w| &w.drive).chain(scene.stages.iter().flat_map(|s| s.walls.iter().map(|(_, d)| d))).any(|d| d.turns) {
