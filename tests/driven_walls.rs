@@ -200,10 +200,7 @@ fn a_run_with_driven_walls_resumes_bitwise() {
             }
             whole.advance(n).unwrap();
             first.advance(n / 3).unwrap();
-            let saved = first.save().unwrap();
-            let mut resumed = make(&s).unwrap();
-            resumed.restore(&saved).unwrap();
-            resumed.advance(n - n / 3).unwrap();
+            let mut resumed = common::resumed(make, &s, first.as_ref(), n - n / 3);
             let (a, b) = (whole.frame(false).unwrap(), resumed.frame(false).unwrap());
             assert_eq!((&a.position, &a.velocity, &a.angular_velocity, &a.walls), (&b.position, &b.velocity, &b.angular_velocity, &b.walls), "{name}");
             assert_eq!(whole.stats().unwrap().external_work, resumed.stats().unwrap().external_work, "{name}");

@@ -240,10 +240,7 @@ fn a_run_with_turning_walls_resumes_bitwise() {
             let mut first = make(&s).unwrap();
             whole.advance(n).unwrap();
             first.advance(n / 3).unwrap();
-            let saved = first.save().unwrap();
-            let mut resumed = make(&s).unwrap();
-            resumed.restore(&saved).unwrap();
-            resumed.advance(n - n / 3).unwrap();
+            let mut resumed = common::resumed(make, &s, first.as_ref(), n - n / 3);
             let (a, b) = (whole.frame(false).unwrap(), resumed.frame(false).unwrap());
             assert_eq!((&a.position, &a.velocity, &a.angular_velocity, &a.walls), (&b.position, &b.velocity, &b.angular_velocity, &b.walls), "{label} on {name}");
             assert_eq!(whole.stats().unwrap().external_work, resumed.stats().unwrap().external_work, "{label} on {name}");

@@ -133,10 +133,7 @@ fn the_gpu_swaps_floors_as_the_cpu_does_and_a_checkpoint_resumes_bitwise() {
         first.set_wall_present(1, true);
         let fall = s.stages[1].max_steps(s.time_step.dt);
         first.advance(fall / 3).unwrap();
-        let saved = first.save().unwrap();
-        let mut resumed = make(&s).unwrap();
-        resumed.restore(&saved).unwrap();
-        resumed.advance(fall - fall / 3).unwrap();
+        let resumed = common::resumed(make, &s, first.as_ref(), fall - fall / 3);
         let (a, b) = (whole.frame(false).unwrap(), resumed.frame(false).unwrap());
         println!("{name}: whole z {:e}, resumed z {:e}", a.position[0].z, b.position[0].z);
         assert_eq!((&a.position, &a.velocity, &a.angular_velocity), (&b.position, &b.velocity, &b.angular_velocity), "{name}");

@@ -78,6 +78,16 @@ pub fn resumable_engines() -> Vec<(&'static str, EngineMaker)> {
     makers
 }
 
+/// `first` saved and restored into a fresh engine of `make`'s for `scene`, then advanced by
+/// `rest` steps: the run resumed from a checkpoint taken where `first` stands.
+pub fn resumed(make: &EngineMaker, scene: &Scene, first: &dyn Engine, rest: u64) -> Box<dyn Engine> {
+    let saved = first.save().unwrap();
+    let mut resumed = make(scene).unwrap();
+    resumed.restore(&saved).unwrap();
+    resumed.advance(rest).unwrap();
+    resumed
+}
+
 /// `text` with each `(from, to)` replaced, failing loudly when a `from` is absent (so that a
 /// change to a shipped scene cannot silently leave a test on the wrong parameters).
 pub fn edit(text: &str, edits: &[(&str, &str)]) -> String {
